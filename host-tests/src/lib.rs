@@ -1,0 +1,9 @@
+//! Host side of `mccs`: the `f64` reference implementation, parameter files, and the
+//! `mccs` command-line tool. The reference is written independently of the fixed-point
+//! core (it shares only the parameter struct and its validation rules) so that the
+//! tests can catch the core's mistakes.
+#![deny(missing_docs)]
+
+pub mod cli;
+pub mod paramfile;
+pub mod reference;

@@ -1,0 +1,266 @@
+//! The `mccs` binary as a user runs it: output format, and one-line errors with exit 2.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mccs(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mccs"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run mccs")
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn temp_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mccs-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::File::create(&path)
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    path
+}
+
+/// Asserts exit 2, empty stdout, and one stderr line containing every `needle`.
+fn assert_usage_error(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(out.stdout.is_empty(), "stdout not empty");
+    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} lacks {n:?}");
+    }
+}
+
+const TABLE2: &str = include_str!("../../params/table2.toml");
+
+#[test]
+fn curve_prints_the_reference_csv() {
+    let out = mccs(&[
+        "curve",
+        "--params",
+        "params/table2.toml",
+        "--from",
+        "-0.2",
+        "--to",
+        "1.3",
+        "--step",
+        "0.1",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("strain,force_n,stiffness_n"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 16);
+    assert_eq!(rows[0][0], -0.2);
+    assert_eq!(rows[15][0], 1.3);
+    let r = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
+    for row in &rows {
+        assert_eq!(row[1], r.force(row[0]));
+        assert_eq!(row[2], r.stiffness(row[0]));
+    }
+    assert!(rows.windows(2).all(|w| w[1][1] > w[0][1]));
+}
+
+#[test]
+fn curve_fixed_backend_tracks_reference() {
+    let args = |b| {
+        mccs(&[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            "-0.5",
+            "--to",
+            "0.95",
+            "--step",
+            "0.01",
+            "--backend",
+            b,
+        ])
+    };
+    let (a, b) = (args("reference"), args("fixed"));
+    assert!(a.status.success() && b.status.success());
+    let (a, b) = (
+        String::from_utf8(a.stdout).unwrap(),
+        String::from_utf8(b.stdout).unwrap(),
+    );
+    assert_eq!(a.lines().count(), b.lines().count());
+    for (x, y) in a.lines().zip(b.lines()).skip(1) {
+        let x: Vec<f64> = x.split(',').map(|v| v.parse().unwrap()).collect();
+        let y: Vec<f64> = y.split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(x[0], y[0]);
+        assert!((x[1] - y[1]).abs() < 1e-4, "{x:?} vs {y:?}");
+    }
+}
+
+#[test]
+fn bad_files_name_file_and_key() {
+    let missing = temp_file("missing.toml", &TABLE2.replace("active_coils = 5.0\n", ""));
+    let out = mccs(&[
+        "curve",
+        "--params",
+        missing.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["missing.toml", "cone.active_coils", "missing"]);
+
+    let neg = temp_file(
+        "neg.toml",
+        &TABLE2.replace("mean_diameter = 0.2", "mean_diameter = -0.2"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        neg.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["neg.toml", "linear.mean_diameter", "> 0"]);
+
+    let nan = temp_file(
+        "nan.toml",
+        &TABLE2.replace("shear_modulus = 1.8472e5", "shear_modulus = nan"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        nan.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["nan.toml", "cone.shear_modulus", "finite"]);
+
+    let order = temp_file(
+        "order.toml",
+        &TABLE2.replace("large_diameter = 0.8", "large_diameter = 0.3"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        order.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["order.toml", "cone.large_diameter"]);
+
+    let text = temp_file(
+        "text.toml",
+        &TABLE2.replace("active_coils = 10.0", "active_coils = \"ten\""),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        text.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["text.toml", "linear.active_coils", "number"]);
+
+    let typo = temp_file(
+        "typo.toml",
+        &TABLE2.replace("wire_diameter = 0.1", "wire_diametr = 0.1"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        typo.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["typo.toml", "cone.wire_diametr", "unknown"]);
+
+    let bad = temp_file("bad.toml", "[cone\nwire_diameter = 1");
+    let out = mccs(&[
+        "curve",
+        "--params",
+        bad.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["bad.toml", "line 1", "TOML"]);
+
+    let out = mccs(&[
+        "curve",
+        "--params",
+        "no/such.toml",
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["no/such.toml", "cannot read"]);
+
+    let pre = temp_file("pre.toml", &format!("{TABLE2}preload = 11.0\n"));
+    let out = mccs(&[
+        "curve",
+        "--params",
+        pre.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["pre.toml", "linear.preload"]);
+}
+
+#[test]
+fn bad_ranges_name_the_argument() {
+    let base = ["curve", "--params", "params/table2.toml"];
+    for (extra, needle) in [
+        (["--from", "0", "--to", "1", "--step", "0"], "--step"),
+        (["--from", "0", "--to", "1", "--step", "-0.1"], "--step"),
+        (["--from", "1", "--to", "0", "--step", "0.1"], "--to"),
+        (["--from", "nan", "--to", "1", "--step", "0.1"], "--from"),
+        (["--from", "0", "--to", "inf", "--step", "0.1"], "--to"),
+        (["--from", "0", "--to", "1", "--step", "1e-12"], "--step"),
+        (["--from", "0", "--to", "x", "--step", "0.1"], "--to"),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra.iter()).copied().collect();
+        assert_usage_error(&mccs(&args), &[needle]);
+    }
+    assert_usage_error(&mccs(&["curve", "--from", "0"]), &["--params"]);
+    assert_usage_error(&mccs(&["frobnicate"]), &["frobnicate"]);
+}

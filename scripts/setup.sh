@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs what the project needs on a fresh machine: the three thumb targets, and
+# Debian's qemu-system-arm (as root). Sourced by scripts/demo.sh and scripts/test.sh.
+set -euo pipefail
+
+need_targets=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
+have_targets=$(rustup target list --installed)
+for t in "${need_targets[@]}"; do
+  if ! grep -qx "$t" <<<"$have_targets"; then
+    echo "setup: rustup target add $t" >&2
+    rustup target add "$t" >&2
+  fi
+done
+
+if ! command -v qemu-system-arm >/dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ]; then
+    echo "setup: installing Debian's qemu-system-arm" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >&2
+    apt-get install -y -qq qemu-system-arm >/dev/null
+  else
+    echo "setup: qemu-system-arm is missing and this is not root: run 'sudo apt-get install qemu-system-arm' and try again" >&2
+    exit 1
+  fi
+fi

@@ -1,0 +1,192 @@
+//! The MCCS law in `f64`, used only when a [`ForceTable`](crate::ForceTable) is built.
+//!
+//! Never called per tick. It follows MODEL.md: `Δ(F) = Δ_cone(F) + max(0, F − P)/k_p`,
+//! where the cone is linear (`F/k`) up to `F_T`, follows eq. 11 up to `F_C`, and is solid
+//! (`H`) beyond, and the series spring, preloaded with `P`, moves only once the load
+//! exceeds `P`. With the default `P = F_T` this is exactly MODEL.md's three pieces; for
+//! another preload it is the continuous, increasing law that MODEL.md's pieces would be
+//! if they kept the preload's meaning (MODEL.md writes `(F − P)/k_p` from `F_T` on, which
+//! jumps at `F_T` or runs backwards when `P ≠ F_T`).
+//!
+//! `Δ` is the compressive strain of an edge; `F` its force in N.
+//!
+//! The inverse `F(Δ)` is a bracketed Newton iteration between the first kink and `F_C`
+//! with a bisection fallback (at most 200 steps, typically 5); the host reference
+//! (`mccs-host`) inverts the same law by a different route (Ferrari's closed form) and
+//! the tests hold the two against each other.
+
+use crate::params::{ParamError, Params};
+
+/// A validated spring with its derived constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    /// Linear-phase stiffness `k` (N per unit strain), eq. 1.
+    pub k: f64,
+    /// Transition force `F_T` (N): the largest coil closes.
+    pub f_t: f64,
+    /// Solid force `F_C` (N): the smallest coil closes.
+    pub f_c: f64,
+    /// Series-spring stiffness `k_p` (N per unit strain).
+    pub k_p: f64,
+    /// Series-spring preload `P` (N), below `F_C`.
+    pub preload: f64,
+    /// `H`, compressible height.
+    h: f64,
+    d1: f64,
+    d2: f64,
+    /// `H G d^4 / (8 n)`: `D_c^3 · F`.
+    a: f64,
+    /// `2 n / (G d^4 (D2 - D1))`.
+    b: f64,
+}
+
+impl Law {
+    /// Validates `params` and derives the constants of MODEL.md.
+    pub fn new(params: &Params) -> Result<Self, ParamError> {
+        params.validate()?;
+        let c = &params.cone;
+        let l = &params.linear;
+        let gd4 = c.shear_modulus * pow4(c.wire_diameter);
+        let (d1, d2, n, h) = (
+            c.small_diameter,
+            c.large_diameter,
+            c.active_coils,
+            c.compressible_height,
+        );
+        let k = gd4 / (2.0 * n * (d1 * d1 + d2 * d2) * (d1 + d2));
+        let f_t = gd4 * h / (8.0 * n * d2 * d2 * d2);
+        let f_c = gd4 * h / (8.0 * n * d1 * d1 * d1);
+        let dp = l.mean_diameter;
+        let k_p = l.shear_modulus * pow4(l.wire_diameter) / (8.0 * l.active_coils * dp * dp * dp);
+        Ok(Self {
+            k,
+            f_t,
+            f_c,
+            k_p,
+            preload: l.preload.unwrap_or(f_t),
+            h,
+            d1,
+            d2,
+            a: h * gd4 / (8.0 * n),
+            b: 2.0 * n / (gd4 * (d2 - d1)),
+        })
+    }
+
+    /// The force where the law first leaves the line `k ε`: `min(F_T, P)`.
+    pub fn first_kink(&self) -> f64 {
+        libm::fmin(self.f_t, self.preload)
+    }
+
+    /// Strain where the law first leaves the line `k ε`, `Δ(min(F_T, P))`.
+    pub fn strain_t(&self) -> f64 {
+        self.delta(self.first_kink())
+    }
+
+    /// Strain at which the cone is solid, `Δ(F_C)`.
+    pub fn strain_c(&self) -> f64 {
+        self.delta(self.f_c)
+    }
+
+    /// Diameter above which coils are closed at force `f` (eq. 5), `f > 0`.
+    fn closed_diameter(&self, f: f64) -> f64 {
+        libm::cbrt(self.a / f)
+    }
+
+    /// Forward law `Δ(F)`: strain at force `f` (N). Defined for every finite `f`.
+    pub fn delta(&self, f: f64) -> f64 {
+        let cone = if f <= self.f_t {
+            f / self.k
+        } else if f < self.f_c {
+            let dc = self.closed_diameter(f);
+            self.b * f * (pow4(dc) - pow4(self.d1)) + self.h * (self.d2 - dc) / (self.d2 - self.d1)
+        } else {
+            self.h
+        };
+        cone + libm::fmax(f - self.preload, 0.0) / self.k_p
+    }
+
+    /// The cone's `dΔ/dF` in its nonlinear phase.
+    fn cone_compliance(&self, f: f64) -> f64 {
+        let dc = self.closed_diameter(f);
+        self.b * (pow4(dc) - pow4(self.d1))
+    }
+
+    /// `dΔ/dF` at force `f`, analytic; at a kink, the derivative from below.
+    pub fn compliance(&self, f: f64) -> f64 {
+        let cone = if f <= self.f_t {
+            1.0 / self.k
+        } else if f <= self.f_c {
+            self.cone_compliance(f)
+        } else {
+            0.0
+        };
+        cone + if f > self.preload {
+            1.0 / self.k_p
+        } else {
+            0.0
+        }
+    }
+
+    /// `dΔ/dF` at force `f`, analytic; at a kink, the derivative from above.
+    pub fn compliance_above(&self, f: f64) -> f64 {
+        let cone = if f < self.f_t {
+            1.0 / self.k
+        } else if f < self.f_c {
+            self.cone_compliance(f)
+        } else {
+            0.0
+        };
+        cone + if f >= self.preload {
+            1.0 / self.k_p
+        } else {
+            0.0
+        }
+    }
+
+    /// Inverse law `F(Δ)`: force (N) at strain `strain`, and the tangent stiffness
+    /// `dF/dΔ` (N per unit strain) there; at a kink, the stiffness from below.
+    pub fn force_and_stiffness(&self, strain: f64) -> (f64, f64) {
+        let f = self.force(strain);
+        (f, 1.0 / self.compliance(f))
+    }
+
+    /// Inverse law `F(Δ)` (N).
+    pub fn force(&self, strain: f64) -> f64 {
+        let f1 = self.first_kink();
+        let (e_1, e_c) = (self.delta(f1), self.strain_c());
+        if strain <= e_1 {
+            return strain * self.k;
+        }
+        if strain >= e_c {
+            return self.preload + (strain - self.h) * self.k_p;
+        }
+        // Bracketed Newton on the increasing strain curve.
+        let (mut lo, mut hi) = (f1, self.f_c);
+        let mut f = f1 + (strain - e_1) / self.compliance_above(f1);
+        if !(f > lo && f < hi) {
+            f = 0.5 * (lo + hi);
+        }
+        for _ in 0..200 {
+            let r = self.delta(f) - strain;
+            if r > 0.0 {
+                hi = f;
+            } else {
+                lo = f;
+            }
+            let mut next = f - r / self.compliance(f);
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if libm::fabs(next - f) <= 1e-15 * f || hi - lo <= 1e-15 * hi {
+                return next;
+            }
+            f = next;
+        }
+        f
+    }
+}
+
+fn pow4(x: f64) -> f64 {
+    let x2 = x * x;
+    x2 * x2
+}
