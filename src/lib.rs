@@ -13,6 +13,7 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+pub mod entry;
 pub mod law;
 pub mod params;
 pub mod table;

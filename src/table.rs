@@ -9,8 +9,9 @@
 //! the tangent there (an under-estimate of the stiffening law above the edge).
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
-//! analytic slopes `dF/dε` there, stored as power-basis coefficients in `t ∈ [0, 1)`
-//! (`4 × i32`, 16 bytes per segment: 1 KiB for 65 knots). The last coefficient is
+//! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
+//! the law bends harder than the grid resolves, so that the curve stays monotone), stored as power-basis coefficients in `t ∈ [0, 1)`
+//! (`3 × i32` per segment, the cubic coefficient implied by the next knot: 812 bytes in all for 65 knots). The last coefficient is
 //! rounded so that each segment ends bit-exactly on the next knot, and the straight
 //! lines are anchored on the end knots, so the fixed-point curve is continuous.
 //!
@@ -53,16 +54,29 @@ pub struct RawTable<const S: usize> {
     pub strain_hi: i32,
     /// Segments per unit strain (Q16).
     pub segments_per_strain: i32,
-    /// The line below `strain_lo` is `(stiffness_lo · ε) >> 20 + offset_lo` (Q20 N).
-    pub offset_lo: i32,
+    /// The line below `strain_lo` passes through (`anchor_lo`, `force_lo`) (Q24, Q20 N):
+    /// through zero when the table starts at the kink, else through the first knot.
+    pub anchor_lo: i32,
+    /// See `anchor_lo`.
+    pub force_lo: i32,
     /// Slope of the line below `strain_lo` (Q16 N per unit strain).
     pub stiffness_lo: i32,
-    /// The line above `strain_hi` is `(stiffness_hi · ε) >> 20 + offset_hi` (Q20 N).
-    pub offset_hi: i32,
+    /// The line above `strain_hi` passes through (`strain_hi`, `force_hi`) (Q20 N).
+    pub force_hi: i32,
     /// Slope of the line above `strain_hi` (Q16 N per unit strain).
     pub stiffness_hi: i32,
-    /// Per segment: `F(t) = c0 + c1 t + c2 t² + c3 t³`, Q20 N, `t ∈ [0, 1)`.
-    pub coeffs: [[i32; 4]; S],
+    /// Extra fraction bits of the knot values `c0`: Q(20 + `value_shift`) N, 0 … 10.
+    pub value_shift: u32,
+    /// Extra fraction bits of `c1, c2, c3`: Q(20 + `poly_shift`) N, `value_shift` … 24.
+    pub poly_shift: u32,
+    /// Per segment `[c0, c1, c2]` of `F(t) = c0 + c1 t + c2 t² + c3 t³`, `t ∈ [0, 1)`:
+    /// `c0` is the knot value, and `c3` is implied, since the cubic ends on the next knot:
+    /// `c3 = ((c0' − c0) << (poly_shift − value_shift)) − c1 − c2`. The shifts are chosen
+    /// per table so that each part uses most of `i32`: the knots keep sub-Q20 precision,
+    /// and a small slope under a large force keeps its resolution.
+    pub segments: [[i32; 3]; S],
+    /// The last knot's value, Q(20 + `value_shift`) N.
+    pub knot_last: i32,
 }
 
 /// A tabulated inverse law with `S` segments (`S + 1` knots); see the module docs.
@@ -181,68 +195,157 @@ impl<const S: usize> ForceTable<S> {
         if hi <= lo {
             return Err(TableError::NoNonlinearPhase);
         }
-        let strain_lo = q(lo, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        // A preload above F_T puts the law's one slope kink, Δ(P), inside the table. The
+        // grid is then placed so that a knot falls on it, and the two segments meeting
+        // there get the two one-sided slopes: the first knot moves down (into the exact
+        // linear phase, or below the domain) by less than a segment, and the step grows
+        // only if the table would otherwise end short of `hi`.
+        let e_p = law.delta(law.preload);
+        let mut kink_knot = None;
+        let mut lo_grid = lo;
+        let mut width = hi - lo;
+        if law.preload > law.f_t && e_p > lo && e_p < hi {
+            let mut step = width / S as f64;
+            let j = libm::ceil((e_p - lo) / step);
+            if j < S as f64 {
+                step = libm::fmax(step, (hi - e_p) / (S as f64 - j));
+                lo_grid = e_p - j * step;
+                width = S as f64 * step;
+                kink_knot = Some(j as usize);
+            }
+        }
+        let strain_lo = q(lo_grid, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        let grid_moved = lo_grid < lo;
         let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
-        let per_strain = q(S as f64 / (hi - lo), U_FRAC).ok_or(TableError::TooNarrow)?;
+        let per_strain = q(S as f64 / width, U_FRAC).ok_or(TableError::TooNarrow)?;
         if per_strain <= 0 {
             return Err(TableError::TooNarrow);
         }
         // The evaluation places knot i at lo + i / per_strain: build at exactly those strains.
         let step = (1u64 << U_FRAC) as f64 / per_strain as f64;
-        let knot = |i: usize| -> Result<(i32, f64), TableError> {
+        let unit = (1u64 << FORCE_FRAC) as f64;
+        // Knot i: force, and the slopes dF/dt (per segment) from below and from above,
+        // all in Q20 N units, unrounded.
+        let knot = |i: usize| -> Result<(f64, f64, f64), TableError> {
             let e = lo + i as f64 * step;
             let f = law.force(e);
-            // The right-hand slope (at F_T the nonlinear phase starts).
-            let slope = 1.0 / law.compliance_above(f);
-            let fq = q(f, FORCE_FRAC).ok_or(TableError::OutOfRange)?;
-            Ok((fq, slope * step * (1u64 << FORCE_FRAC) as f64))
-        };
-        let below = if at_kink {
-            law.k
-        } else {
-            1.0 / law.compliance(law.force(lo))
-        };
-        let stiffness_lo = q(below, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
-        let mut coeffs = [[0i32; 4]; S];
-        let (mut f0, mut m0) = knot(0)?;
-        // At the kink the line below is `k ε` exactly (zero force at zero strain), and the
-        // first knot takes the line's value so that the curve is continuous bit for bit.
-        let offset_lo = if at_kink {
-            f0 = sat_i32(line_bits(stiffness_lo, strain_lo));
-            0
-        } else {
-            f0.wrapping_sub(sat_i32(line_bits(stiffness_lo, strain_lo)))
-        };
-        for (i, c) in coeffs.iter_mut().enumerate() {
-            let (f1, m1) = knot(i + 1)?;
-            let df = f1 as f64 - f0 as f64;
-            let c1 = libm::round(m0);
-            let c2 = libm::round(3.0 * df - 2.0 * m0 - m1);
-            let c3 = df - c1 - c2; // exact: the segment ends on the next knot
-            if libm::fabs(c1) > 1.0e9 || libm::fabs(c2) > 1.0e9 || libm::fabs(c3) > 1.0e9 {
+            // At a kink, the one-sided slopes at the kink itself (the knot's strain is
+            // rounded, and may sit a hair to either side). The first knot's segment lies
+            // above the kink it starts at.
+            let f_slope = if kink_knot == Some(i) {
+                law.preload
+            } else if i == 0 && at_kink && !grid_moved {
+                libm::fmax(f, law.first_kink())
+            } else {
+                f
+            };
+            let below = 1.0 / law.compliance(f_slope);
+            let above = 1.0 / law.compliance_above(f_slope);
+            if !(libm::fabs(f * unit) < (1u64 << 31) as f64
+                && below.is_finite()
+                && above.is_finite())
+            {
                 return Err(TableError::OutOfRange);
             }
-            *c = [f0, c1 as i32, c2 as i32, c3 as i32];
-            (f0, m0) = (f1, m1);
+            Ok((f * unit, below * step * unit, above * step * unit))
+        };
+        // First pass: the largest knot value and the largest polynomial coefficient bound
+        // (|c1|, |c2|, |c3| ≤ 3|secant| + 3 max|slope|) pick the two shifts.
+        let (mut big_value, mut big_poly) = (1.0f64, 1.0f64);
+        let mut prev = knot(0)?;
+        for i in 0..=S {
+            let k = if i == 0 { prev } else { knot(i)? };
+            let secant = libm::fabs(k.0 - prev.0);
+            let slopes = libm::fmax(libm::fabs(k.1), libm::fabs(prev.2));
+            big_value = libm::fmax(big_value, libm::fabs(k.0));
+            big_poly = libm::fmax(big_poly, 3.0 * secant + 3.0 * slopes);
+            prev = k;
         }
+        let fits = |big: f64, shift: u32| big * (1u64 << shift) as f64 <= (1u64 << 29) as f64;
+        let mut value_shift = 0u32;
+        while value_shift < 10 && fits(big_value, value_shift + 1) {
+            value_shift += 1;
+        }
+        let mut poly_shift = value_shift;
+        while poly_shift < 24 && fits(big_poly, poly_shift + 1) {
+            poly_shift += 1;
+        }
+        let (vscale, pscale) = ((1u64 << value_shift) as f64, (1u64 << poly_shift) as f64);
+        // Second pass: the segments, knots rounded to Q(20 + value_shift).
+        let round_knot = |f: f64| -> f64 { libm::round(f * vscale) };
+        let (f_first, _, m_first) = knot(0)?;
+        let mut segments = [[0i32; 3]; S];
+        let (mut a0, mut m0) = (round_knot(f_first), m_first);
+        let a_first = a0;
+        for (i, c) in segments.iter_mut().enumerate() {
+            let (f1, m1, m1_above) = knot(i + 1)?;
+            let a1 = round_knot(f1);
+            // In the polynomial's scale: secant and end slopes.
+            let secant = (a1 - a0) * (pscale / vscale);
+            let (mut s0, mut s1) = (m0 * pscale, m1 * pscale);
+            // Fritsch–Carlson: where the law bends harder than the grid resolves (a soft
+            // cone against a stiff series spring, just below the solid point), scale the
+            // end slopes of this segment into the circle α² + β² ≤ 9 that keeps the cubic
+            // monotone. Smooth laws (Table 2) never reach it.
+            if secant > 0.0 {
+                let (al, be) = (s0 / secant, s1 / secant);
+                let r2 = al * al + be * be;
+                if r2 > 9.0 {
+                    let tau = 3.0 / libm::sqrt(r2);
+                    (s0, s1) = (tau * s0, tau * s1);
+                }
+            }
+            let c1 = libm::round(s0);
+            let c2 = libm::round(3.0 * secant - 2.0 * s0 - s1);
+            let c3 = secant - c1 - c2; // exact: the segment ends on the next knot
+            let limit = (1u64 << 30) as f64;
+            if [a0, c1, c2, c3].iter().any(|v| libm::fabs(*v) >= limit) {
+                return Err(TableError::OutOfRange);
+            }
+            *c = [a0 as i32, c1 as i32, c2 as i32];
+            (a0, m0) = (a1, m1_above);
+        }
+        // The lines are anchored on the end knots floored to Q20: the table's own values
+        // floor the same way, so the curve stays monotone across the anchors.
+        let first_q20 = (a_first as i32) >> value_shift;
+        let last_q20 = (a0 as i32) >> value_shift;
         let e_hi = lo + S as f64 * step;
         let strain_hi = q(e_hi, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        // Line below: exact `k` when the table starts at the kink, else the tangent.
+        // Below the table: at the kink, the exact line `k ε` through zero, with `k` rounded
+        // down so that the line never passes above the first knot (the curve stays
+        // monotone; the step up at the knot is `(k − k_q) ε_lo` ≤ 2^-16 ε_lo N). Otherwise
+        // the tangent at the domain edge, through the first knot. Above the table, the
+        // line through the last knot: `k_p` when the table ends at the solid point, else
+        // the tangent there.
+        let (stiffness_lo, anchor_lo, force_lo) = if at_kink {
+            let kq = libm::floor(law.k * (1u64 << STIFF_FRAC) as f64);
+            if kq > i32::MAX as f64 {
+                return Err(TableError::OutOfRange);
+            }
+            (kq as i32, 0, 0)
+        } else {
+            let kq =
+                q(1.0 / law.compliance(law.force(lo)), STIFF_FRAC).ok_or(TableError::OutOfRange)?;
+            (kq, strain_lo, first_q20)
+        };
         let above = if at_solid {
             law.k_p
         } else {
             1.0 / law.compliance(law.force(e_hi))
         };
-        let stiffness_hi = q(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
         let raw = RawTable {
             strain_lo,
             strain_hi,
             segments_per_strain: per_strain,
-            offset_lo,
+            anchor_lo,
+            force_lo,
             stiffness_lo,
-            offset_hi: f0.wrapping_sub(sat_i32(line_bits(stiffness_hi, strain_hi))),
-            stiffness_hi,
-            coeffs,
+            force_hi: last_q20,
+            stiffness_hi: q(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
+            value_shift,
+            poly_shift,
+            segments,
+            knot_last: a0 as i32,
         };
         Ok(Self { raw })
     }
@@ -287,13 +390,13 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
-            return line(r.stiffness_lo, e, r.offset_lo);
+            return line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
         }
         if e >= r.strain_hi {
-            return line(r.stiffness_hi, e, r.offset_hi);
+            return line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
         }
         let (c, t) = self.segment(e);
-        Force::from_bits(horner(c, t))
+        Force::from_bits(value(r, &c, poly(&c, t)))
     }
 
     /// Force (N) and tangent stiffness `dF/dε` (N per unit strain) at `strain`;
@@ -303,50 +406,62 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
-            let f = line(r.stiffness_lo, e, r.offset_lo);
+            let f = line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
             return (f, Stiffness::from_bits(r.stiffness_lo));
         }
         if e >= r.strain_hi {
-            let f = line(r.stiffness_hi, e, r.offset_hi);
+            let f = line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
             return (f, Stiffness::from_bits(r.stiffness_hi));
         }
         let (c, t) = self.segment(e);
-        let f = horner(c, t);
+        let f = value(r, &c, poly(&c, t));
         // dF/dt = c1 + 2 c2 t + 3 c3 t², then dF/dε = dF/dt · segments per strain.
         let c2x2 = c[2].saturating_mul(2);
         let c3x3 = c[3].saturating_mul(3);
         let dfdt = c[1].saturating_add(mul_q16(c2x2.saturating_add(mul_q16(c3x3, t)), t));
-        let k = (dfdt as i64 * r.segments_per_strain as i64) >> (FORCE_FRAC + U_FRAC - STIFF_FRAC);
+        let k = (dfdt as i64 * r.segments_per_strain as i64)
+            >> (FORCE_FRAC + U_FRAC - STIFF_FRAC + r.poly_shift);
         (Force::from_bits(f), Stiffness::from_bits(sat_i32(k)))
     }
 
     /// The segment holding `e` (strictly inside the table) and the Q16 position in it.
     #[inline(always)]
-    fn segment(&self, e: i32) -> (&[i32; 4], i32) {
+    fn segment(&self, e: i32) -> ([i32; 4], i32) {
         let r = &self.raw;
         let u = ((e.wrapping_sub(r.strain_lo) as u32 as i64 * r.segments_per_strain as i64)
             >> STRAIN_FRAC) as u64;
         let i = ((u >> U_FRAC) as usize).min(S - 1);
         let t = (u - ((i as u64) << U_FRAC)).min((1 << U_FRAC) - 1) as i32;
-        (&r.coeffs[i], t)
+        let [c0, c1, c2] = r.segments[i];
+        let next = if i + 1 < S {
+            r.segments[i + 1][0]
+        } else {
+            r.knot_last
+        };
+        let secant = next.wrapping_sub(c0) << (r.poly_shift - r.value_shift);
+        ([c0, c1, c2, secant.wrapping_sub(c1).wrapping_sub(c2)], t)
     }
 }
 
+/// `c1 t + c2 t² + c3 t³` in the polynomial's scale, Q(20 + `poly_shift`).
 #[inline(always)]
-fn horner(c: &[i32; 4], t: i32) -> i32 {
+fn poly(c: &[i32; 4], t: i32) -> i32 {
     let a = c[2].saturating_add(mul_q16(c[3], t));
     let a = c[1].saturating_add(mul_q16(a, t));
-    c[0].saturating_add(mul_q16(a, t))
+    mul_q16(a, t)
 }
 
-/// `(k · e) >> 20` in Q20 N from a Q16 slope and a Q24 strain, unsaturated.
+/// `c0 + poly` in Q20 N.
 #[inline(always)]
-fn line_bits(k: i32, e: i32) -> i64 {
-    (k as i64 * e as i64) >> (STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC)
+fn value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], poly: i32) -> i32 {
+    c[0].saturating_add(poly >> (r.poly_shift - r.value_shift)) >> r.value_shift
 }
 
-/// `(k · e) >> 20 + offset` in Q20 N; saturating.
+/// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;
+/// saturating. `k ≥ 0` and `|e − e0| < 2^32` keep the product within `i64`.
 #[inline(always)]
-fn line(k: i32, e: i32, offset: i32) -> Force {
-    Force::from_bits(sat_i32(line_bits(k, e) + offset as i64))
+fn line(f0: i32, k: i32, e: i32, e0: i32) -> Force {
+    let de = e as i64 - e0 as i64;
+    let df = (k as i64 * de) >> (STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC);
+    Force::from_bits(sat_i32(f0 as i64 + df))
 }

@@ -176,14 +176,34 @@ fn table<const S: usize>(
     from: f64,
     to: f64,
 ) -> Result<ForceTable<S>, CliError> {
-    ForceTable::<S>::with_domain(p, from, to).map_err(|e| match e {
-        TableError::Param(pe) => file_error(file, pe),
-        TableError::BadDomain | TableError::NoNonlinearPhase | TableError::TooNarrow => {
-            CliError(format!(
-                "--from/--to: {}",
-                e.to_string().trim_start_matches("domain: ")
-            ))
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if !v.is_finite() || v.abs() >= 127.0 {
+            return Err(arg_error(name, "must be a finite strain within ±127"));
         }
+    }
+    if from >= to {
+        return Err(arg_error("--to", "must be > --from"));
+    }
+    let law = mccs::Law::new(p).map_err(|e| file_error(file, e))?;
+    ForceTable::<S>::from_law(&law, from, to).map_err(|e| match e {
+        TableError::NoNonlinearPhase if to <= law.strain_t() => arg_error(
+            "--to",
+            &format!(
+                "must exceed {:.6}, where this spring's law stops being linear",
+                law.strain_t()
+            ),
+        ),
+        TableError::NoNonlinearPhase => arg_error(
+            "--from",
+            &format!(
+                "must be below {:.6}, where this spring's cone is solid",
+                law.strain_c()
+            ),
+        ),
+        TableError::TooNarrow => arg_error(
+            "--from/--to",
+            "the nonlinear phase inside them is too narrow for this many knots",
+        ),
         other => CliError(format!("{}: {other}", file.display())),
     })
 }
@@ -267,20 +287,21 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
         ("strain_lo", r.strain_lo),
         ("strain_hi", r.strain_hi),
         ("segments_per_strain", r.segments_per_strain),
-        ("offset_lo", r.offset_lo),
+        ("anchor_lo", r.anchor_lo),
+        ("force_lo", r.force_lo),
         ("stiffness_lo", r.stiffness_lo),
-        ("offset_hi", r.offset_hi),
+        ("force_hi", r.force_hi),
         ("stiffness_hi", r.stiffness_hi),
     ] {
         s.push_str(&format!("    {name}: {v},\n"));
     }
-    s.push_str("    coeffs: [\n");
-    for c in &r.coeffs {
-        s.push_str(&format!(
-            "        [{}, {}, {}, {}],\n",
-            c[0], c[1], c[2], c[3]
-        ));
+    for (name, v) in [("value_shift", r.value_shift), ("poly_shift", r.poly_shift)] {
+        s.push_str(&format!("    {name}: {v},\n"));
     }
-    s.push_str("    ],\n})\n");
+    s.push_str("    segments: [\n");
+    for c in &r.segments {
+        s.push_str(&format!("        [{}, {}, {}],\n", c[0], c[1], c[2]));
+    }
+    s.push_str(&format!("    ],\n    knot_last: {},\n}})\n", r.knot_last));
     s
 }

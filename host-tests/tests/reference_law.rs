@@ -1,7 +1,10 @@
 //! The f64 reference law against an independent coil-by-coil oracle, its invariants,
 //! its two inverses against each other, and random springs (proptest).
 
-use mccs::{Cone, Linear, ParamError, ParamKey, Params};
+mod common;
+
+use common::any_spring;
+use mccs::{Cone, ParamError, ParamKey, Params};
 use mccs_host::reference::Reference;
 use proptest::prelude::*;
 
@@ -252,38 +255,6 @@ fn every_invalid_parameter_is_named() {
             ParamKey::ConeLargeDiameter
         );
     }
-}
-
-/// Random valid springs around Table 2 (each value × 0.3 … 3, D2 > D1).
-pub fn any_spring() -> impl Strategy<Value = Params> {
-    let f = || 0.3f64..3.0;
-    (
-        (f(), f(), 1.05f64..4.0, f(), f(), f()),
-        (f(), f(), f(), f(), prop::option::of(0.3f64..3.0)),
-    )
-        .prop_map(|((d, d1, ratio, n, h, g), (dp, dmp, np, gp, pre))| {
-            let t = Params::TABLE2;
-            let small = t.cone.small_diameter * d1;
-            let cone = Cone {
-                wire_diameter: t.cone.wire_diameter * d,
-                small_diameter: small,
-                large_diameter: small * ratio,
-                active_coils: t.cone.active_coils * n,
-                compressible_height: t.cone.compressible_height * h,
-                shear_modulus: t.cone.shear_modulus * g,
-            };
-            let f_t = Reference::cone_only(&cone).f_t;
-            Params {
-                cone,
-                linear: Linear {
-                    wire_diameter: t.linear.wire_diameter * dp,
-                    mean_diameter: t.linear.mean_diameter * dmp,
-                    active_coils: t.linear.active_coils * np,
-                    shear_modulus: t.linear.shear_modulus * gp,
-                    preload: pre.map(|x| (x * f_t).min(0.9 * Reference::cone_only(&cone).f_c)),
-                },
-            }
-        })
 }
 
 proptest! {

@@ -1,0 +1,56 @@
+//! Shared test helpers: random valid springs.
+#![allow(dead_code)]
+
+use mccs::{Cone, Linear, Params};
+use mccs_host::reference::Reference;
+use proptest::prelude::*;
+
+/// Random valid springs around Table 2: each value × 0.3 … 3, `D2/D1` in 1.05 … 4, and an
+/// optional preload of 0.3 … 3 `F_T` (capped at 0.9 `F_C`).
+pub fn any_spring() -> impl Strategy<Value = Params> {
+    any_spring_with(1.05, prop::option::of(0.3f64..3.0))
+}
+
+/// As [`any_spring`], with the default preload `P = F_T` and `D2/D1` from `min_ratio`.
+pub fn any_spring_default_preload(min_ratio: f64) -> impl Strategy<Value = Params> {
+    any_spring_with(min_ratio, Just(None))
+}
+
+/// As [`any_spring`], always with a preload (0.3 … 3 `F_T`), `D2/D1` from `min_ratio`.
+pub fn any_spring_with_preload(min_ratio: f64) -> impl Strategy<Value = Params> {
+    any_spring_with(min_ratio, (0.3f64..3.0).prop_map(Some))
+}
+
+fn any_spring_with(
+    min_ratio: f64,
+    preload: impl Strategy<Value = Option<f64>>,
+) -> impl Strategy<Value = Params> {
+    let f = || 0.3f64..3.0;
+    (
+        (f(), f(), min_ratio..4.0, f(), f(), f()),
+        (f(), f(), f(), f(), preload),
+    )
+        .prop_map(|((d, d1, ratio, n, h, g), (dp, dmp, np, gp, pre))| {
+            let t = Params::TABLE2;
+            let small = t.cone.small_diameter * d1;
+            let cone = Cone {
+                wire_diameter: t.cone.wire_diameter * d,
+                small_diameter: small,
+                large_diameter: small * ratio,
+                active_coils: t.cone.active_coils * n,
+                compressible_height: t.cone.compressible_height * h,
+                shear_modulus: t.cone.shear_modulus * g,
+            };
+            let r = Reference::cone_only(&cone);
+            Params {
+                cone,
+                linear: Linear {
+                    wire_diameter: t.linear.wire_diameter * dp,
+                    mean_diameter: t.linear.mean_diameter * dmp,
+                    active_coils: t.linear.active_coils * np,
+                    shear_modulus: t.linear.shear_modulus * gp,
+                    preload: pre.map(|x| (x * r.f_t).min(0.9 * r.f_c)),
+                },
+            }
+        })
+}

@@ -1,0 +1,82 @@
+//! `mccs table` emits Rust source that firmware `include!`s: it must be the table the core
+//! builds at start-up, bit for bit, and the committed copy must be current.
+
+use mccs::{ForceTable, ForceTable64, Params, Strain};
+use std::process::Command;
+
+static COMMITTED: ForceTable64 = include!("../../tables/table2.rs");
+
+#[test]
+fn included_table_is_bit_identical_to_the_runtime_build() {
+    let built = ForceTable64::new(&Params::TABLE2).unwrap();
+    assert_eq!(COMMITTED, built);
+    for i in -1000..=1000 {
+        let e = Strain::from_num(i as f64 / 500.0);
+        assert_eq!(
+            COMMITTED.force_and_stiffness(e),
+            built.force_and_stiffness(e)
+        );
+    }
+}
+
+#[test]
+fn committed_table_is_what_the_cli_emits() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
+        .args(["table", "--params", "params/table2.toml"])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let committed = std::fs::read_to_string(format!("{root}/tables/table2.rs")).unwrap();
+    assert_eq!(
+        String::from_utf8(out.stdout).unwrap(),
+        committed,
+        "tables/table2.rs is stale: run `mccs table --params params/table2.toml --out tables/table2.rs`"
+    );
+}
+
+#[test]
+fn every_knot_count_renders_and_round_trips() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    for knots in ["17", "33", "65", "129"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(["table", "--params", "params/table2.toml", "--knots", knots])
+            .current_dir(root)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        let segs = knots.parse::<usize>().unwrap() - 1;
+        assert!(text.contains(&format!("mccs::ForceTable::<{segs}>::from_raw")));
+        assert_eq!(text.matches("\n        [").count(), segs);
+    }
+    // A table emitted to a file for another domain matches the runtime build too.
+    let t = ForceTable::<32>::with_domain(&Params::TABLE2, -0.2, 1.5).unwrap();
+    let text = mccs_host::cli::render_table("", &t);
+    assert!(text.contains(&format!("knot_last: {},", t.raw().knot_last)));
+}
+
+#[test]
+fn table_errors_are_one_line_exit_2() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    for (args, needle) in [
+        (vec!["--knots", "64"], "--knots"),
+        (vec!["--from", "0.5", "--to", "0.5"], "--to"),
+        (vec!["--from", "-0.5", "--to", "0.1"], "--to"),
+        (vec!["--from", "2", "--to", "3"], "--from"),
+        (vec!["--from", "nan"], "--from"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(["table", "--params", "params/table2.toml"])
+            .args(&args)
+            .current_dir(root)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(out.stdout.is_empty());
+        assert_eq!(err.lines().count(), 1);
+        assert!(err.contains(needle), "{err}");
+    }
+}
