@@ -7,25 +7,36 @@
 //! - [`Params`], [`Law`]: the spring and its `f64` law, used when tables are built.
 //! - [`ForceTable`]: the inverse law `F(ε)` tabulated for constant-time fixed-point
 //!   evaluation per tick.
+//! - [`Topology`], [`Solver`], [`Coupling`]: the local mass-spring patch around the
+//!   probe, stepped once per haptic tick.
 //!
 //! Fixed-point formats (all from the `fixed` crate):
 //! [`Strain`] `I8F24`, [`Force`] `I12F20` (N), [`Stiffness`] `I16F16` (N per unit strain).
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+pub mod coupling;
 pub mod entry;
 pub mod law;
 pub mod params;
+pub mod q;
+pub mod solver;
 pub mod table;
+pub mod topology;
+pub mod trajectory;
 
 #[cfg(feature = "defmt")]
 mod defmt_impls;
 
+pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Linear, ParamError, ParamKey, Params};
+pub use solver::{ConfigKey, Length, Solver, SolverConfig, SolverError, Velocity};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableError,
 };
+pub use topology::{Edge, End, Topology, TopologyError, GROUND};
+pub use trajectory::{demo_path, PathError, ProbePath, Waypoint};
 
 /// Compressive strain `ε = (l0 − l) / l0` (dimensionless; positive = compressed). ±128.
 pub type Strain = fixed::types::I8F24;

@@ -371,17 +371,19 @@ impl<const S: usize> ForceTable<S> {
         )
     }
 
-    /// The largest tangent stiffness of the law at or below strain `strain`, for
-    /// stability bounds: the law stiffens monotonically, so this is the stiffness at
-    /// `strain` (or the larger line slope beyond the table).
-    pub fn max_stiffness_up_to(&self, strain: Strain) -> Stiffness {
-        let (_, s) = self.force_and_stiffness(strain);
-        let s = s.max(Stiffness::from_bits(self.raw.stiffness_lo));
-        s.max(if strain.to_bits() >= self.raw.strain_hi {
-            Stiffness::from_bits(self.raw.stiffness_hi)
-        } else {
-            Stiffness::ZERO
-        })
+    /// The largest tangent stiffness anywhere on the curve (both lines, and every segment
+    /// at its ends and middle), for stability bounds. A loop over the segments: call it
+    /// at start-up, not per tick.
+    pub fn max_stiffness(&self) -> Stiffness {
+        let r = &self.raw;
+        let mut max = r.stiffness_lo.max(r.stiffness_hi);
+        let span = r.strain_hi.saturating_sub(r.strain_lo) as i64;
+        for i in 0..=(2 * S) as i64 {
+            let e = r.strain_lo as i64 + span * i / (2 * S) as i64;
+            let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
+            max = max.max(k.to_bits());
+        }
+        Stiffness::from_bits(max)
     }
 
     /// Force (N) at compressive strain `strain`; constant time, saturating, no panic.

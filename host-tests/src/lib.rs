@@ -6,4 +6,5 @@
 
 pub mod cli;
 pub mod paramfile;
+pub mod patch;
 pub mod reference;

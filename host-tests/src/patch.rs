@@ -1,0 +1,266 @@
+//! The f64 twin of the core's patch solver: MODEL.md's standard patch, the reference law,
+//! the paper's improved Euler (eqs. 21–22), and the same virtual coupling, written without
+//! the core's code so that tests can hold one against the other.
+//!
+//! Nodes are stored as they are (fixed ones included); positions are absolute, in mm, in
+//! the patch frame (origin at the contact node's rest position, `z` up).
+
+use crate::reference::Reference;
+
+/// A 3-vector of f64.
+pub type V = [f64; 3];
+
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm(a: V) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// One spring: node indices and rest length (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    /// First node.
+    pub i: usize,
+    /// Second node.
+    pub j: usize,
+    /// Rest length, mm.
+    pub l0: f64,
+}
+
+/// Nodes and springs of a patch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Rest positions, mm.
+    pub rest: Vec<V>,
+    /// Whether each node is fixed.
+    pub fixed: Vec<bool>,
+    /// The springs.
+    pub springs: Vec<Spring>,
+    /// The contact node.
+    pub contact: usize,
+}
+
+impl Mesh {
+    /// MODEL.md's standard patch: `n × n` surface nodes (index `i·n + j`), then the base
+    /// layer (index `n² + i·n + j`); springs with both ends fixed are left out.
+    pub fn standard(n: usize, spacing: f64) -> Mesh {
+        let c = (n / 2) as f64;
+        let mut rest = Vec::new();
+        let mut fixed = Vec::new();
+        for layer in [0.0, -spacing] {
+            for i in 0..n {
+                for j in 0..n {
+                    rest.push([(i as f64 - c) * spacing, (j as f64 - c) * spacing, layer]);
+                    let ring = i == 0 || j == 0 || i == n - 1 || j == n - 1;
+                    fixed.push(layer < 0.0 || ring);
+                }
+            }
+        }
+        let id = |i: usize, j: usize| i * n + j;
+        let mut pairs = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                if i + 1 < n {
+                    pairs.push((id(i, j), id(i + 1, j)));
+                }
+                if j + 1 < n {
+                    pairs.push((id(i, j), id(i, j + 1)));
+                }
+                if i + 1 < n && j + 1 < n {
+                    pairs.push((id(i, j), id(i + 1, j + 1)));
+                    pairs.push((id(i + 1, j), id(i, j + 1)));
+                }
+                pairs.push((id(i, j), n * n + id(i, j)));
+            }
+        }
+        let springs = pairs
+            .into_iter()
+            .filter(|&(a, b)| !(fixed[a] && fixed[b]))
+            .map(|(a, b)| Spring {
+                i: a,
+                j: b,
+                l0: norm(sub(rest[b], rest[a])),
+            })
+            .collect();
+        Mesh {
+            rest,
+            fixed,
+            springs,
+            contact: id(n / 2, n / 2),
+        }
+    }
+}
+
+/// Configuration of the twin (same meaning and units as the core's `SolverConfig`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TwinConfig {
+    /// Tick rate, Hz.
+    pub tick_hz: f64,
+    /// Substeps per tick.
+    pub substeps: u32,
+    /// Node mass, kg.
+    pub node_mass: f64,
+    /// Spring (relative) damping, N·s/m.
+    pub spring_damping: f64,
+    /// Node (absolute) damping, N·s/m.
+    pub node_damping: f64,
+    /// Coupling stiffness N/mm, damping N·s/m, max force per axis N.
+    pub coupling: (f64, f64, f64),
+}
+
+/// The stability bound of the core's solver docs, computed independently: substeps per
+/// tick for `mesh` with the law's largest tangent stiffness `k_max` (N per unit strain).
+pub fn substeps(mesh: &Mesh, k_max: f64, cfg: &TwinConfig) -> Option<u32> {
+    let n = mesh.rest.len();
+    let mut stiff = vec![0.0; n];
+    let mut damp = vec![cfg.node_damping; n];
+    for s in &mesh.springs {
+        for e in [s.i, s.j] {
+            stiff[e] += k_max / s.l0 * 1000.0;
+            damp[e] += cfg.spring_damping;
+        }
+    }
+    stiff[mesh.contact] += cfg.coupling.0 * 1000.0;
+    damp[mesh.contact] += cfg.coupling.1;
+    let free = (0..n).filter(|&i| !mesh.fixed[i]);
+    let c_max = free.clone().map(|i| damp[i]).fold(0.0, f64::max);
+    let tau = free
+        .map(|i| damp[i] / stiff[i])
+        .fold(f64::INFINITY, f64::min);
+    if tau <= 0.0 || c_max <= 0.0 {
+        return None;
+    }
+    let h = 0.5 * (cfg.node_mass / c_max).min(2.0 * tau);
+    Some((1.0 / (cfg.tick_hz * h)).ceil() as u32)
+}
+
+/// The f64 patch.
+#[derive(Clone, Debug)]
+pub struct Twin {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The law.
+    pub law: Reference,
+    /// Configuration.
+    pub cfg: TwinConfig,
+    /// Positions, mm.
+    pub x: Vec<V>,
+    /// Velocities, mm/s.
+    pub v: Vec<V>,
+    probe_prev: V,
+    coupling_force: V,
+    reaction: V,
+}
+
+impl Twin {
+    /// At rest.
+    pub fn new(mesh: Mesh, law: Reference, cfg: TwinConfig) -> Twin {
+        let x = mesh.rest.clone();
+        let v = vec![[0.0; 3]; x.len()];
+        Twin {
+            mesh,
+            law,
+            cfg,
+            x,
+            v,
+            probe_prev: [0.0; 3],
+            coupling_force: [0.0; 3],
+            reaction: [0.0; 3],
+        }
+    }
+
+    fn h(&self) -> f64 {
+        1.0 / (self.cfg.tick_hz * self.cfg.substeps as f64)
+    }
+
+    /// Force of every spring on every node (N): the law along the edge + eq. 17 damping.
+    pub fn spring_forces(&self, x: &[V], v: &[V]) -> Vec<V> {
+        let mut f = vec![[0.0; 3]; x.len()];
+        for s in &self.mesh.springs {
+            let d = sub(x[s.j], x[s.i]);
+            let l = norm(d);
+            let strain = (s.l0 - l) / s.l0;
+            let force = self.law.force(strain);
+            let dv = sub(v[s.j], v[s.i]);
+            for k in 0..3 {
+                let along = if l > 0.0 { force * d[k] / l } else { 0.0 };
+                let on_i = -along + self.cfg.spring_damping / 1000.0 * dv[k];
+                f[s.i][k] += on_i;
+                f[s.j][k] -= on_i;
+            }
+        }
+        f
+    }
+
+    fn substep(&mut self, probe: Option<(V, V)>, held: Option<(V, V)>) {
+        let h = self.h();
+        let mut f = self.spring_forces(&self.x, &self.v);
+        let c = self.mesh.contact;
+        self.reaction = f[c];
+        self.coupling_force = [0.0; 3];
+        if let Some((p, pv)) = probe {
+            let (kc, bc, fmax) = self.cfg.coupling;
+            if p[2] < self.x[c][2] {
+                for k in 0..3 {
+                    let fk = kc * (p[k] - self.x[c][k]) + bc / 1000.0 * (pv[k] - self.v[c][k]);
+                    self.coupling_force[k] = fk.clamp(-fmax, fmax);
+                    f[c][k] += self.coupling_force[k];
+                }
+            }
+        }
+        for i in 0..self.x.len() {
+            if self.mesh.fixed[i] {
+                continue;
+            }
+            for k in 0..3 {
+                let net = f[i][k] - self.cfg.node_damping / 1000.0 * self.v[i][k];
+                let v_new = self.v[i][k] + h * 1000.0 * net / self.cfg.node_mass;
+                self.x[i][k] += 0.5 * h * (self.v[i][k] + v_new);
+                self.v[i][k] = v_new;
+            }
+        }
+        if let Some((pos, vel)) = held {
+            self.x[c] = pos;
+            self.v[c] = vel;
+        }
+    }
+
+    /// One tick with the probe at `probe` (mm); the device force (N).
+    pub fn step(&mut self, probe: V) -> V {
+        let pv = sub(probe, self.probe_prev).map(|d| d * self.cfg.tick_hz);
+        self.probe_prev = probe;
+        for _ in 0..self.cfg.substeps {
+            self.substep(Some((probe, pv)), None);
+        }
+        self.coupling_force.map(|f| -f)
+    }
+
+    /// One tick with the contact node held at `position` (absolute, mm), moved there
+    /// linearly over the tick; the spring force on it (N).
+    pub fn step_held(&mut self, position: V) -> V {
+        let c = self.mesh.contact;
+        let start = self.x[c];
+        let vel = sub(position, start).map(|d| d * self.cfg.tick_hz);
+        let n = self.cfg.substeps;
+        for s in 1..=n {
+            let t = s as f64 / n as f64;
+            let pos = [0, 1, 2].map(|k| start[k] + (position[k] - start[k]) * t);
+            self.substep(None, Some((pos, vel)));
+        }
+        self.reaction
+    }
+
+    /// Kinetic energy (J): Σ ½ m |v|², v in m/s.
+    pub fn kinetic_energy(&self) -> f64 {
+        self.v
+            .iter()
+            .zip(&self.mesh.fixed)
+            .filter(|(_, f)| !**f)
+            .map(|(v, _)| {
+                0.5 * self.cfg.node_mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 1e-6
+            })
+            .sum()
+    }
+}

@@ -1,0 +1,70 @@
+//! `Coupling`: the virtual coupling (Adams & Hannaford) between the haptic device's probe
+//! and the contact node — a spring–damper whose force is what the device renders.
+//!
+//! It is unilateral: it acts only while the probe is below the contact node (pressing
+//! into the tissue); then it acts on all three axes, so a stroke drags the tissue under
+//! the probe (no slip). The force is clamped per axis to the device maximum, on the
+//! device and on the node alike, so the coupling stays passive.
+
+/// Coupling parameters (runtime values; see [`crate::SolverConfig`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coupling {
+    /// Spring stiffness, N/mm (> 0).
+    pub stiffness: f64,
+    /// Damper, N·s/m (≥ 0).
+    pub damping: f64,
+    /// Largest force per axis the device renders, N (> 0, < 2048).
+    pub max_force: f64,
+}
+
+impl Default for Coupling {
+    /// 1 N/mm, 0.5 N·s/m, 10 N per axis.
+    fn default() -> Self {
+        Self {
+            stiffness: 1.0,
+            damping: 0.5,
+            max_force: 10.0,
+        }
+    }
+}
+
+/// The coupling in the solver's fixed-point units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct CouplingQ {
+    /// N/mm, Q16.
+    pub stiffness: i32,
+    /// N·s/mm, Q24.
+    pub damping: i32,
+    /// N, Q20.
+    pub max_force: i32,
+}
+
+impl CouplingQ {
+    /// Force on the contact node (Q20 N) from the probe at `probe` (Q24 mm) moving at
+    /// `probe_vel` (Q16 mm/s), the node at `node` moving at `node_vel`. Zero when the
+    /// probe is not below the node.
+    #[inline(always)]
+    pub fn force(
+        &self,
+        probe: [i32; 3],
+        probe_vel: [i32; 3],
+        node: [i32; 3],
+        node_vel: [i32; 3],
+    ) -> [i32; 3] {
+        use crate::q::sat;
+        if probe[2] >= node[2] {
+            return [0; 3];
+        }
+        let mut out = [0; 3];
+        for i in 0..3 {
+            let dx = probe[i] as i64 - node[i] as i64;
+            let dv = probe_vel[i] as i64 - node_vel[i] as i64;
+            // Q24 mm · Q16 N/mm → Q20 N; Q16 mm/s · Q24 N·s/mm → Q20 N.
+            let spring = (dx * self.stiffness as i64) >> 20;
+            let damper = (dv * self.damping as i64) >> 20;
+            let f = sat(spring + damper);
+            out[i] = f.clamp(-self.max_force, self.max_force);
+        }
+        out
+    }
+}

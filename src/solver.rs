@@ -1,0 +1,540 @@
+//! `Solver`: the MCCS patch in fixed point, one call per haptic tick.
+//!
+//! Each spring applies the tabulated law ([`ForceTable`]) to its compressive strain
+//! `ε = (l0 − l)/l0` along the edge, plus the paper's relative-velocity damping (eq. 17);
+//! each free node integrates `m a = f_ext − Σ F_spring − Σ C (v_i − v_j) − c v_i` with the
+//! paper's improved Euler: velocity by an explicit Euler step (eq. 21), position by the
+//! trapezoid of old and new velocity (eq. 22). The probe drives the contact node through a
+//! virtual [`Coupling`]; the device renders the coupling force.
+//!
+//! # Per tick
+//! [`Solver::step`] runs a fixed number of substeps (chosen at construction), each a loop
+//! over the springs and one over the nodes: constant time, no division, no square root
+//! (the length comes from a warm-started Newton step for `1/l`), no floating point, no
+//! heap, no panic, saturating arithmetic throughout.
+//!
+//! # Units and formats
+//! Displacements from rest in mm, Q24 (±128 mm); velocities in mm/s, Q16 (±32768 mm/s);
+//! forces in N, Q20 (±2048 N). Positions are in the patch frame (origin at the contact
+//! node's rest position, `z` up).
+//!
+//! # Stability (the substep count)
+//! For one mass `m` on a spring `K` with damping rate `γ = C/m`, the improved Euler step
+//! `h` is stable exactly when `h < 2/γ` and `h < 2 C/K`: unlike symplectic Euler it
+//! *amplifies* an undamped oscillation (by `1 + h²ω²/2` per step), so it needs damping.
+//! The solver applies that per node, Gershgorin-style, with a safety factor of 2:
+//! `K_i = Σ k_max / l0` over the node's springs (+ the coupling), `C_i = Σ C` over its
+//! springs + the node damping (+ the coupling damper), and
+//! `h ≤ ½ · min(2 m / (2 max C_i), 2 min(C_i / K_i))`, where `k_max` is the table's largest
+//! tangent stiffness. The masses are haptic masses (a few grams per node), not the
+//! tissue's: they set how many substeps a tick needs, not the settled force.
+
+use crate::coupling::{Coupling, CouplingQ};
+use crate::q::{self, V3};
+use crate::table::ForceTable;
+use crate::topology::{Topology, GROUND, LEN_FRAC};
+use crate::{Force, Strain};
+use fixed::types::I8F24;
+
+/// Length in mm, Q24 (±128 mm).
+pub type Length = I8F24;
+/// Velocity in mm/s, Q16 (±32768 mm/s).
+pub type Velocity = fixed::types::I16F16;
+
+const ONE: i32 = 1 << LEN_FRAC;
+/// Fraction bits of velocities (mm/s).
+const VEL_FRAC: u32 = 16;
+/// Fraction bits of forces (N).
+const FORCE_FRAC: u32 = 20;
+/// Fraction bits of damping coefficients (N·s/mm).
+const DAMP_FRAC: u32 = 24;
+/// Fraction bits of `h/m` ((mm/s)/N).
+const HM_FRAC: u32 = 20;
+/// Fraction bits of `h/2` (s).
+const HALF_H_FRAC: u32 = 32;
+/// Bounds of the warm-started `|l0/l|`: springs shorter than `l0/64` keep `1/l` at 64.
+const R_MAX: i32 = 64 << LEN_FRAC;
+const R_MIN: i32 = 1 << (LEN_FRAC - 6);
+
+/// Runtime configuration of a [`Solver`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverConfig {
+    /// Haptic tick rate, Hz (1 … 100,000).
+    pub tick_hz: f64,
+    /// Haptic (scaled) mass of each free node, kg.
+    pub node_mass: f64,
+    /// Relative-velocity damping of each spring (eq. 17), N·s/m (≥ 0).
+    pub spring_damping: f64,
+    /// Absolute damping of each node (eq. 21), N·s/m (≥ 0).
+    pub node_damping: f64,
+    /// Largest number of substeps per tick the stability bound may ask for.
+    pub max_substeps: u32,
+    /// The probe coupling.
+    pub coupling: Coupling,
+}
+
+impl Default for SolverConfig {
+    /// 1 kHz; 5 g nodes; 1 N·s/m per spring, 0.05 N·s/m per node; at most 64 substeps;
+    /// the default coupling.
+    fn default() -> Self {
+        Self {
+            tick_hz: 1000.0,
+            node_mass: 0.005,
+            spring_damping: 1.0,
+            node_damping: 0.05,
+            max_substeps: 64,
+            coupling: Coupling::default(),
+        }
+    }
+}
+
+/// A configuration value the solver cannot use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ConfigKey {
+    TickHz,
+    NodeMass,
+    SpringDamping,
+    NodeDamping,
+    MaxSubsteps,
+    CouplingStiffness,
+    CouplingDamping,
+    CouplingMaxForce,
+}
+
+impl ConfigKey {
+    /// The field's name.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::TickHz => "tick_hz",
+            Self::NodeMass => "node_mass",
+            Self::SpringDamping => "spring_damping",
+            Self::NodeDamping => "node_damping",
+            Self::MaxSubsteps => "max_substeps",
+            Self::CouplingStiffness => "coupling.stiffness",
+            Self::CouplingDamping => "coupling.damping",
+            Self::CouplingMaxForce => "coupling.max_force",
+        }
+    }
+}
+
+/// Why a solver could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverError {
+    /// A configuration value is out of its range (see [`SolverConfig`]).
+    Config(ConfigKey),
+    /// No damping at all: the improved Euler step is unstable at any step size.
+    NoDamping,
+    /// The stability bound needs more substeps per tick than `max_substeps`.
+    TooManySubsteps {
+        /// Substeps the bound asks for (saturated at `u32::MAX`).
+        needed: u32,
+    },
+    /// The topology has no contact node.
+    NoContact,
+}
+
+impl core::fmt::Display for SolverError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Config(k) => write!(f, "{}: out of range", k.as_str()),
+            Self::NoDamping => f.write_str(
+                "spring_damping/node_damping: the improved Euler integrator needs damping",
+            ),
+            Self::TooManySubsteps { needed } => write!(
+                f,
+                "max_substeps: stability needs {needed} substeps per tick (raise max_substeps, the node mass or the damping, or lower the tick rate)"
+            ),
+            Self::NoContact => f.write_str("topology: no contact node"),
+        }
+    }
+}
+
+impl core::error::Error for SolverError {}
+
+/// How the contact node is driven.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Drive {
+    /// By the probe through the coupling.
+    Probe { probe: V3, probe_vel: V3 },
+    /// Held at a commanded displacement moving at a commanded velocity.
+    Hold { disp: V3, vel: V3 },
+}
+
+/// The fixed-point coefficients derived from a [`SolverConfig`] and the step size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Coeffs {
+    /// `h/m`, (mm/s)/N, Q20.
+    h_over_m: i32,
+    /// `h/2`, s, Q32.
+    half_h: i32,
+    /// Spring damping, N·s/mm, Q24.
+    spring_damping: i32,
+    /// Node damping, N·s/mm, Q24.
+    node_damping: i32,
+    /// Tick rate, Hz (for the probe velocity).
+    tick_hz: i32,
+    coupling: CouplingQ,
+}
+
+/// The patch solver: topology, force table and state. `NODES` counts the ground slot.
+#[derive(Clone, Debug)]
+pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
+    topo: Topology<NODES, EDGES>,
+    table: ForceTable<S>,
+    c: Coeffs,
+    substeps: u32,
+    contact: usize,
+    /// Displacement from rest, Q24 mm.
+    disp: [V3; NODES],
+    /// Velocity, Q16 mm/s.
+    vel: [V3; NODES],
+    /// Force accumulator of the current substep, Q20 N.
+    force: [V3; NODES],
+    /// Warm-started `l0 / l` of each spring, Q24.
+    inv_stretch: [i32; EDGES],
+    /// Last probe position, Q24 mm.
+    probe_prev: V3,
+    /// Spring force on the contact node in the last substep, Q20 N.
+    reaction: V3,
+    /// Coupling force on the contact node in the last substep, Q20 N.
+    coupling_force: V3,
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES, S> {
+    /// Builds a solver at rest; computes the substeps per tick from the stability bound.
+    pub fn new(
+        topo: Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<Self, SolverError> {
+        let contact = topo.contact() as usize;
+        if contact == GROUND as usize {
+            return Err(SolverError::NoContact);
+        }
+        let substeps = Self::substeps_for(&topo, &table, config)?;
+        let h = 1.0 / (config.tick_hz * substeps as f64);
+        let cp = &config.coupling;
+        // N·s/m → N·s/mm: / 1000. h/m: (s/kg = m/(s·N)) · 1000 → (mm/s)/N.
+        let c = Coeffs {
+            h_over_m: q::from_f64(1000.0 * h / config.node_mass, HM_FRAC),
+            half_h: q::from_f64(0.5 * h, HALF_H_FRAC),
+            spring_damping: q::from_f64(config.spring_damping / 1000.0, DAMP_FRAC),
+            node_damping: q::from_f64(config.node_damping / 1000.0, DAMP_FRAC),
+            tick_hz: config.tick_hz as i32,
+            coupling: CouplingQ {
+                stiffness: q::from_f64(cp.stiffness, 16),
+                damping: q::from_f64(cp.damping / 1000.0, DAMP_FRAC),
+                max_force: q::from_f64(cp.max_force, FORCE_FRAC),
+            },
+        };
+        Ok(Self {
+            topo,
+            table,
+            c,
+            substeps,
+            contact,
+            disp: [[0; 3]; NODES],
+            vel: [[0; 3]; NODES],
+            force: [[0; 3]; NODES],
+            inv_stretch: [ONE; EDGES],
+            probe_prev: [0; 3],
+            reaction: [0; 3],
+            coupling_force: [0; 3],
+        })
+    }
+
+    /// Checks `config` and returns the substeps per tick the stability bound asks for
+    /// (see the module docs).
+    pub fn substeps_for(
+        topo: &Topology<NODES, EDGES>,
+        table: &ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<u32, SolverError> {
+        use ConfigKey as K;
+        let check = |ok: bool, k: ConfigKey| {
+            if ok {
+                Ok(())
+            } else {
+                Err(SolverError::Config(k))
+            }
+        };
+        let cp = &config.coupling;
+        check((1.0..=100_000.0).contains(&config.tick_hz), K::TickHz)?;
+        check(
+            config.node_mass.is_finite() && config.node_mass > 0.0,
+            K::NodeMass,
+        )?;
+        check(
+            (0.0..=1e4).contains(&config.spring_damping),
+            K::SpringDamping,
+        )?;
+        check((0.0..=1e4).contains(&config.node_damping), K::NodeDamping)?;
+        check(config.max_substeps >= 1, K::MaxSubsteps)?;
+        check(
+            cp.stiffness > 0.0 && cp.stiffness <= 1000.0,
+            K::CouplingStiffness,
+        )?;
+        check((0.0..=1000.0).contains(&cp.damping), K::CouplingDamping)?;
+        check(
+            cp.max_force > 0.0 && cp.max_force < 2000.0,
+            K::CouplingMaxForce,
+        )?;
+        // Per node: stiffness K_i (N/m) and damping C_i (N·s/m).
+        let k_max = table.max_stiffness().to_num::<f64>();
+        let mut stiff = [0.0f64; NODES];
+        let mut damp = [config.node_damping; NODES];
+        for e in topo.edges() {
+            let k = k_max * 1000.0 / Topology::<NODES, EDGES>::rest_length(e);
+            for n in [e.a, e.b] {
+                if let (Some(s), Some(d)) = (stiff.get_mut(n as usize), damp.get_mut(n as usize)) {
+                    *s += k;
+                    *d += config.spring_damping;
+                }
+            }
+        }
+        let contact = topo.contact() as usize;
+        if let (Some(s), Some(d)) = (stiff.get_mut(contact), damp.get_mut(contact)) {
+            *s += cp.stiffness * 1000.0;
+            *d += cp.damping;
+        }
+        let (mut c_max, mut tau_min) = (0.0f64, f64::INFINITY);
+        for i in 1..topo.node_count().min(NODES) {
+            c_max = c_max.max(damp[i]);
+            if stiff[i] > 0.0 {
+                tau_min = tau_min.min(damp[i] / stiff[i]);
+            }
+        }
+        if tau_min.is_nan() || tau_min <= 0.0 || c_max <= 0.0 {
+            return Err(SolverError::NoDamping);
+        }
+        let h_max = 0.5 * (2.0 * config.node_mass / (2.0 * c_max)).min(2.0 * tau_min);
+        let needed = libm::ceil(1.0 / (config.tick_hz * h_max));
+        if needed.is_nan() || needed > config.max_substeps as f64 {
+            let needed = if needed < u32::MAX as f64 {
+                needed as u32
+            } else {
+                u32::MAX
+            };
+            return Err(SolverError::TooManySubsteps { needed });
+        }
+        let n = (needed as u32).max(1);
+        // h/m must fit Q20 ((mm/s)/N < 2048) and h/2 must fit Q32 comfortably.
+        let h = 1.0 / (config.tick_hz * n as f64);
+        check(1000.0 * h / config.node_mass < 2000.0, K::NodeMass)?;
+        check(h < 0.004, K::TickHz)?;
+        Ok(n)
+    }
+
+    /// Substeps per tick.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// The topology.
+    pub fn topology(&self) -> &Topology<NODES, EDGES> {
+        &self.topo
+    }
+
+    /// The force table.
+    pub fn table(&self) -> &ForceTable<S> {
+        &self.table
+    }
+
+    /// One haptic tick with the probe at `probe` (mm, patch frame). Returns the force the
+    /// device must render on the probe (N per axis, clamped to the coupling maximum).
+    pub fn step(&mut self, probe: [Length; 3]) -> [Force; 3] {
+        let p = probe.map(Length::to_bits);
+        // Probe velocity over the tick: Q24 mm · Hz → Q16 mm/s.
+        let probe_vel = core::array::from_fn(|i| {
+            q::sat(((p[i] as i64 - self.probe_prev[i] as i64) * self.c.tick_hz as i64) >> 8)
+        });
+        self.probe_prev = p;
+        let drive = Drive::Probe {
+            probe: p,
+            probe_vel,
+        };
+        for _ in 0..self.substeps {
+            self.substep(drive);
+        }
+        self.coupling_force
+            .map(|f| Force::from_bits(f.saturating_neg()))
+    }
+
+    /// One tick with the contact node held at `position` (mm, patch frame) — the
+    /// indentation test. Returns the reaction: the force the springs exert on the contact
+    /// node (N), `z` positive when it resists a downward indentation.
+    pub fn step_held(&mut self, position: [Length; 3]) -> [Force; 3] {
+        let target = position.map(Length::to_bits);
+        let prev = self.disp.get(self.contact).copied().unwrap_or([0; 3]);
+        // The held node moves linearly from where it was to the target over the tick.
+        let vel = core::array::from_fn(|i| {
+            q::sat(((target[i] as i64 - prev[i] as i64) * self.c.tick_hz as i64) >> 8)
+        });
+        let n = self.substeps as i64;
+        for s in 1..=n {
+            let disp = core::array::from_fn(|i| {
+                q::sat(prev[i] as i64 + (target[i] as i64 - prev[i] as i64) * s / n)
+            });
+            self.substep(Drive::Hold { disp, vel });
+        }
+        self.reaction.map(Force::from_bits)
+    }
+
+    /// Displacement of node `i` from rest (mm), `None` if it does not exist.
+    pub fn displacement(&self, i: u16) -> Option<[Length; 3]> {
+        self.disp.get(i as usize).map(|d| d.map(Length::from_bits))
+    }
+
+    /// Velocity of node `i` (mm/s, as `I16F16`).
+    pub fn velocity(&self, i: u16) -> Option<[Velocity; 3]> {
+        self.vel.get(i as usize).map(|v| v.map(Velocity::from_bits))
+    }
+
+    /// Puts node `i` at displacement `disp` (mm) with velocity `vel` (mm/s); the ground
+    /// and missing nodes are ignored. For tests and for starting from a known state.
+    pub fn set_state(&mut self, i: u16, disp: [Length; 3], vel: [Velocity; 3]) {
+        if i == GROUND {
+            return;
+        }
+        if let (Some(d), Some(v)) = (self.disp.get_mut(i as usize), self.vel.get_mut(i as usize)) {
+            *d = disp.map(Length::to_bits);
+            *v = vel.map(Velocity::to_bits);
+        }
+    }
+
+    /// Back to rest.
+    pub fn reset(&mut self) {
+        self.disp = [[0; 3]; NODES];
+        self.vel = [[0; 3]; NODES];
+        self.inv_stretch = [ONE; EDGES];
+        self.probe_prev = [0; 3];
+        self.reaction = [0; 3];
+        self.coupling_force = [0; 3];
+    }
+
+    /// One substep: spring forces, then the improved Euler update of every free node.
+    fn substep(&mut self, drive: Drive) {
+        self.force = [[0; 3]; NODES];
+        self.spring_forces();
+        let c = self.contact;
+        self.reaction = self.force.get(c).copied().unwrap_or([0; 3]);
+        match drive {
+            Drive::Probe { probe, probe_vel } => {
+                let (node, node_vel) = (self.node_disp(c), self.node_vel(c));
+                self.coupling_force = self.c.coupling.force(probe, probe_vel, node, node_vel);
+                if let Some(f) = self.force.get_mut(c) {
+                    *f = q::add(*f, self.coupling_force);
+                }
+            }
+            Drive::Hold { .. } => self.coupling_force = [0; 3],
+        }
+        let count = self.topo.node_count().min(NODES);
+        for i in 1..count {
+            self.integrate(i);
+        }
+        if let Drive::Hold { disp, vel } = drive {
+            if let (Some(d), Some(v)) = (self.disp.get_mut(c), self.vel.get_mut(c)) {
+                *d = disp;
+                *v = vel;
+            }
+        }
+    }
+
+    fn node_disp(&self, i: usize) -> V3 {
+        self.disp.get(i).copied().unwrap_or([0; 3])
+    }
+
+    fn node_vel(&self, i: usize) -> V3 {
+        self.vel.get(i).copied().unwrap_or([0; 3])
+    }
+
+    /// Accumulates every spring's force (law + damping) on its two nodes.
+    fn spring_forces(&mut self) {
+        let c = self.c;
+        for (k, e) in self.topo.edges().iter().enumerate() {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let (ua, ub) = (self.node_disp(a), self.node_disp(b));
+            let (va, vb) = (self.node_vel(a), self.node_vel(b));
+            let Some(r) = self.inv_stretch.get_mut(k) else {
+                continue;
+            };
+            let f_on_a = spring_force(
+                &self.table,
+                e.dir,
+                e.inv_len,
+                ua,
+                ub,
+                va,
+                vb,
+                r,
+                c.spring_damping,
+            );
+            if let Some(f) = self.force.get_mut(a) {
+                *f = q::add(*f, f_on_a);
+            }
+            if let Some(f) = self.force.get_mut(b) {
+                *f = q::sub(*f, f_on_a);
+            }
+        }
+    }
+
+    /// Improved Euler for node `i` (eqs. 21, 22).
+    fn integrate(&mut self, i: usize) {
+        let c = self.c;
+        let (Some(u), Some(v), Some(f)) =
+            (self.disp.get_mut(i), self.vel.get_mut(i), self.force.get(i))
+        else {
+            return;
+        };
+        for j in 0..3 {
+            // Q16 mm/s · Q24 N·s/mm → Q20 N.
+            let drag = q::mul(v[j], c.node_damping, VEL_FRAC + DAMP_FRAC - FORCE_FRAC);
+            let net = f[j].saturating_sub(drag);
+            // Q20 N · Q20 (mm/s)/N → Q16 mm/s.
+            let dv = q::mul(net, c.h_over_m, FORCE_FRAC + HM_FRAC - VEL_FRAC);
+            let v_new = v[j].saturating_add(dv);
+            // (Q16 mm/s) · Q32 s → Q24 mm.
+            let sum = v[j] as i64 + v_new as i64;
+            let du = q::sat((sum * c.half_h as i64) >> (VEL_FRAC + HALF_H_FRAC - LEN_FRAC));
+            u[j] = u[j].saturating_add(du);
+            v[j] = v_new;
+        }
+    }
+}
+
+/// The force on end `a` of one spring (Q20 N): the law along the edge plus the relative
+/// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
+/// `r` is the spring's warm-started `l0/l` (Q24), advanced by one guarded Newton step.
+///
+/// A spring crushed below `l0/64` keeps `l0/l` at 64: its direction vector then shortens
+/// with the spring, so the force fades to zero at zero length instead of flipping.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn spring_force<const S: usize>(
+    table: &ForceTable<S>,
+    dir: V3,
+    inv_len: i32,
+    ua: V3,
+    ub: V3,
+    va: V3,
+    vb: V3,
+    r: &mut i32,
+    damping: i32,
+) -> V3 {
+    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24.
+    let w = q::add(dir, q::scale(q::sub(ub, ua), inv_len, LEN_FRAC));
+    let a = q::norm2(w, LEN_FRAC); // |w|², Q24
+                                   // Newton for 1/|w|: r ← r (3 − a r²)/2, the factor kept within [1/4, 3/2].
+    let x = q::mul(q::mul(a, *r, LEN_FRAC), *r, LEN_FRAC);
+    let factor = ((3 * ONE).saturating_sub(x) >> 1).clamp(ONE / 4, 3 * ONE / 2);
+    *r = q::mul(*r, factor, LEN_FRAC).clamp(R_MIN, R_MAX);
+    let stretch = q::mul(a, *r, LEN_FRAC); // |w| = l / l0
+    let strain = Strain::from_bits(ONE.saturating_sub(stretch));
+    let f = table.force(strain).to_bits();
+    let n = q::scale(w, *r, LEN_FRAC); // unit vector a → b
+                                       // A compressed spring (f > 0) pushes a away from b: −f n. Damping: C (v_b − v_a).
+    let push = q::scale(n, f, LEN_FRAC);
+    let drag = q::scale(q::sub(vb, va), damping, VEL_FRAC + DAMP_FRAC - FORCE_FRAC);
+    q::sub(drag, push)
+}

@@ -1,0 +1,241 @@
+//! `Topology`: the springs of a patch and what the per-tick loop needs of each, computed
+//! once so that a step does no division and no square root.
+//!
+//! Node 0 is the *ground*: every fixed node (the patch's outer ring, the base layer) is
+//! represented by it. Its displacement and velocity stay zero; each edge keeps its own
+//! rest geometry, so one ground slot serves all fixed nodes and costs no branch per edge.
+//! Nodes `1 …` are free. Positions are in mm in the patch frame: origin at the contact
+//! node's rest position, `z` up, surface at `z = 0`.
+
+use crate::q::{self, V3};
+use heapless::Vec;
+
+/// Index of the ground node (all fixed nodes).
+pub const GROUND: u16 = 0;
+
+/// Fraction bits of lengths (mm) and dimensionless ratios in the patch: Q24.
+pub const LEN_FRAC: u32 = 24;
+
+/// One spring of the patch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Edge {
+    /// First node (0 = ground).
+    pub a: u16,
+    /// Second node (0 = ground).
+    pub b: u16,
+    /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q24.
+    pub dir: V3,
+    /// `1 / l0` in 1/mm, Q24.
+    pub inv_len: i32,
+}
+
+/// An end of an edge being added: a free node, or a fixed point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum End {
+    /// A free node, by index (from [`Topology::add_free_node`]).
+    Free(u16),
+    /// A fixed point at this rest position (mm, patch frame).
+    Fixed([f64; 3]),
+}
+
+/// Why a topology could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TopologyError {
+    /// More free nodes than the capacity `NODES − 1`.
+    NodeCapacity,
+    /// More edges than the capacity `EDGES`.
+    EdgeCapacity,
+    /// The grid size is below 3 or above 200, or the spacing is not finite and > 0.
+    BadGrid,
+    /// A position beyond ±100 mm (the Q24 length format holds ±128 mm).
+    OutOfRange,
+    /// An edge whose ends coincide, or shorter than 1/64 mm.
+    TooShort,
+    /// An edge referring to a node that does not exist, or joining two fixed points.
+    BadEnd,
+}
+
+impl core::fmt::Display for TopologyError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NodeCapacity => "topology: more free nodes than the node capacity",
+            Self::EdgeCapacity => "topology: more springs than the edge capacity",
+            Self::BadGrid => "topology: grid must be 3..=200 with a finite spacing > 0",
+            Self::OutOfRange => "topology: a node lies beyond ±100 mm of the contact node",
+            Self::TooShort => "topology: a spring is shorter than 1/64 mm",
+            Self::BadEnd => "topology: a spring refers to a missing node or joins two fixed points",
+        })
+    }
+}
+
+impl core::error::Error for TopologyError {}
+
+/// The springs and free nodes of a patch; capacities in the type.
+#[derive(Clone, Debug)]
+pub struct Topology<const NODES: usize, const EDGES: usize> {
+    edges: Vec<Edge, EDGES>,
+    /// Rest positions of the nodes (index 0: ground, unused), mm.
+    rest: Vec<[f64; 3], NODES>,
+    contact: u16,
+}
+
+impl<const NODES: usize, const EDGES: usize> Default for Topology<NODES, EDGES> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
+    /// An empty topology (the ground only). Add nodes and edges, then [`Self::set_contact`].
+    pub fn new() -> Self {
+        let mut rest = Vec::new();
+        // NODES = 0 leaves no room for the ground: every later call reports capacity.
+        let _ = rest.push([0.0; 3]);
+        Self {
+            edges: Vec::new(),
+            rest,
+            contact: GROUND,
+        }
+    }
+
+    /// Adds a free node at `rest` (mm); returns its index.
+    pub fn add_free_node(&mut self, rest: [f64; 3]) -> Result<u16, TopologyError> {
+        if rest.iter().any(|x| !x.is_finite() || x.abs() > 100.0) {
+            return Err(TopologyError::OutOfRange);
+        }
+        if self.rest.is_empty() {
+            return Err(TopologyError::NodeCapacity);
+        }
+        let index = self.rest.len();
+        self.rest
+            .push(rest)
+            .map_err(|_| TopologyError::NodeCapacity)?;
+        Ok(index as u16)
+    }
+
+    /// Adds a spring between two ends, at least one of them free.
+    pub fn add_edge(&mut self, a: End, b: End) -> Result<(), TopologyError> {
+        let end = |e: End| -> Result<(u16, [f64; 3]), TopologyError> {
+            match e {
+                End::Free(i) if i != GROUND && (i as usize) < self.rest.len() => {
+                    Ok((i, self.rest[i as usize]))
+                }
+                End::Free(_) => Err(TopologyError::BadEnd),
+                End::Fixed(p) if p.iter().all(|x| x.is_finite() && x.abs() <= 100.0) => {
+                    Ok((GROUND, p))
+                }
+                End::Fixed(_) => Err(TopologyError::OutOfRange),
+            }
+        };
+        let ((ia, pa), (ib, pb)) = (end(a)?, end(b)?);
+        if ia == GROUND && ib == GROUND {
+            return Err(TopologyError::BadEnd);
+        }
+        let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+        let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if len < 1.0 / 64.0 {
+            return Err(TopologyError::TooShort);
+        }
+        let dir = d.map(|x| q::from_f64(x / len, LEN_FRAC));
+        self.edges
+            .push(Edge {
+                a: ia,
+                b: ib,
+                dir,
+                inv_len: q::from_f64(1.0 / len, LEN_FRAC),
+            })
+            .map_err(|_| TopologyError::EdgeCapacity)
+    }
+
+    /// Chooses the node the probe couples to (and indentation drives).
+    pub fn set_contact(&mut self, node: u16) -> Result<(), TopologyError> {
+        if node == GROUND || node as usize >= self.rest.len() {
+            return Err(TopologyError::BadEnd);
+        }
+        self.contact = node;
+        Ok(())
+    }
+
+    /// MODEL.md's standard patch: `n × n` surface nodes on a square grid of spacing
+    /// `spacing` mm at `z = 0`, the outer ring fixed, a fixed base layer at `z = −spacing`
+    /// under every surface node; structural, shear and vertical springs, leaving out
+    /// those with both ends fixed (n = 5: 61 springs, n = 8: 214). The contact node is
+    /// `(n/2, n/2)`, at the origin.
+    pub fn standard_patch(n: usize, spacing: f64) -> Result<Self, TopologyError> {
+        if !(3..=200).contains(&n) || !spacing.is_finite() || spacing <= 0.0 {
+            return Err(TopologyError::BadGrid);
+        }
+        let mut t = Self::new();
+        let c = (n / 2) as f64;
+        let pos =
+            |i: usize, j: usize, z: f64| [(i as f64 - c) * spacing, (j as f64 - c) * spacing, z];
+        let fixed = |i: usize, j: usize| i == 0 || j == 0 || i == n - 1 || j == n - 1;
+        // Free surface node (i, j) gets index 1 + (i − 1)(n − 2) + (j − 1).
+        for i in 1..n - 1 {
+            for j in 1..n - 1 {
+                t.add_free_node(pos(i, j, 0.0))?;
+            }
+        }
+        let surface = |i: usize, j: usize| -> End {
+            if fixed(i, j) {
+                End::Fixed(pos(i, j, 0.0))
+            } else {
+                End::Free((1 + (i - 1) * (n - 2) + (j - 1)) as u16)
+            }
+        };
+        let both_fixed = |p: (usize, usize), q: (usize, usize)| fixed(p.0, p.1) && fixed(q.0, q.1);
+        let mut pairs = |p: (usize, usize), q: (usize, usize)| -> Result<(), TopologyError> {
+            if both_fixed(p, q) {
+                return Ok(());
+            }
+            t.add_edge(surface(p.0, p.1), surface(q.0, q.1))
+        };
+        for i in 0..n {
+            for j in 0..n {
+                if i + 1 < n {
+                    pairs((i, j), (i + 1, j))?;
+                }
+                if j + 1 < n {
+                    pairs((i, j), (i, j + 1))?;
+                }
+                if i + 1 < n && j + 1 < n {
+                    pairs((i, j), (i + 1, j + 1))?;
+                    pairs((i + 1, j), (i, j + 1))?;
+                }
+            }
+        }
+        for i in 1..n - 1 {
+            for j in 1..n - 1 {
+                t.add_edge(surface(i, j), End::Fixed(pos(i, j, -spacing)))?;
+            }
+        }
+        let contact = 1 + (n / 2 - 1) * (n - 2) + (n / 2 - 1);
+        t.set_contact(contact as u16)?;
+        Ok(t)
+    }
+
+    /// The springs.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// Number of node slots in use, the ground included.
+    pub fn node_count(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// The contact node.
+    pub fn contact(&self) -> u16 {
+        self.contact
+    }
+
+    /// Rest position of node `i` (mm), `None` if it does not exist.
+    pub fn rest(&self, i: u16) -> Option<[f64; 3]> {
+        self.rest.get(i as usize).copied()
+    }
+
+    /// Rest length of edge `e` (mm), from its stored `1/l0`.
+    pub fn rest_length(e: &Edge) -> f64 {
+        (1u64 << LEN_FRAC) as f64 / e.inv_len as f64
+    }
+}
