@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job. Until the firmware lands: the Table 2 curve from the host CLI.
+# The main job: the haptic firmware on the default controller (Cortex-M4F, QEMU
+# netduinoplus2), running the 1 kHz MCCS patch against a simulated probe, with its defmt
+# log decoded. Other cores: scripts/firmware.sh m3 | m0.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
-cargo build --release --quiet
-./target/release/mccs curve --params params/table2.toml --from -0.2 --to 1.3 --step 0.05
+exec bash scripts/firmware.sh m4f

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what the project needs on a fresh machine: the three thumb targets, and
-# Debian's qemu-system-arm (as root). Sourced by scripts/demo.sh and scripts/test.sh.
+# Installs what the project needs on a fresh machine: the three thumb targets, Debian's
+# qemu-system-arm (as root), and defmt-print (to decode the firmware's logs). Sourced by
+# scripts/demo.sh and scripts/test.sh.
 set -euo pipefail
 
 need_targets=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
@@ -22,4 +23,9 @@ if ! command -v qemu-system-arm >/dev/null 2>&1; then
     echo "setup: qemu-system-arm is missing and this is not root: run 'sudo apt-get install qemu-system-arm' and try again" >&2
     exit 1
   fi
+fi
+
+if ! command -v defmt-print >/dev/null 2>&1; then
+  echo "setup: cargo install defmt-print (a few minutes, once)" >&2
+  cargo install defmt-print --version 1.2.0 --locked --quiet >&2
 fi

@@ -24,6 +24,22 @@ for t in thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf; do
   cargo build -p mccs --release --target "$t" --features defmt
 done
 
+step "firmware in QEMU: the demo on all three cores, checked against the host"
+cargo build --quiet --release -p mccs-host --bin mccs
+mkdir -p target/qemu
+for core in m4f m3 m0; do
+  bash scripts/firmware.sh "$core" > "target/qemu/demo-$core.log"
+  tail -n 2 "target/qemu/demo-$core.log"
+  ./target/release/mccs demo --core "$core" --check "target/qemu/demo-$core.log"
+done
+
+step "firmware in QEMU: a panic exits with failure"
+if bash scripts/firmware.sh m4f --features panic-test > target/qemu/panic.log; then
+  echo "test.sh: the panic-test firmware exited with success" >&2
+  exit 1
+fi
+grep -q "panic: " target/qemu/panic.log
+
 step "host tests"
 log=$(mktemp)
 cargo test --workspace 2>&1 | tee "$log"

@@ -9,15 +9,27 @@
 //!   evaluation per tick.
 //! - [`Topology`], [`Solver`], [`Coupling`]: the local mass-spring patch around the
 //!   probe, stepped once per haptic tick.
+//! - [`HapticDevice`], [`Controller`], [`Mailbox`]: the device layer, the tick with its
+//!   safe state, and the double buffer between main loop and tick interrupt.
 //!
 //! Fixed-point formats (all from the `fixed` crate):
 //! [`Strain`] `I8F24`, [`Force`] `I12F20` (N), [`Stiffness`] `I16F16` (N per unit strain).
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+// Lets generated tables (`tables/*.rs`, which say `mccs::…`) be included here too.
+extern crate self as mccs;
+
+pub mod as5047p;
+pub mod controller;
 pub mod coupling;
+pub mod demo;
+pub mod device;
 pub mod entry;
 pub mod law;
+pub mod mailbox;
+pub mod motor;
+pub mod one_dof;
 pub mod params;
 pub mod q;
 pub mod solver;
@@ -28,10 +40,13 @@ pub mod trajectory;
 #[cfg(feature = "defmt")]
 mod defmt_impls;
 
+pub use controller::{Controller, Fault, Telemetry};
 pub use coupling::Coupling;
+pub use device::{HapticDevice, SimulatedDevice};
 pub use law::Law;
+pub use mailbox::{Mailbox, Shared};
 pub use params::{Cone, Linear, ParamError, ParamKey, Params};
-pub use solver::{ConfigKey, Length, Solver, SolverConfig, SolverError, Velocity};
+pub use solver::{ConfigKey, Length, ParamSet, Solver, SolverConfig, SolverError, Velocity};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableError,
 };

@@ -17,6 +17,12 @@ pub fn mul(a: i32, b: i32, shift: u32) -> i32 {
     sat((a as i64 * b as i64) >> shift)
 }
 
+/// `(a · b) >> S`, not saturated: for products the caller knows to fit.
+#[inline(always)]
+pub fn mulsh<const S: u32>(a: i32, b: i32) -> i32 {
+    ((a as i64 * b as i64) >> S) as i32
+}
+
 /// Component-wise saturating `a + b`.
 #[inline(always)]
 pub fn add(a: V3, b: V3) -> V3 {

@@ -14,8 +14,8 @@
 //! heap, no panic, saturating arithmetic throughout.
 //!
 //! # Units and formats
-//! Displacements from rest in mm, Q24 (±128 mm); velocities in mm/s, Q16 (±32768 mm/s);
-//! forces in N, Q20 (±2048 N). Positions are in the patch frame (origin at the contact
+//! Displacements from rest in mm, Q24, kept within ±60 mm; velocities in mm/s, Q16, kept
+//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's force within ±128 N). Positions are in the patch frame (origin at the contact
 //! node's rest position, `z` up).
 //!
 //! # Stability (the substep count)
@@ -52,9 +52,19 @@ const DAMP_FRAC: u32 = 24;
 const HM_FRAC: u32 = 20;
 /// Fraction bits of `h/2` (s).
 const HALF_H_FRAC: u32 = 32;
-/// Bounds of the warm-started `|l0/l|`: springs shorter than `l0/64` keep `1/l` at 64.
-const R_MAX: i32 = 64 << LEN_FRAC;
-const R_MIN: i32 = 1 << (LEN_FRAC - 6);
+/// Bounds of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
+const R_MAX: i32 = 16 << LEN_FRAC;
+const R_MIN: i32 = 1 << (LEN_FRAC - 3);
+/// Largest law force of one spring, N in Q20: 64 N.
+pub const SPRING_FORCE_LIMIT: i32 = 64 << FORCE_FRAC;
+/// Largest damping force of one spring, N in Q20: 32 N.
+pub const DAMP_FORCE_LIMIT: i32 = 32 << FORCE_FRAC;
+/// Most springs at one node: their summed forces cannot overflow the Q20 accumulator.
+pub const MAX_SPRINGS_PER_NODE: usize = 20;
+/// Largest displacement from rest, mm in Q24: 60 mm.
+const DISP_LIMIT: i32 = 60 << LEN_FRAC;
+/// Largest speed, mm/s in Q16: 16384 mm/s.
+const VEL_LIMIT: i32 = 1 << 30;
 
 /// Runtime configuration of a [`Solver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,7 +73,7 @@ pub struct SolverConfig {
     pub tick_hz: f64,
     /// Haptic (scaled) mass of each free node, kg.
     pub node_mass: f64,
-    /// Relative-velocity damping of each spring (eq. 17), N·s/m (≥ 0).
+    /// Relative-velocity damping of each spring (eq. 17), N·s/m (0 … 10).
     pub spring_damping: f64,
     /// Absolute damping of each node (eq. 21), N·s/m (≥ 0).
     pub node_damping: f64,
@@ -177,6 +187,28 @@ struct Coeffs {
     coupling: CouplingQ,
 }
 
+/// A force table with the substeps and coefficients it needs on a given topology and
+/// configuration: built by [`Solver::prepare`] (start-up or main loop, `f64`), switched in
+/// by [`Solver::apply`] between two ticks (a few moves).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParamSet<const S: usize> {
+    table: ForceTable<S>,
+    substeps: u32,
+    c: Coeffs,
+}
+
+impl<const S: usize> ParamSet<S> {
+    /// The table.
+    pub fn table(&self) -> &ForceTable<S> {
+        &self.table
+    }
+
+    /// Substeps per tick.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+}
+
 /// The patch solver: topology, force table and state. `NODES` counts the ground slot.
 #[derive(Clone, Debug)]
 pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
@@ -203,6 +235,7 @@ pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
 
 impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES, S> {
     /// Builds a solver at rest; computes the substeps per tick from the stability bound.
+    #[inline(never)]
     pub fn new(
         topo: Topology<NODES, EDGES>,
         table: ForceTable<S>,
@@ -212,7 +245,49 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         if contact == GROUND as usize {
             return Err(SolverError::NoContact);
         }
-        let substeps = Self::substeps_for(&topo, &table, config)?;
+        let set = Self::prepare_for(&topo, table, config)?;
+        Ok(Self {
+            topo,
+            table: set.table,
+            c: set.c,
+            substeps: set.substeps,
+            contact,
+            disp: [[0; 3]; NODES],
+            vel: [[0; 3]; NODES],
+            force: [[0; 3]; NODES],
+            inv_stretch: [ONE; EDGES],
+            probe_prev: [0; 3],
+            reaction: [0; 3],
+            coupling_force: [0; 3],
+        })
+    }
+
+    /// Prepares a parameter set for this solver's topology: the table, the substeps the
+    /// stability bound asks for with it, and the fixed-point coefficients.
+    pub fn prepare(
+        &self,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<ParamSet<S>, SolverError> {
+        Self::prepare_for(&self.topo, table, config)
+    }
+
+    /// Switches to a prepared parameter set; the state (positions, velocities) is kept.
+    pub fn apply(&mut self, set: ParamSet<S>) {
+        self.table = set.table;
+        self.substeps = set.substeps;
+        self.c = set.c;
+    }
+
+    /// [`Solver::prepare`] for a topology without a solver (e.g. in another context than
+    /// the one owning the solver).
+    #[inline(never)]
+    pub fn prepare_for(
+        topo: &Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<ParamSet<S>, SolverError> {
+        let substeps = Self::substeps_for(topo, &table, config)?;
         let h = 1.0 / (config.tick_hz * substeps as f64);
         let cp = &config.coupling;
         // N·s/m → N·s/mm: / 1000. h/m: (s/kg = m/(s·N)) · 1000 → (mm/s)/N.
@@ -228,20 +303,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
                 max_force: q::from_f64(cp.max_force, FORCE_FRAC),
             },
         };
-        Ok(Self {
-            topo,
-            table,
-            c,
-            substeps,
-            contact,
-            disp: [[0; 3]; NODES],
-            vel: [[0; 3]; NODES],
-            force: [[0; 3]; NODES],
-            inv_stretch: [ONE; EDGES],
-            probe_prev: [0; 3],
-            reaction: [0; 3],
-            coupling_force: [0; 3],
-        })
+        Ok(ParamSet { table, substeps, c })
     }
 
     /// Checks `config` and returns the substeps per tick the stability bound asks for
@@ -413,6 +475,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         self.coupling_force = [0; 3];
     }
 
+    /// One substep with the probe at `probe` (Q24 mm, not moving): for benchmarks.
+    pub fn substep_probe(&mut self, probe: [Length; 3]) {
+        self.substep(Drive::Probe {
+            probe: probe.map(Length::to_bits),
+            probe_vel: [0; 3],
+        });
+    }
+
     /// One substep: spring forces, then the improved Euler update of every free node.
     fn substep(&mut self, drive: Drive) {
         self.force = [[0; 3]; NODES];
@@ -470,11 +540,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
                 r,
                 c.spring_damping,
             );
+            // At most MAX_SPRINGS_PER_NODE springs of ≤ 96 N each: the sums fit.
             if let Some(f) = self.force.get_mut(a) {
-                *f = q::add(*f, f_on_a);
+                *f = core::array::from_fn(|k| f[k].wrapping_add(f_on_a[k]));
             }
             if let Some(f) = self.force.get_mut(b) {
-                *f = q::sub(*f, f_on_a);
+                *f = core::array::from_fn(|k| f[k].wrapping_sub(f_on_a[k]));
             }
         }
     }
@@ -493,11 +564,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             let net = f[j].saturating_sub(drag);
             // Q20 N · Q20 (mm/s)/N → Q16 mm/s.
             let dv = q::mul(net, c.h_over_m, FORCE_FRAC + HM_FRAC - VEL_FRAC);
-            let v_new = v[j].saturating_add(dv);
-            // (Q16 mm/s) · Q32 s → Q24 mm.
-            let sum = v[j] as i64 + v_new as i64;
-            let du = q::sat((sum * c.half_h as i64) >> (VEL_FRAC + HALF_H_FRAC - LEN_FRAC));
-            u[j] = u[j].saturating_add(du);
+            let v_new = v[j].saturating_add(dv).clamp(-VEL_LIMIT, VEL_LIMIT);
+            // (Q16 mm/s) · Q32 s → Q24 mm; |v + v'| < 2^31.
+            let du = q::mul(
+                v[j].wrapping_add(v_new),
+                c.half_h,
+                VEL_FRAC + HALF_H_FRAC - LEN_FRAC,
+            );
+            u[j] = u[j].saturating_add(du).clamp(-DISP_LIMIT, DISP_LIMIT);
             v[j] = v_new;
         }
     }
@@ -507,11 +581,20 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
 /// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
 /// `r` is the spring's warm-started `l0/l` (Q24), advanced by one guarded Newton step.
 ///
-/// A spring crushed below `l0/64` keeps `l0/l` at 64: its direction vector then shortens
-/// with the spring, so the force fades to zero at zero length instead of flipping.
+/// Ranges that let most steps skip saturation: displacements within ±60 mm and velocities
+/// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
+/// [`MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 10
+/// N·s/m (the configuration checks). Limits that follow, documented behaviour:
+/// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±4 per axis: a spring
+///   stretched further pulls as if stretched 4 `l0` along that axis;
+/// - `l0/l` stays within [1/8, 16]: a spring crushed below `l0/16` keeps it at 16, so its
+///   direction vector shortens with the spring and the force fades to zero at zero length
+///   instead of flipping;
+/// - one spring's law force is limited to ±64 N and its damping force to ±32 N, so a
+///   node's sum cannot overflow.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn spring_force<const S: usize>(
+pub fn spring_force<const S: usize>(
     table: &ForceTable<S>,
     dir: V3,
     inv_len: i32,
@@ -522,19 +605,39 @@ pub(crate) fn spring_force<const S: usize>(
     r: &mut i32,
     damping: i32,
 ) -> V3 {
-    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24.
-    let w = q::add(dir, q::scale(q::sub(ub, ua), inv_len, LEN_FRAC));
-    let a = q::norm2(w, LEN_FRAC); // |w|², Q24
-                                   // Newton for 1/|w|: r ← r (3 − a r²)/2, the factor kept within [1/4, 3/2].
-    let x = q::mul(q::mul(a, *r, LEN_FRAC), *r, LEN_FRAC);
-    let factor = ((3 * ONE).saturating_sub(x) >> 1).clamp(ONE / 4, 3 * ONE / 2);
-    *r = q::mul(*r, factor, LEN_FRAC).clamp(R_MIN, R_MAX);
-    let stretch = q::mul(a, *r, LEN_FRAC); // |w| = l / l0
-    let strain = Strain::from_bits(ONE.saturating_sub(stretch));
-    let f = table.force(strain).to_bits();
-    let n = q::scale(w, *r, LEN_FRAC); // unit vector a → b
-                                       // A compressed spring (f > 0) pushes a away from b: −f n. Damping: C (v_b − v_a).
-    let push = q::scale(n, f, LEN_FRAC);
-    let drag = q::scale(q::sub(vb, va), damping, VEL_FRAC + DAMP_FRAC - FORCE_FRAC);
-    q::sub(drag, push)
+    const W_LIMIT: i32 = 4 << LEN_FRAC;
+    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24; |u_b − u_a| ≤ 120 mm, l0 ≥ 1 mm.
+    let w: V3 = core::array::from_fn(|k| {
+        dir[k]
+            .wrapping_add(q::mulsh::<LEN_FRAC>(ub[k].wrapping_sub(ua[k]), inv_len))
+            .clamp(-W_LIMIT, W_LIMIT - 1)
+    });
+    // |w|² ≤ 48, Q24.
+    let a = ((w[0] as i64 * w[0] as i64 + w[1] as i64 * w[1] as i64 + w[2] as i64 * w[2] as i64)
+        >> LEN_FRAC) as i32;
+    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2), the factor kept
+    // within [1/4, 3/2]. With a stale `r`, `a r` may be large: held at 8 (|w| ≤ 6.93 when
+    // converged), which still drives the factor to its floor.
+    let s0 = ((a as i64 * *r as i64) >> LEN_FRAC).min((8 * ONE) as i64) as i32;
+    let half_x = ((s0 as i64 * *r as i64) >> (LEN_FRAC + 1)) as i32; // a r² / 2 ≤ 64
+    let factor = (3 * ONE / 2 - half_x).max(ONE / 4);
+    let rn = q::mulsh::<LEN_FRAC>(*r, factor).clamp(R_MIN, R_MAX);
+    *r = rn;
+    // |w| = l / l0 = a r; beyond 8 (tension past ε = −7) it is held at 8.
+    let stretch = ((a as i64 * rn as i64) >> LEN_FRAC).min((8 * ONE) as i64) as i32;
+    let strain = Strain::from_bits(ONE - stretch);
+    let f = table
+        .force(strain)
+        .to_bits()
+        .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1);
+    // A compressed spring (f > 0) pushes a away from b: −f w/|w| = −w (f r).
+    let fr = q::mulsh::<LEN_FRAC>(f, rn); // |fr| ≤ 2^30
+    core::array::from_fn(|k| {
+        let push = q::mul(w[k], fr, LEN_FRAC).clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1);
+        // Damping: C (v_b − v_a); Q16 mm/s · Q24 N·s/mm → Q20 N, ≤ 2^29 before the clamp.
+        let dv = vb[k].wrapping_sub(va[k]);
+        let drag = q::mulsh::<{ VEL_FRAC + DAMP_FRAC - FORCE_FRAC }>(dv, damping)
+            .clamp(-DAMP_FORCE_LIMIT, DAMP_FORCE_LIMIT - 1);
+        drag - push
+    })
 }

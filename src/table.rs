@@ -138,15 +138,25 @@ impl fmt::Display for TableError {
 
 impl core::error::Error for TableError {}
 
-/// `(a · t) >> 16` for a Q16 `t ∈ [0, 65535]`, exact floor, in 32-bit arithmetic only.
+/// `(a · t) >> 16` for a Q16 `t ∈ [0, 65535]`, exact floor.
+///
+/// Cores with a 32 × 32 → 64 multiply (everything but Cortex-M0) use it; the M0 splits
+/// `a = hi·2^16 + lo` (`lo ∈ [0, 65535]`): `(a·t) >> 16 = hi·t + (lo·t) >> 16` exactly,
+/// and neither product overflows 32 bits for `t ≤ 65535`. Both give the same bits.
 #[inline(always)]
 pub fn mul_q16(a: i32, t: i32) -> i32 {
-    // a = hi·2^16 + lo with lo ∈ [0, 65535]: (a·t) >> 16 = hi·t + (lo·t) >> 16 exactly,
-    // and neither product overflows 32 bits for t ≤ 65535.
-    let hi = a >> 16;
-    let lo = (a & 0xFFFF) as u32;
-    hi.wrapping_mul(t)
-        .wrapping_add(((lo * t as u32) >> 16) as i32)
+    #[cfg(core = "m0")]
+    {
+        let hi = a >> 16;
+        let lo = (a & 0xFFFF) as u32;
+        hi.wrapping_mul(t)
+            .wrapping_add(((lo * t as u32) >> 16) as i32)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        // t ∈ [0, 65535]: through u16, so the compiler knows it is not negative.
+        ((a as i64 * (t as u16) as i64) >> 16) as i32
+    }
 }
 
 fn q(x: f64, frac: u32) -> Option<i32> {
@@ -179,6 +189,7 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// Builds the table for an already derived law.
+    #[inline(never)]
     pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         if S == 0 {
             return Err(TableError::NoSegments);
@@ -430,8 +441,9 @@ impl<const S: usize> ForceTable<S> {
     #[inline(always)]
     fn segment(&self, e: i32) -> ([i32; 4], i32) {
         let r = &self.raw;
-        let u = ((e.wrapping_sub(r.strain_lo) as u32 as i64 * r.segments_per_strain as i64)
-            >> STRAIN_FRAC) as u64;
+        // e > strain_lo and segments_per_strain > 0: an unsigned 32 × 32 → 64 product.
+        let u = (e.wrapping_sub(r.strain_lo) as u32 as u64 * r.segments_per_strain as u32 as u64)
+            >> STRAIN_FRAC;
         let i = ((u >> U_FRAC) as usize).min(S - 1);
         let t = (u - ((i as u64) << U_FRAC)).min((1 << U_FRAC) - 1) as i32;
         let [c0, c1, c2] = r.segments[i];

@@ -49,10 +49,12 @@ pub enum TopologyError {
     BadGrid,
     /// A position beyond ±100 mm (the Q24 length format holds ±128 mm).
     OutOfRange,
-    /// An edge whose ends coincide, or shorter than 1/64 mm.
+    /// An edge shorter than 1 mm (the solver's fixed-point ranges assume `l0 ≥ 1 mm`).
     TooShort,
     /// An edge referring to a node that does not exist, or joining two fixed points.
     BadEnd,
+    /// More than `solver::MAX_SPRINGS_PER_NODE` springs at one free node.
+    TooManySprings,
 }
 
 impl core::fmt::Display for TopologyError {
@@ -62,8 +64,9 @@ impl core::fmt::Display for TopologyError {
             Self::EdgeCapacity => "topology: more springs than the edge capacity",
             Self::BadGrid => "topology: grid must be 3..=200 with a finite spacing > 0",
             Self::OutOfRange => "topology: a node lies beyond ±100 mm of the contact node",
-            Self::TooShort => "topology: a spring is shorter than 1/64 mm",
+            Self::TooShort => "topology: a spring is shorter than 1 mm",
             Self::BadEnd => "topology: a spring refers to a missing node or joins two fixed points",
+            Self::TooManySprings => "topology: more than 20 springs at one node",
         })
     }
 }
@@ -133,8 +136,18 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         }
         let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
         let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        if len < 1.0 / 64.0 {
+        if len < 1.0 {
             return Err(TopologyError::TooShort);
+        }
+        for i in [ia, ib] {
+            let degree = self
+                .edges
+                .iter()
+                .filter(|e| i != GROUND && (e.a == i || e.b == i))
+                .count();
+            if degree >= crate::solver::MAX_SPRINGS_PER_NODE {
+                return Err(TopologyError::TooManySprings);
+            }
         }
         let dir = d.map(|x| q::from_f64(x / len, LEN_FRAC));
         self.edges
@@ -161,6 +174,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     /// under every surface node; structural, shear and vertical springs, leaving out
     /// those with both ends fixed (n = 5: 61 springs, n = 8: 214). The contact node is
     /// `(n/2, n/2)`, at the origin.
+    #[inline(never)]
     pub fn standard_patch(n: usize, spacing: f64) -> Result<Self, TopologyError> {
         if !(3..=200).contains(&n) || !spacing.is_finite() || spacing <= 0.0 {
             return Err(TopologyError::BadGrid);

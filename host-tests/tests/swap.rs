@@ -1,0 +1,95 @@
+//! The main loop hands parameter sets to the tick through a `Mailbox` (double buffer):
+//! under real concurrency (two threads, critical-section's std implementation), every tick
+//! runs wholly on the old set or wholly on a new one, never a mix.
+
+use mccs::demo::{self, SmallDemoController};
+use mccs::{ForceTable64, Mailbox, ParamSet, Params, Shared, Telemetry};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static SWAP: Mailbox<ParamSet<64>> = Mailbox::new();
+static TELEMETRY: Shared<Telemetry> = Shared::new(Telemetry::new());
+static DONE: AtomicBool = AtomicBool::new(false);
+
+#[test]
+fn a_tick_runs_on_one_whole_parameter_set() {
+    let spec = demo::M3;
+    let ctl: SmallDemoController = spec
+        .controller(ForceTable64::new(&Params::TABLE2).unwrap())
+        .unwrap();
+    let a = spec.swapped_set::<5, 30>().unwrap();
+    let b = ctl
+        .solver()
+        .prepare(*ctl.solver().table(), &spec.config())
+        .unwrap();
+    assert_ne!(a.table(), b.table());
+
+    let poster = std::thread::spawn(move || {
+        let mut posts = 0u32;
+        while !DONE.load(Ordering::Relaxed) {
+            let _ = SWAP.post(if posts % 2 == 0 { a } else { b });
+            posts += 1;
+            if posts % 7 == 0 {
+                std::thread::yield_now();
+            }
+        }
+        posts
+    });
+
+    let mut ctl = ctl;
+    let mut swaps_seen = 0;
+    for _ in 0..spec.ticks() {
+        // What the tick could produce: the active set, A, or B — each wholly.
+        let candidates: Vec<_> = [None, Some(a), Some(b)]
+            .into_iter()
+            .map(|set| {
+                let (mut solver, mut device) = (ctl.solver().clone(), *ctl.device());
+                if let Some(s) = set {
+                    solver.apply(s);
+                }
+                let p = mccs::HapticDevice::read_position(&mut device).unwrap();
+                solver.step(p)
+            })
+            .collect();
+        let swap = SWAP.take();
+        swaps_seen += swap.is_some() as u32;
+        let force = ctl.tick(swap);
+        assert!(candidates.contains(&force), "a tick mixed parameter sets");
+        let (t, k) = (ctl.solver().table(), ctl.solver().substeps());
+        assert!(
+            (t == a.table() && k == a.substeps()) || (t == b.table() && k == b.substeps()),
+            "the active set is not one of the posted ones"
+        );
+        TELEMETRY.set(ctl.telemetry());
+    }
+    DONE.store(true, Ordering::Relaxed);
+    let posts = poster.join().unwrap();
+    assert!(
+        posts > 10 && swaps_seen > 10,
+        "posts {posts}, swaps {swaps_seen}"
+    );
+    assert_eq!(TELEMETRY.get().ticks, spec.ticks());
+}
+
+#[test]
+fn an_untaken_post_is_returned_to_the_poster() {
+    let m: Mailbox<u32> = Mailbox::new();
+    assert_eq!(m.post(1), None);
+    assert_eq!(m.post(2), Some(1));
+    assert_eq!(m.take(), Some(2));
+    assert_eq!(m.take(), None);
+}
+
+#[test]
+fn host_demo_matches_a_hand_run() {
+    for spec in [demo::M4F, demo::M3, demo::M0] {
+        let s = demo::run_on_host(&spec).unwrap();
+        assert_eq!(s.ticks, spec.ticks());
+        assert_eq!(s.overruns, 0);
+        assert!(
+            s.steady_force > 0.5 && s.steady_force < 0.7,
+            "{}",
+            s.steady_force
+        );
+        assert!(s.max_force > s.steady_force);
+    }
+}

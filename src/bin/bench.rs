@@ -1,0 +1,164 @@
+//! Instruction counts of the per-tick arithmetic, measured in QEMU under `-icount`:
+//! SysTick runs free (no interrupt) at the machine's clock, and is calibrated against a
+//! loop of known instruction count; each case is averaged over repeated calls of an
+//! `#[inline(never)]` entry point (`mccs::entry`) with `black_box`ed inputs, less the cost
+//! of an empty call. Prints `BENCH core=<m4f|m3|m0> case=<name> instructions=<n>`.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("bench is firmware: run it in QEMU (see README)");
+    std::process::exit(2);
+}
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::hint::black_box;
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use cortex_m_rt::{entry, exception, ExceptionFrame};
+    use defmt_semihosting as _;
+    use mccs::{entry as e, ForceTable64, Length, Solver, SolverConfig, Strain, Topology};
+
+    #[cfg(core = "m4f")]
+    const CORE: &str = "m4f";
+    #[cfg(core = "m3")]
+    const CORE: &str = "m3";
+    #[cfg(core = "m0")]
+    const CORE: &str = "m0";
+
+    static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
+
+    /// `n` iterations of a two-instruction loop.
+    #[inline(never)]
+    fn known_loop(n: u32) {
+        unsafe {
+            core::arch::asm!("2:", "subs {0}, #1", "bne 2b", inout(reg) n => _, options(nomem, nostack));
+        }
+    }
+
+    fn now() -> u32 {
+        SYST::get_current()
+    }
+
+    /// SysTick counts per 1024 instructions.
+    fn calibrate() -> u32 {
+        let t0 = now();
+        known_loop(black_box(1000));
+        let t1 = now();
+        known_loop(black_box(11000));
+        let t2 = now();
+        let small = t0.wrapping_sub(t1) & 0xFF_FFFF;
+        let large = t1.wrapping_sub(t2) & 0xFF_FFFF;
+        // 20000 more instructions in the large run.
+        ((large - small) as u64 * 1024 / 20000) as u32
+    }
+
+    /// Instructions of `reps` runs of `f`, per run.
+    fn measure(cpk: u32, reps: u32, mut f: impl FnMut()) -> u32 {
+        let t0 = now();
+        for _ in 0..reps {
+            f();
+        }
+        let t1 = now();
+        let counts = t0.wrapping_sub(t1) & 0xFF_FFFF;
+        ((counts as u64 * 1024 / cpk as u64) / reps as u64) as u32
+    }
+
+    #[entry]
+    fn main() -> ! {
+        let Some(mut cp) = cortex_m::Peripherals::take() else {
+            exit(false)
+        };
+        cp.SYST.set_clock_source(SystClkSource::Core);
+        cp.SYST.set_reload(0x00FF_FFFF);
+        cp.SYST.clear_current();
+        cp.SYST.enable_counter();
+        while now() == 0 {}
+        let cpk = calibrate();
+        defmt::info!("calibration: {=u32} counts per 1024 instructions", cpk);
+        let empty = measure(cpk, 64, || {
+            black_box(0u32);
+        });
+        let table = black_box(TABLE2);
+        let mut k = 0i32;
+        let fs = measure(cpk, 256, || {
+            k = k.wrapping_add(65_713);
+            let eps = Strain::from_bits((k & 0x00FF_FFFF) - 0x0040_0000);
+            black_box(e::force_and_stiffness(black_box(&table), eps));
+        });
+        defmt::println!(
+            "BENCH core={=str} case=force_and_stiffness instructions={=u32}",
+            CORE,
+            fs - empty
+        );
+        let mut r = 1 << 24;
+        let spring = measure(cpk, 256, || {
+            black_box(e::spring(
+                black_box(&table),
+                black_box([0, 0, -(1 << 24)]),
+                black_box(1 << 22),
+                black_box([0, 0, -(1 << 22)]),
+                black_box([0; 3]),
+                black_box([10, -20, 30]),
+                black_box([0; 3]),
+                &mut r,
+                black_box(16777),
+            ));
+        });
+        defmt::println!(
+            "BENCH core={=str} case=spring instructions={=u32}",
+            CORE,
+            spring - empty
+        );
+        let cfg = SolverConfig::default();
+        let (Ok(topo), true) = (Topology::<10, 61>::standard_patch(5, 2.5), cpk > 0) else {
+            exit(false)
+        };
+        let Ok(mut s5) = Solver::new(topo, table, &cfg) else {
+            exit(false)
+        };
+        let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
+        for _ in 0..200 {
+            e::tick(&mut s5, probe);
+        }
+        let sub5 = measure(cpk, 16, || e::substep(&mut s5, black_box(probe)));
+        defmt::println!(
+            "BENCH core={=str} case=substep_n5 instructions={=u32}",
+            CORE,
+            sub5 - empty
+        );
+        let tick = measure(cpk, 4, || {
+            black_box(e::tick(&mut s5, black_box(probe)));
+        });
+        defmt::println!(
+            "BENCH core={=str} case=tick instructions={=u32}",
+            CORE,
+            tick - empty
+        );
+        exit(true)
+    }
+
+    #[exception]
+    unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+        exit(false)
+    }
+
+    #[panic_handler]
+    fn panic(info: &core::panic::PanicInfo) -> ! {
+        defmt::error!("panic: {}", defmt::Display2Format(info));
+        exit(false)
+    }
+
+    fn exit(success: bool) -> ! {
+        use cortex_m_semihosting::debug;
+        debug::exit(if success {
+            debug::EXIT_SUCCESS
+        } else {
+            debug::EXIT_FAILURE
+        });
+        loop {
+            cortex_m::asm::bkpt();
+        }
+    }
+}
