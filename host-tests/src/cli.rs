@@ -85,6 +85,25 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Fit models to compression data (CSV `strain,force_n`) and compare them: one line
+    /// `FIT model=<name> mean_abs=<f> max_abs=<f> mse=<f>` per model.
+    Fit {
+        /// Data file, CSV with the header `strain,force_n`.
+        #[arg(long)]
+        data: PathBuf,
+        /// mccs, mcs, ms or all.
+        #[arg(long, default_value = "all")]
+        model: String,
+        /// Write the fitted MCCS parameters here (MODEL.md's TOML schema).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Draw the data and the fitted curves here (SVG).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Print the shipped synthetic demo data set (`params/demo-data.csv`): the Table 2
+    /// MCCS law at 40 forces to 1 N, strains with 1 % Gaussian noise (seed 2020).
+    DemoData,
     /// Run the firmware's demo on the host (the same code, fixed point) and print its
     /// SUMMARY line; with `--check LOG`, compare a firmware log's SUMMARY line with it.
     Demo {
@@ -155,6 +174,71 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             };
             write_curve(out, &rows)
         }
+        Command::Fit {
+            data,
+            model,
+            out: dest,
+            plot,
+        } => {
+            use crate::fit::{self, ModelKind};
+            let kinds: Vec<ModelKind> = match model.as_str() {
+                "all" => ModelKind::ALL.to_vec(),
+                name => vec![ModelKind::ALL
+                    .into_iter()
+                    .find(|k| k.name() == name)
+                    .ok_or_else(|| arg_error("--model", "must be mccs, mcs, ms or all"))?],
+            };
+            if dest.is_some() && !kinds.contains(&ModelKind::Mccs) {
+                return Err(arg_error(
+                    "--out",
+                    "needs the mccs model (--model mccs or all)",
+                ));
+            }
+            let points = fit::read_data(&data).map_err(|e| CliError(e.to_string()))?;
+            let mut fits = Vec::new();
+            for kind in kinds {
+                let f = fit::fit(kind, &points).ok_or_else(|| {
+                    CliError(format!(
+                        "{}: the {} model could not be fitted",
+                        data.display(),
+                        kind.name()
+                    ))
+                })?;
+                let m = f.metrics;
+                writeln!(
+                    out,
+                    "FIT model={} mean_abs={:.6} max_abs={:.6} mse={:.3e}",
+                    kind.name(),
+                    m.mean_abs,
+                    m.max_abs,
+                    m.mse
+                )
+                .map_err(io_error)?;
+                fits.push(f);
+            }
+            let mccs_params = fits.iter().find_map(|f| match f.model {
+                fit::Fitted::Mccs(p) => Some(p),
+                _ => None,
+            });
+            if let (Some(path), Some(p)) = (dest, mccs_params) {
+                let text = format!(
+                    "# MCCS parameters fitted by `mccs fit` to {}\n{}",
+                    data.display(),
+                    paramfile::to_toml(&p)
+                );
+                std::fs::write(&path, text)
+                    .map_err(|e| CliError(format!("{}: cannot write: {e}", path.display())))?;
+            }
+            if let Some(path) = plot {
+                let title = format!("{}: fitted models", data.display());
+                fit::plot(&path, &points, &fits, &title)
+                    .map_err(|e| CliError(format!("{}: cannot draw: {e}", path.display())))?;
+            }
+            Ok(())
+        }
+        Command::DemoData => out
+            .write_all(crate::fit::to_csv(&crate::fit::demo_data()).as_bytes())
+            .map_err(io_error),
         Command::Demo { core, check } => {
             let spec = mccs::demo::spec(&core)
                 .ok_or_else(|| arg_error("--core", "must be m4f, m3 or m0"))?;

@@ -5,6 +5,7 @@
 #![deny(missing_docs)]
 
 pub mod cli;
+pub mod fit;
 pub mod paramfile;
 pub mod patch;
 pub mod reference;

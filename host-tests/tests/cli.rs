@@ -370,3 +370,83 @@ fn patch_errors_name_the_argument() {
         &["--spacing"],
     );
 }
+
+#[test]
+fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
+    let dir = std::env::temp_dir().join(format!("mccs-fit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (toml, svg) = (dir.join("fitted.toml"), dir.join("fit.svg"));
+    let out = mccs(&[
+        "fit",
+        "--data",
+        "params/demo-data.csv",
+        "--model",
+        "all",
+        "--out",
+        toml.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 3);
+    for (line, model) in lines.iter().zip(["ms", "mcs", "mccs"]) {
+        assert!(
+            line.starts_with(&format!("FIT model={model} mean_abs=")),
+            "{line}"
+        );
+        assert!(line.contains(" max_abs=") && line.contains(" mse="));
+    }
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    // The fitted file feeds `mccs table` directly.
+    let out = mccs(&["table", "--params", toml.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let one = mccs(&["fit", "--data", "params/demo-data.csv", "--model", "mcs"]);
+    assert_eq!(String::from_utf8(one.stdout).unwrap().lines().count(), 1);
+}
+
+#[test]
+fn fit_errors_name_the_file_and_row() {
+    let bad = temp_file(
+        "bad.csv",
+        "strain,force_n\n0.1,0.1\n0.2,0.2\n0.15,0.3\n0.4,0.4\n0.5,0.5\n",
+    );
+    assert_usage_error(
+        &mccs(&["fit", "--data", bad.to_str().unwrap()]),
+        &["bad.csv", "row 4", "strain"],
+    );
+    let short = temp_file("short.csv", "strain,force_n\n0.1,0.1\n");
+    assert_usage_error(
+        &mccs(&["fit", "--data", short.to_str().unwrap()]),
+        &["short.csv", "at least 5"],
+    );
+    assert_usage_error(
+        &mccs(&["fit", "--data", "params/demo-data.csv", "--model", "fem"]),
+        &["--model"],
+    );
+    assert_usage_error(
+        &mccs(&[
+            "fit",
+            "--data",
+            "params/demo-data.csv",
+            "--model",
+            "ms",
+            "--out",
+            "x.toml",
+        ]),
+        &["--out"],
+    );
+    assert_usage_error(
+        &mccs(&["fit", "--data", "no/such.csv"]),
+        &["no/such.csv", "cannot read"],
+    );
+}
