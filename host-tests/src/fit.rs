@@ -298,7 +298,8 @@ pub fn ms_strain(c1: f64, c2: f64, c3: f64, f: f64) -> f64 {
         return 0.0;
     }
     let (mut lo, mut hi) = (0.0, 1.0 - 1e-12);
-    if !(ms_force(c1, c2, c3, hi) >= f) {
+    let top = ms_force(c1, c2, c3, hi);
+    if top.is_nan() || top < f {
         return hi;
     }
     for _ in 0..100 {
