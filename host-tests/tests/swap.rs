@@ -37,7 +37,13 @@ fn a_tick_runs_on_one_whole_parameter_set() {
 
     let mut ctl = ctl;
     let mut swaps_seen = 0;
-    for _ in 0..spec.ticks() {
+    let mut ticks = 0u32;
+    // Tick until 50 swaps have happened (the threads interleave as the OS pleases).
+    while swaps_seen < 50 && ticks < 200_000 {
+        ticks += 1;
+        if ticks % 5 == 0 {
+            std::thread::yield_now();
+        }
         // What the tick could produce: the active set, A, or B — each wholly.
         let candidates: Vec<_> = [None, Some(a), Some(b)]
             .into_iter()
@@ -63,11 +69,8 @@ fn a_tick_runs_on_one_whole_parameter_set() {
     }
     DONE.store(true, Ordering::Relaxed);
     let posts = poster.join().unwrap();
-    assert!(
-        posts > 10 && swaps_seen > 10,
-        "posts {posts}, swaps {swaps_seen}"
-    );
-    assert_eq!(TELEMETRY.get().ticks, spec.ticks());
+    assert!(swaps_seen >= 50, "posts {posts}, swaps {swaps_seen}");
+    assert_eq!(TELEMETRY.get().ticks, ticks);
 }
 
 #[test]
