@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what the project needs on a fresh machine: the three thumb targets, Debian's
-# qemu-system-arm (as root), and defmt-print (to decode the firmware's logs). Sourced by
+# Installs what the project needs on a fresh machine: the three thumb targets, rustup's
+# llvm-tools, Debian's qemu-system-arm (as root), and defmt-print (to decode the
+# firmware's logs). Sourced by
 # scripts/demo.sh and scripts/test.sh.
 set -euo pipefail
 
@@ -12,6 +13,11 @@ for t in "${need_targets[@]}"; do
     rustup target add "$t" >&2
   fi
 done
+
+if ! rustup component list --installed | grep -q '^llvm-tools'; then
+  echo "setup: rustup component add llvm-tools (llvm-objdump, for the tick-path check)" >&2
+  rustup component add llvm-tools >&2
+fi
 
 if ! command -v qemu-system-arm >/dev/null 2>&1; then
   if [ "$(id -u)" = 0 ]; then

@@ -33,12 +33,24 @@ for core in m4f m3 m0; do
   ./target/release/mccs demo --core "$core" --check "target/qemu/demo-$core.log"
 done
 
-step "firmware in QEMU: a panic exits with failure"
+step "static check of the per-tick path: no panic, division or floating point"
+for t in thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi; do
+  python3 scripts/check_tick_path.py "target/$t/release/haptic" | tail -n 1
+done
+
+step "firmware in QEMU: a panic exits with failure (and the check above sees it)"
 if bash scripts/firmware.sh m4f --features panic-test > target/qemu/panic.log; then
   echo "test.sh: the panic-test firmware exited with success" >&2
   exit 1
 fi
 grep -q "panic: " target/qemu/panic.log
+if python3 scripts/check_tick_path.py target/thumbv7em-none-eabihf/release/haptic > /dev/null; then
+  echo "test.sh: the tick-path check missed the injected panic" >&2
+  exit 1
+fi
+
+step "instruction counts in QEMU against bench/baseline.txt (no figure may grow by more than 5 %)"
+bash scripts/bench.sh
 
 step "host tests"
 log=$(mktemp)

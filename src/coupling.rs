@@ -63,7 +63,8 @@ impl CouplingQ {
             let spring = (dx * self.stiffness as i64) >> 20;
             let damper = (dv * self.damping as i64) >> 20;
             let f = sat(spring + damper);
-            out[i] = f.clamp(-self.max_force, self.max_force);
+            // max/min, not clamp: clamp keeps a panic path for min > max.
+            out[i] = f.max(-self.max_force).min(self.max_force);
         }
         out
     }

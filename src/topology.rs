@@ -77,8 +77,8 @@ impl core::error::Error for TopologyError {}
 #[derive(Clone, Debug)]
 pub struct Topology<const NODES: usize, const EDGES: usize> {
     edges: Vec<Edge, EDGES>,
-    /// Rest positions of the nodes (index 0: ground, unused), mm.
-    rest: Vec<[f64; 3], NODES>,
+    /// Rest positions of the nodes (index 0: ground, unused), mm, Q24.
+    rest: Vec<[i32; 3], NODES>,
     contact: u16,
 }
 
@@ -93,7 +93,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     pub fn new() -> Self {
         let mut rest = Vec::new();
         // NODES = 0 leaves no room for the ground: every later call reports capacity.
-        let _ = rest.push([0.0; 3]);
+        let _ = rest.push([0; 3]);
         Self {
             edges: Vec::new(),
             rest,
@@ -111,7 +111,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         }
         let index = self.rest.len();
         self.rest
-            .push(rest)
+            .push(rest.map(|x| q::from_f64(x, LEN_FRAC)))
             .map_err(|_| TopologyError::NodeCapacity)?;
         Ok(index as u16)
     }
@@ -121,7 +121,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         let end = |e: End| -> Result<(u16, [f64; 3]), TopologyError> {
             match e {
                 End::Free(i) if i != GROUND && (i as usize) < self.rest.len() => {
-                    Ok((i, self.rest[i as usize]))
+                    Ok((i, self.rest[i as usize].map(from_q24)))
                 }
                 End::Free(_) => Err(TopologyError::BadEnd),
                 End::Fixed(p) if p.iter().all(|x| x.is_finite() && x.abs() <= 100.0) => {
@@ -245,11 +245,15 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
 
     /// Rest position of node `i` (mm), `None` if it does not exist.
     pub fn rest(&self, i: u16) -> Option<[f64; 3]> {
-        self.rest.get(i as usize).copied()
+        self.rest.get(i as usize).map(|p| p.map(from_q24))
     }
 
     /// Rest length of edge `e` (mm), from its stored `1/l0`.
     pub fn rest_length(e: &Edge) -> f64 {
         (1u64 << LEN_FRAC) as f64 / e.inv_len as f64
     }
+}
+
+fn from_q24(x: i32) -> f64 {
+    x as f64 / (1u64 << LEN_FRAC) as f64
 }

@@ -111,32 +111,81 @@ mod firmware {
             CORE,
             spring - empty
         );
-        let cfg = SolverConfig::default();
-        let (Ok(topo), true) = (Topology::<10, 61>::standard_patch(5, 2.5), cpk > 0) else {
-            exit(false)
-        };
-        let Ok(mut s5) = Solver::new(topo, table, &cfg) else {
-            exit(false)
-        };
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
-        for _ in 0..200 {
-            e::tick(&mut s5, probe);
+        let sub3 = substep_case::<2, 9>(cpk, 3, &table, probe);
+        report("substep_n3", sub3 - empty);
+        let sub4 = substep_case::<5, 30>(cpk, 4, &table, probe);
+        report("substep_n4", sub4 - empty);
+        let sub5 = substep_case::<10, 61>(cpk, 5, &table, probe);
+        report("substep_n5", sub5 - empty);
+        #[cfg(not(core = "m0"))]
+        {
+            let sub8 = substep_case::<37, 214>(cpk, 8, &table, probe);
+            report("substep_n8", sub8 - empty);
         }
-        let sub5 = measure(cpk, 16, || e::substep(&mut s5, black_box(probe)));
+        // One whole tick of this core's demo configuration, in contact.
+        let tick = tick_case(cpk, &table, probe);
+        report("tick", tick - empty);
         defmt::println!(
-            "BENCH core={=str} case=substep_n5 instructions={=u32}",
+            "MEM core={=str} solver_n4={=usize} solver_n5={=usize} solver_n8={=usize} table={=usize}",
             CORE,
-            sub5 - empty
-        );
-        let tick = measure(cpk, 4, || {
-            black_box(e::tick(&mut s5, black_box(probe)));
-        });
-        defmt::println!(
-            "BENCH core={=str} case=tick instructions={=u32}",
-            CORE,
-            tick - empty
+            core::mem::size_of::<Solver<5, 30, 64>>(),
+            core::mem::size_of::<Solver<10, 61, 64>>(),
+            core::mem::size_of::<Solver<37, 214, 64>>(),
+            core::mem::size_of::<ForceTable64>()
         );
         exit(true)
+    }
+
+    fn report(case: &str, instructions: u32) {
+        defmt::println!(
+            "BENCH core={=str} case={=str} instructions={=u32}",
+            CORE,
+            case,
+            instructions
+        );
+    }
+
+    /// One substep of the standard N × N patch (2.5 mm, default configuration), after
+    /// 200 ticks pressed in, averaged over 16.
+    #[inline(never)]
+    fn substep_case<const N: usize, const E: usize>(
+        cpk: u32,
+        n: usize,
+        table: &ForceTable64,
+        probe: [Length; 3],
+    ) -> u32 {
+        let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
+            exit(false)
+        };
+        let Ok(mut s) = Solver::new(topo, *table, &SolverConfig::default()) else {
+            exit(false)
+        };
+        for _ in 0..200 {
+            e::tick(&mut s, probe);
+        }
+        measure(cpk, 16, || e::substep(&mut s, black_box(probe)))
+    }
+
+    /// One tick of this core's demo configuration, pressed in, averaged over 4.
+    #[inline(never)]
+    fn tick_case(cpk: u32, table: &ForceTable64, probe: [Length; 3]) -> u32 {
+        #[cfg(core = "m4f")]
+        let (spec, topo) = (mccs::demo::M4F, Topology::<10, 61>::standard_patch(5, 2.5));
+        #[cfg(core = "m3")]
+        let (spec, topo) = (mccs::demo::M3, Topology::<10, 61>::standard_patch(4, 2.5));
+        #[cfg(core = "m0")]
+        let (spec, topo) = (mccs::demo::M0, Topology::<10, 61>::standard_patch(4, 2.5));
+        let Ok(topo) = topo else { exit(false) };
+        let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
+            exit(false)
+        };
+        for _ in 0..200 {
+            e::tick(&mut s, probe);
+        }
+        measure(cpk, 4, || {
+            black_box(e::tick(&mut s, black_box(probe)));
+        })
     }
 
     #[exception]
