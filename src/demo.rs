@@ -46,14 +46,14 @@ pub const M4F: DemoSpec = DemoSpec {
     clock_hz: 168_000_000,
 };
 
-/// Cortex-M3 (LM3S6965, 50 MHz): N = 4 at 1 kHz, 3 substeps per tick (heavier haptic
+/// Cortex-M3 (LM3S6965, 50 MHz): N = 4 at 1 kHz, 2 substeps per tick (heavier haptic
 /// masses and more damping). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
 pub const M3: DemoSpec = DemoSpec {
     core: "m3",
     tick_hz: 1000,
     grid: 4,
-    node_mass: 0.02,
-    spring_damping: 2.0,
+    node_mass: 0.03,
+    spring_damping: 3.0,
     icount_shift: 5,
     clock_hz: 50_000_000,
 };
