@@ -578,18 +578,7 @@ impl PatchRun {
             Backend::Reference => {
                 let law = Reference::new(p).map_err(|e| file_error(file, e))?;
                 let mesh = crate::patch::Mesh::standard(self.grid, self.spacing);
-                let mut tc = crate::patch::TwinConfig {
-                    tick_hz: self.rate,
-                    substeps: 0,
-                    node_mass: cfg.node_mass,
-                    spring_damping: cfg.spring_damping,
-                    node_damping: cfg.node_damping,
-                    coupling: (
-                        cfg.coupling.stiffness,
-                        cfg.coupling.damping,
-                        cfg.coupling.max_force,
-                    ),
-                };
+                let mut tc = crate::patch::TwinConfig::from_solver(&cfg, 0);
                 let k_max = reference_max_stiffness(&law);
                 let n = crate::patch::substeps(&mesh, k_max, &tc)
                     .ok_or_else(|| too_stiff(mccs::SolverError::NoDamping))?;

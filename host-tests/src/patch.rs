@@ -110,6 +110,24 @@ pub struct TwinConfig {
     pub coupling: (f64, f64, f64),
 }
 
+impl TwinConfig {
+    /// The twin of a core `SolverConfig`, at `substeps` per tick.
+    pub fn from_solver(cfg: &mccs::SolverConfig, substeps: u32) -> TwinConfig {
+        TwinConfig {
+            tick_hz: cfg.tick_hz,
+            substeps,
+            node_mass: cfg.node_mass,
+            spring_damping: cfg.spring_damping,
+            node_damping: cfg.node_damping,
+            coupling: (
+                cfg.coupling.stiffness,
+                cfg.coupling.damping,
+                cfg.coupling.max_force,
+            ),
+        }
+    }
+}
+
 /// The stability bound of the core's solver docs, computed independently: substeps per
 /// tick for `mesh` with the law's largest tangent stiffness `k_max` (N per unit strain).
 pub fn substeps(mesh: &Mesh, k_max: f64, cfg: &TwinConfig) -> Option<u32> {

@@ -9,18 +9,7 @@ use nalgebra::{DMatrix, DVector};
 type Fixed<const N: usize, const E: usize> = Solver<N, E, 64>;
 
 fn twin_config(cfg: &SolverConfig, substeps: u32) -> TwinConfig {
-    TwinConfig {
-        tick_hz: cfg.tick_hz,
-        substeps,
-        node_mass: cfg.node_mass,
-        spring_damping: cfg.spring_damping,
-        node_damping: cfg.node_damping,
-        coupling: (
-            cfg.coupling.stiffness,
-            cfg.coupling.damping,
-            cfg.coupling.max_force,
-        ),
-    }
+    TwinConfig::from_solver(cfg, substeps)
 }
 
 fn fixed<const N: usize, const E: usize>(

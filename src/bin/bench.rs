@@ -13,11 +13,15 @@ fn main() {
 }
 
 #[cfg(target_os = "none")]
+mod fw_common;
+
+#[cfg(target_os = "none")]
 mod firmware {
+    use super::fw_common;
     use core::hint::black_box;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
-    use cortex_m_rt::{entry, exception, ExceptionFrame};
-    use defmt_semihosting as _;
+    use cortex_m_rt::entry;
+    use fw_common::exit;
     use mccs::{entry as e, ForceTable64, Length, Solver, SolverConfig, Strain, Topology};
 
     #[cfg(core = "m4f")]
@@ -186,28 +190,5 @@ mod firmware {
         measure(cpk, 4, || {
             black_box(e::tick(&mut s, black_box(probe)));
         })
-    }
-
-    #[exception]
-    unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-        exit(false)
-    }
-
-    #[panic_handler]
-    fn panic(info: &core::panic::PanicInfo) -> ! {
-        defmt::error!("panic: {}", defmt::Display2Format(info));
-        exit(false)
-    }
-
-    fn exit(success: bool) -> ! {
-        use cortex_m_semihosting::debug;
-        debug::exit(if success {
-            debug::EXIT_SUCCESS
-        } else {
-            debug::EXIT_FAILURE
-        });
-        loop {
-            cortex_m::asm::bkpt();
-        }
     }
 }

@@ -24,16 +24,16 @@ fn main() {
 }
 
 #[cfg(target_os = "none")]
+mod fw_common;
+
+#[cfg(target_os = "none")]
 mod firmware {
+    use super::fw_common;
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
-    use cortex_m_rt::{entry, exception, ExceptionFrame};
+    use cortex_m_rt::{entry, exception};
+    use fw_common::exit;
     use mccs::demo::{self, DemoSpec};
     use mccs::{ForceTable64, Mailbox, ParamSet, Shared, Telemetry};
-
-    #[cfg(feature = "rtt")]
-    use defmt_rtt as _;
-    #[cfg(not(feature = "rtt"))]
-    use defmt_semihosting as _;
 
     /// SysTick clock (the core clock as each QEMU machine models it).
     #[cfg(core = "m4f")]
@@ -229,37 +229,8 @@ mod firmware {
         }
     }
 
-    #[exception]
-    unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-        exit(false)
-    }
-
-    #[panic_handler]
-    fn panic(info: &core::panic::PanicInfo) -> ! {
-        defmt::error!("panic: {}", defmt::Display2Format(info));
-        exit(false)
-    }
-
     fn fail(what: &str) -> ! {
         defmt::error!("start-up failed: {=str}", what);
         exit(false)
-    }
-
-    /// Ends the run: QEMU exits through semihosting (0 on success); on hardware with RTT
-    /// logging, the core stops at a breakpoint.
-    fn exit(success: bool) -> ! {
-        #[cfg(not(feature = "rtt"))]
-        {
-            use cortex_m_semihosting::debug;
-            debug::exit(if success {
-                debug::EXIT_SUCCESS
-            } else {
-                debug::EXIT_FAILURE
-            });
-        }
-        let _ = success;
-        loop {
-            cortex_m::asm::bkpt();
-        }
     }
 }
