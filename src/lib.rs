@@ -26,6 +26,7 @@ pub mod coupling;
 pub mod demo;
 pub mod device;
 pub mod entry;
+pub mod float_patch;
 pub mod law;
 pub mod mailbox;
 pub mod motor;

@@ -22,6 +22,7 @@ mod firmware {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::entry;
     use fw_common::exit;
+    use mccs::float_patch::{FloatPatch, Real};
     use mccs::{entry as e, ForceTable64, Length, Solver, SolverConfig, Strain, Topology};
 
     #[cfg(core = "m4f")]
@@ -127,6 +128,19 @@ mod firmware {
             let sub8 = substep_case::<37, 214>(cpk, 8, &table, probe);
             report("substep_n8", sub8 - empty);
         }
+        // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
+        // in f64 (software everywhere).
+        let f32_5 = float_case::<f32, 10, 61>(cpk, 5, &table);
+        report("substep_n5_f32", f32_5 - empty);
+        let f64_5 = float_case::<f64, 10, 61>(cpk, 5, &table);
+        report("substep_n5_f64", f64_5 - empty);
+        #[cfg(not(core = "m0"))]
+        {
+            let f32_8 = float_case::<f32, 37, 214>(cpk, 8, &table);
+            report("substep_n8_f32", f32_8 - empty);
+            let f64_8 = float_case::<f64, 37, 214>(cpk, 8, &table);
+            report("substep_n8_f64", f64_8 - empty);
+        }
         // One whole tick of this core's demo configuration, in contact.
         let tick = tick_case(cpk, &table, probe);
         report("tick", tick - empty);
@@ -169,6 +183,37 @@ mod firmware {
             e::tick(&mut s, probe);
         }
         measure(cpk, 16, || e::substep(&mut s, black_box(probe)))
+    }
+
+    /// One floating-point substep of the standard N × N patch, after 200 substeps pressed
+    /// in, averaged over 4.
+    #[inline(never)]
+    fn float_case<T: Real, const N: usize, const E: usize>(
+        cpk: u32,
+        n: usize,
+        table: &ForceTable64,
+    ) -> u32 {
+        let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
+            exit(false)
+        };
+        let cfg = SolverConfig::default();
+        let Ok(substeps) = Solver::<N, E, 64>::substeps_for(&topo, table, &cfg) else {
+            exit(false)
+        };
+        let mut p = FloatPatch::<T, N, E, 64>::new(&topo, table, &cfg, substeps);
+        let probe = [T::ZERO, T::ZERO, T::of(-0.5)];
+        for _ in 0..200 {
+            float_substep(&mut p, probe);
+        }
+        measure(cpk, 4, || float_substep(&mut p, black_box(probe)))
+    }
+
+    #[inline(never)]
+    fn float_substep<T: Real, const N: usize, const E: usize>(
+        p: &mut FloatPatch<T, N, E, 64>,
+        probe: [T; 3],
+    ) {
+        p.substep(probe)
     }
 
     /// One tick of this core's demo configuration, pressed in, averaged over 4.
