@@ -11,11 +11,13 @@
 //! [`Solver::step`] runs a fixed number of substeps (chosen at construction), each a loop
 //! over the springs and one over the nodes: constant time, no division, no square root
 //! (the length comes from a warm-started Newton step for `1/l`), no floating point, no
-//! heap, no panic, saturating arithmetic throughout.
+//! heap, no panic; every step saturates or works within ranges the clamps bound (see
+//! [`spring_force`]).
 //!
 //! # Units and formats
 //! Displacements from rest in mm, Q24, kept within ±60 mm; velocities in mm/s, Q16, kept
-//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's force within ±128 N). Positions are in the patch frame (origin at the contact
+//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's law force within ±64 N,
+//! its damping within ±32 N). Positions are in the patch frame (origin at the contact
 //! node's rest position, `z` up).
 //!
 //! # Stability (the substep count)
