@@ -33,30 +33,43 @@ pub trait Real:
     fn from_index(i: usize) -> Self;
 }
 
-impl Real for f32 {
-    const ZERO: Self = 0.0;
-    fn of(x: f64) -> Self {
-        x as f32
-    }
-    #[inline(always)]
-    fn index(self) -> usize {
-        self as usize
-    }
-    #[inline(always)]
-    fn from_index(i: usize) -> Self {
-        i as Self
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        #[cfg(core = "m4f")]
-        {
-            // SAFETY: the Cortex-M4F has the single-precision FPU this instruction needs.
-            unsafe { vsqrt(self) }
+/// `Real` for a primitive float, its square root given as a function.
+macro_rules! real {
+    ($t:ty, $sqrt:expr) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            fn of(x: f64) -> Self {
+                x as $t
+            }
+            #[inline(always)]
+            fn index(self) -> usize {
+                self as usize
+            }
+            #[inline(always)]
+            fn from_index(i: usize) -> Self {
+                i as $t
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $sqrt(self)
+            }
         }
-        #[cfg(not(core = "m4f"))]
-        {
-            libm::sqrtf(self)
-        }
+    };
+}
+
+real!(f32, sqrt_f32);
+real!(f64, libm::sqrt);
+
+#[inline(always)]
+fn sqrt_f32(x: f32) -> f32 {
+    #[cfg(core = "m4f")]
+    {
+        // SAFETY: the Cortex-M4F has the single-precision FPU this instruction needs.
+        unsafe { vsqrt(x) }
+    }
+    #[cfg(not(core = "m4f"))]
+    {
+        libm::sqrtf(x)
     }
 }
 
@@ -83,25 +96,6 @@ unsafe extern "C" {
 unsafe fn vsqrt(x: f32) -> f32 {
     // SAFETY: the function above reads s0 and returns in s0, nothing else.
     unsafe { mccs_vsqrtf(x) }
-}
-
-impl Real for f64 {
-    const ZERO: Self = 0.0;
-    fn of(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn index(self) -> usize {
-        self as usize
-    }
-    #[inline(always)]
-    fn from_index(i: usize) -> Self {
-        i as Self
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        libm::sqrt(self)
-    }
 }
 
 #[derive(Clone, Copy)]

@@ -111,35 +111,18 @@ impl<const K: usize> ProbePath<K> {
 /// contact node, at `tick_hz` (waypoint times scale with it). Depth 1.2 mm below the
 /// surface, stroke 2 mm along `x`.
 pub fn demo_path(tick_hz: u32) -> Result<ProbePath<7>, PathError> {
-    let at = |s: f64| (s * tick_hz as f64) as u32;
-    ProbePath::new(&[
-        Waypoint {
-            tick: at(0.0),
-            position: [0.0, 0.0, 1.0],
-        },
-        Waypoint {
-            tick: at(0.3),
-            position: [0.0, 0.0, 0.0],
-        },
-        Waypoint {
-            tick: at(0.7),
-            position: [0.0, 0.0, -1.2],
-        },
-        Waypoint {
-            tick: at(1.0),
-            position: [0.0, 0.0, -1.2],
-        },
-        Waypoint {
-            tick: at(1.5),
-            position: [2.0, 0.0, -1.2],
-        },
-        Waypoint {
-            tick: at(1.8),
-            position: [2.0, 0.0, 1.0],
-        },
-        Waypoint {
-            tick: at(2.0),
-            position: [2.0, 0.0, 1.0],
-        },
-    ])
+    // (time in s, position in mm)
+    const LEGS: [(f64, [f64; 3]); 7] = [
+        (0.0, [0.0, 0.0, 1.0]),
+        (0.3, [0.0, 0.0, 0.0]),
+        (0.7, [0.0, 0.0, -1.2]),
+        (1.0, [0.0, 0.0, -1.2]),
+        (1.5, [2.0, 0.0, -1.2]),
+        (1.8, [2.0, 0.0, 1.0]),
+        (2.0, [2.0, 0.0, 1.0]),
+    ];
+    ProbePath::new(&LEGS.map(|(s, position)| Waypoint {
+        tick: (s * tick_hz as f64) as u32,
+        position,
+    }))
 }
