@@ -146,22 +146,11 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
     ) -> Self {
         let raw = table.raw();
         let q = |x: i32, frac: u32| x as f64 / (1u64 << frac) as f64;
-        let (vs, ps) = (raw.value_shift, raw.poly_shift);
+        // C0 … C3 carry 1, 2, 4, 8 times c0 … c3, in Q(20 + shift) N.
+        let unit = (1u64 << (20 + raw.shift)) as f64;
         let mut seg = [[T::ZERO; 4]; S];
-        for (i, s) in seg.iter_mut().enumerate() {
-            let [c0, c1, c2] = raw.segments[i];
-            let next = if i + 1 < S {
-                raw.segments[i + 1][0]
-            } else {
-                raw.knot_last
-            };
-            let c3 = ((next as i64 - c0 as i64) << (ps - vs)) - c1 as i64 - c2 as i64;
-            *s = [
-                T::of(q(c0, 20 + vs)),
-                T::of(q(c1, 20 + ps)),
-                T::of(q(c2, 20 + ps)),
-                T::of(c3 as f64 / (1u64 << (20 + ps)) as f64),
-            ];
+        for (s, c) in seg.iter_mut().zip(raw.segments.iter()) {
+            *s = core::array::from_fn(|j| T::of(c[j] as f64 / unit / (1u32 << j) as f64));
         }
         let mut springs = [Spring {
             a: 0,
@@ -189,7 +178,7 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             seg,
             strain_lo: T::of(q(raw.strain_lo, 24)),
             strain_hi: T::of(q(raw.strain_hi, 24)),
-            per_strain: T::of(q(raw.segments_per_strain, 16)),
+            per_strain: T::of(raw.index_scale as f64 * raw.index_pre as f64 / (1u64 << 23) as f64),
             k_lo: T::of(q(raw.stiffness_lo, 16)),
             f_lo: T::of(q(raw.force_lo, 20) - q(raw.stiffness_lo, 16) * q(raw.anchor_lo, 24)),
             k_hi: T::of(q(raw.stiffness_hi, 16)),

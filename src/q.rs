@@ -75,3 +75,95 @@ pub fn from_f64(x: f64, frac: u32) -> i32 {
         v as i32
     }
 }
+
+/// `⌊a · b / 2³²⌋`: the high word of the signed 64-bit product.
+///
+/// One `smull` on cores with a long multiply; on the Cortex-M0 (32 × 32 → 32 only)
+/// [`mulhi_split`], which gives the same bits.
+#[inline(always)]
+pub fn mulhi(a: i32, b: i32) -> i32 {
+    #[cfg(core = "m0")]
+    {
+        mulhi_split(a, b)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        ((a as i64 * b as i64) >> 32) as i32
+    }
+}
+
+/// [`mulhi`] from four 16 × 16 products, exact: with `a = a₁2¹⁶ + a₀`, `b = b₁2¹⁶ + b₀`
+/// (`a₀, b₀ ∈ [0, 2¹⁶)`), `m = a₁b₀ + ⌊a₀b₀/2¹⁶⌋` and `n = a₀b₁ + (m mod 2¹⁶)` both
+/// fit `i32`, and `⌊ab/2³²⌋ = a₁b₁ + ⌊m/2¹⁶⌋ + ⌊n/2¹⁶⌋`.
+#[inline(always)]
+pub fn mulhi_split(a: i32, b: i32) -> i32 {
+    let (a1, a0) = (a >> 16, (a & 0xFFFF) as u32);
+    let (b1, b0) = (b >> 16, (b & 0xFFFF) as u32);
+    let m = a1
+        .wrapping_mul(b0 as i32)
+        .wrapping_add((a0.wrapping_mul(b0) >> 16) as i32);
+    let n = (a0 as i32).wrapping_mul(b1).wrapping_add(m & 0xFFFF);
+    a1.wrapping_mul(b1)
+        .wrapping_add(m >> 16)
+        .wrapping_add(n >> 16)
+}
+
+/// `⌊a · b / 2³²⌋` unsigned: one `umull` with a long multiply, else [`mulhi_u_split`].
+#[inline(always)]
+pub fn mulhi_u(a: u32, b: u32) -> u32 {
+    #[cfg(core = "m0")]
+    {
+        mulhi_u_split(a, b)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        ((a as u64 * b as u64) >> 32) as u32
+    }
+}
+
+/// [`mulhi_u`] from four 16 × 16 products, exact (the unsigned [`mulhi_split`]).
+#[inline(always)]
+pub fn mulhi_u_split(a: u32, b: u32) -> u32 {
+    // LLVM recognises this pattern and would fold it back into a 64-bit product, which
+    // on the M0 is a library call (`__aeabi_lmul`): an empty `asm!` hides one half.
+    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF));
+    let (b1, b0) = (b >> 16, b & 0xFFFF);
+    let m = a1.wrapping_mul(b0).wrapping_add(a0.wrapping_mul(b0) >> 16);
+    let n = a0.wrapping_mul(b1).wrapping_add(m & 0xFFFF);
+    a1.wrapping_mul(b1)
+        .wrapping_add(m >> 16)
+        .wrapping_add(n >> 16)
+}
+
+/// `⌊a · t / 2¹⁶⌋` for `t ∈ [0, 2¹⁵)`: a product by a Q15 fraction that comes out halved
+/// (callers scale their coefficients for it). One `smull` against `t · 2¹⁶` with a long
+/// multiply, else [`mul_t_split`]; the same bits. Larger `t` are masked to 15 bits.
+#[inline(always)]
+pub fn mul_t(a: i32, t: u32) -> i32 {
+    #[cfg(core = "m0")]
+    {
+        mul_t_split(a, t)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        ((a as i64 * (((t & 0x7FFF) << 16) as i32) as i64) >> 32) as i32
+    }
+}
+
+/// [`mul_t`] from two 16 × 16 products, exact: `⌊at/2¹⁶⌋ = a₁t + ⌊a₀t/2¹⁶⌋`.
+#[inline(always)]
+pub fn mul_t_split(a: i32, t: u32) -> i32 {
+    let t = t & 0x7FFF;
+    let (a1, a0) = (a >> 16, (a & 0xFFFF) as u32);
+    a1.wrapping_mul(t as i32)
+        .wrapping_add((a0.wrapping_mul(t) >> 16) as i32)
+}
+
+/// `x`, through an empty `asm!` block: no instruction, but the optimiser cannot see what
+/// it is, so it cannot rewrite the arithmetic around it.
+#[inline(always)]
+fn opaque(mut x: u32) -> u32 {
+    // SAFETY: the template is empty: it reads and writes only `x`'s register.
+    unsafe { core::arch::asm!("/* {0} */", inout(reg) x, options(pure, nomem, nostack)) };
+    x
+}

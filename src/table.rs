@@ -40,14 +40,13 @@
 
 use crate::law::Law;
 use crate::params::{ParamError, Params};
+use crate::q::{mul_t, mulhi, mulhi_u};
 use crate::{Force, Stiffness, Strain};
 use core::fmt;
 
 const STRAIN_FRAC: u32 = 24;
 const FORCE_FRAC: u32 = 20;
 const STIFF_FRAC: u32 = 16;
-/// Fraction bits of the segment coordinate `u = (ε − ε_lo) · segments per unit strain`.
-const U_FRAC: u32 = 16;
 
 /// The default strain domain `[ε_min, ε_max]`.
 pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
@@ -57,10 +56,14 @@ pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
 pub struct RawTable<const S: usize> {
     /// Lower end of the tabulated strain range (Q24).
     pub strain_lo: i32,
-    /// Upper end of the tabulated strain range (Q24).
+    /// Upper end of the tabulated strain range (Q24), exclusive.
     pub strain_hi: i32,
-    /// Segments per unit strain (Q16).
-    pub segments_per_strain: i32,
+    /// The segment coordinate of a strain `e` inside the table, Q15 segments, is
+    /// `⌊(e − strain_lo) · index_pre · index_scale / 2³²⌋` (unsigned; `index_pre` a power
+    /// of two that puts the table's width at the top of a `u32`).
+    pub index_pre: u32,
+    /// See `index_pre`.
+    pub index_scale: u32,
     /// The line below `strain_lo` passes through (`anchor_lo`, `force_lo`) (Q24, Q20 N):
     /// through zero when the table starts at the kink, else through the first knot.
     pub anchor_lo: i32,
@@ -72,18 +75,19 @@ pub struct RawTable<const S: usize> {
     pub force_hi: i32,
     /// Slope of the line above `strain_hi` (Q16 N per unit strain).
     pub stiffness_hi: i32,
-    /// Extra fraction bits of the knot values `c0`: Q(20 + `value_shift`) N, 0 … 10.
-    pub value_shift: u32,
-    /// Extra fraction bits of `c1, c2, c3`: Q(20 + `poly_shift`) N, `value_shift` … 24.
-    pub poly_shift: u32,
-    /// Per segment `[c0, c1, c2]` of `F(t) = c0 + c1 t + c2 t² + c3 t³`, `t ∈ [0, 1)`:
-    /// `c0` is the knot value, and `c3` is implied, since the cubic ends on the next knot:
-    /// `c3 = ((c0' − c0) << (poly_shift − value_shift)) − c1 − c2`. The shifts are chosen
-    /// per table so that each part uses most of `i32`: the knots keep sub-Q20 precision,
-    /// and a small slope under a large force keeps its resolution.
-    pub segments: [[i32; 3]; S],
-    /// The last knot's value, Q(20 + `value_shift`) N.
-    pub knot_last: i32,
+    /// The coefficients' unit: Q(20 + `shift`) N, `shift` ∈ 0 … 12.
+    pub shift: u32,
+    /// The stiffness in Q16 is `⌊D · stiff_scale / 2³²⌋ · stiff_post` for `D = 2 dF/dτ` in
+    /// the coefficients' unit (`stiff_post` a power of two).
+    pub stiff_scale: i32,
+    /// See `stiff_scale`.
+    pub stiff_post: i32,
+    /// Per segment `[C0, C1, C2, C3] = [c0, 2 c1, 4 c2, 8 c3]` of the cubic
+    /// `F(τ) = c0 + c1 τ + c2 τ² + c3 τ³`, `τ ∈ [0, 1)`: the degree-`j` coefficient carries
+    /// `2^j` so that each Horner step is one product by `τ/2` ([`crate::q::mul_t`]).
+    /// `c0` is the knot value and `C3 = 8 (c0' − c0) − 4 C1 − 2 C2` makes the cubic end
+    /// on the next knot `c0'` exactly.
+    pub segments: [[i32; 4]; S],
 }
 
 /// A tabulated inverse law with `S` segments (`S + 1` knots); see the module docs.
@@ -145,27 +149,6 @@ impl fmt::Display for TableError {
 
 impl core::error::Error for TableError {}
 
-/// `(a · t) >> 16` for a Q16 `t ∈ [0, 65535]`, exact floor.
-///
-/// Cores with a 32 × 32 → 64 multiply (everything but Cortex-M0) use it; the M0 splits
-/// `a = hi·2^16 + lo` (`lo ∈ [0, 65535]`): `(a·t) >> 16 = hi·t + (lo·t) >> 16` exactly,
-/// and neither product overflows 32 bits for `t ≤ 65535`. Both give the same bits.
-#[inline(always)]
-pub fn mul_q16(a: i32, t: i32) -> i32 {
-    #[cfg(core = "m0")]
-    {
-        let hi = a >> 16;
-        let lo = (a & 0xFFFF) as u32;
-        hi.wrapping_mul(t)
-            .wrapping_add(((lo * t as u32) >> 16) as i32)
-    }
-    #[cfg(not(core = "m0"))]
-    {
-        // t ∈ [0, 65535]: through u16, so the compiler knows it is not negative.
-        ((a as i64 * (t as u16) as i64) >> 16) as i32
-    }
-}
-
 fn q(x: f64, frac: u32) -> Option<i32> {
     let v = libm::round(x * (1u64 << frac) as f64);
     if v.is_finite() && v >= i32::MIN as f64 && v <= i32::MAX as f64 {
@@ -173,11 +156,6 @@ fn q(x: f64, frac: u32) -> Option<i32> {
     } else {
         None
     }
-}
-
-#[inline(always)]
-fn sat_i32(x: i64) -> i32 {
-    x.clamp(i32::MIN as i64, i32::MAX as i64) as i32
 }
 
 impl<const S: usize> ForceTable<S> {
@@ -235,12 +213,30 @@ impl<const S: usize> ForceTable<S> {
         let strain_lo = q(lo_grid, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         let grid_moved = lo_grid < lo;
         let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
-        let per_strain = q(S as f64 / width, U_FRAC).ok_or(TableError::TooNarrow)?;
-        if per_strain <= 0 {
+        // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
+        // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
+        // scale keeps about 21 significant bits.
+        let span = libm::ceil(width * (1u64 << STRAIN_FRAC) as f64) + 2.0;
+        if !(span < (1u64 << 32) as f64) {
+            return Err(TableError::BadDomain);
+        }
+        let mut index_shift = 0u32;
+        while index_shift < 31 && span * (2u64 << index_shift) as f64 <= (1u64 << 32) as f64 {
+            index_shift += 1;
+        }
+        let scale = libm::floor(S as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
+        if !(scale >= 1.0 && scale < (1u64 << 32) as f64) {
             return Err(TableError::TooNarrow);
         }
-        // The evaluation places knot i at lo + i / per_strain: build at exactly those strains.
-        let step = (1u64 << U_FRAC) as f64 / per_strain as f64;
+        let index_scale = scale as u32;
+        // The evaluation places knot i at lo + i · step: build at exactly those strains.
+        let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
+        // Strains below strain_lo + d (in Q24 LSBs) have coordinates below S·2¹⁵.
+        let num = (S as u128) << 47;
+        let den = (index_scale as u128) << index_shift;
+        let d = num.div_ceil(den);
+        let strain_hi =
+            i32::try_from(strain_lo as i128 + d as i128).map_err(|_| TableError::BadDomain)?;
         let unit = (1u64 << FORCE_FRAC) as f64;
         // Knot i: force, and the slopes dF/dt (per segment) from below and from above,
         // all in Q20 N units, unrounded.
@@ -259,7 +255,7 @@ impl<const S: usize> ForceTable<S> {
             };
             let below = 1.0 / law.compliance(f_slope);
             let above = 1.0 / law.compliance_above(f_slope);
-            if !(libm::fabs(f * unit) < (1u64 << 31) as f64
+            if !(libm::fabs(f * unit) < (1u64 << 30) as f64
                 && below.is_finite()
                 && above.is_finite())
             {
@@ -267,44 +263,14 @@ impl<const S: usize> ForceTable<S> {
             }
             Ok((f * unit, below * step * unit, above * step * unit))
         };
-        // First pass: the largest knot value and the largest polynomial coefficient bound
-        // (|c1|, |c2|, |c3| ≤ 3|secant| + 3 max|slope|) pick the two shifts.
-        let (mut big_value, mut big_poly) = (1.0f64, 1.0f64);
-        let mut prev = knot(0)?;
-        for i in 0..=S {
-            let k = if i == 0 { prev } else { knot(i)? };
-            let secant = libm::fabs(k.0 - prev.0);
-            let slopes = libm::fmax(libm::fabs(k.1), libm::fabs(prev.2));
-            big_value = libm::fmax(big_value, libm::fabs(k.0));
-            big_poly = libm::fmax(big_poly, 3.0 * secant + 3.0 * slopes);
-            prev = k;
-        }
-        let fits = |big: f64, shift: u32| big * (1u64 << shift) as f64 <= (1u64 << 29) as f64;
-        let mut value_shift = 0u32;
-        while value_shift < 10 && fits(big_value, value_shift + 1) {
-            value_shift += 1;
-        }
-        let mut poly_shift = value_shift;
-        while poly_shift < 24 && fits(big_poly, poly_shift + 1) {
-            poly_shift += 1;
-        }
-        let (vscale, pscale) = ((1u64 << value_shift) as f64, (1u64 << poly_shift) as f64);
-        // Second pass: the segments, knots rounded to Q(20 + value_shift).
-        let round_knot = |f: f64| -> f64 { libm::round(f * vscale) };
-        let (f_first, _, m_first) = knot(0)?;
-        let mut segments = [[0i32; 3]; S];
-        let (mut a0, mut m0) = (round_knot(f_first), m_first);
-        let a_first = a0;
-        for (i, c) in segments.iter_mut().enumerate() {
-            let (f1, m1, m1_above) = knot(i + 1)?;
-            let a1 = round_knot(f1);
-            // In the polynomial's scale: secant and end slopes.
-            let secant = (a1 - a0) * (pscale / vscale);
-            let (mut s0, mut s1) = (m0 * pscale, m1 * pscale);
-            // Fritsch–Carlson: where the law bends harder than the grid resolves (a soft
-            // cone against a stiff series spring, just below the solid point), scale the
-            // end slopes of this segment into the circle α² + β² ≤ 9 that keeps the cubic
-            // monotone. Smooth laws (Table 2) never reach it.
+        // The cubic of one segment from its end values `a0, a1` and end slopes `m0, m1`
+        // (same unit): `[C1, C2, C3]` unrounded, with the Fritsch–Carlson limiter where the
+        // law bends harder than the grid resolves (a soft cone against a stiff series
+        // spring, just below the solid point): the end slopes are scaled into the circle
+        // α² + β² ≤ 9 that keeps the cubic monotone. Smooth laws (Table 2) never reach it.
+        let cubic = |a0: f64, a1: f64, m0: f64, m1: f64| -> [f64; 3] {
+            let secant = a1 - a0;
+            let (mut s0, mut s1) = (m0, m1);
             if secant > 0.0 {
                 let (al, be) = (s0 / secant, s1 / secant);
                 let r2 = al * al + be * be;
@@ -313,22 +279,92 @@ impl<const S: usize> ForceTable<S> {
                     (s0, s1) = (tau * s0, tau * s1);
                 }
             }
-            let c1 = libm::round(s0);
-            let c2 = libm::round(3.0 * secant - 2.0 * s0 - s1);
-            let c3 = secant - c1 - c2; // exact: the segment ends on the next knot
-            let limit = (1u64 << 30) as f64;
-            if [a0, c1, c2, c3].iter().any(|v| libm::fabs(*v) >= limit) {
+            let c1 = 2.0 * s0;
+            let c2 = 4.0 * (3.0 * secant - 2.0 * s0 - s1);
+            [c1, c2, 8.0 * secant - 4.0 * c1 - 2.0 * c2]
+        };
+        // First pass, in Q20: the largest knot and the largest |C1| + |C2| + |C3| pick the
+        // unit: knots within 2³⁰ and that sum within 2²⁹, so that no Horner step of the
+        // value or the stiffness can overflow.
+        let (mut big_value, mut big_poly) = (1e-30f64, 1e-30f64);
+        let mut prev = knot(0)?;
+        big_value = libm::fmax(big_value, libm::fabs(prev.0));
+        for i in 1..=S {
+            let k = knot(i)?;
+            let c = cubic(prev.0, k.0, prev.2, k.1);
+            big_value = libm::fmax(big_value, libm::fabs(k.0));
+            big_poly = libm::fmax(
+                big_poly,
+                libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]),
+            );
+            prev = k;
+        }
+        let fits = |shift: u32| {
+            let x = (1u64 << shift) as f64;
+            big_value * x <= (1u64 << 30) as f64 - 64.0
+                && 1.01 * big_poly * x <= (1u64 << 29) as f64 - 64.0
+        };
+        if !fits(0) {
+            return Err(TableError::OutOfRange);
+        }
+        let mut shift = 0u32;
+        while shift < 12 && fits(shift + 1) {
+            shift += 1;
+        }
+        let scale = (1u64 << shift) as f64;
+        // Second pass: the segments, knots rounded to Q(20 + shift).
+        let (f_first, _, m_first) = knot(0)?;
+        let mut segments = [[0i32; 4]; S];
+        let (mut a0, mut m0) = (libm::round(f_first * scale), m_first);
+        let a_first = a0;
+        let mut slope_bound = 0.0f64;
+        for (i, c) in segments.iter_mut().enumerate() {
+            let (f1, m1, m1_above) = knot(i + 1)?;
+            let a1 = libm::round(f1 * scale);
+            // C1, C2 rounded at full resolution; C3 = 8 (a1 − a0) − 4 C1 − 2 C2 exact,
+            // so that c0 + c1 + c2 + c3 is the next knot.
+            let [c1, c2, _] = cubic(a0, a1, m0 * scale, m1 * scale);
+            let (c1, c2) = (libm::round(c1), libm::round(c2));
+            let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+            if libm::fabs(a0) >= (1u64 << 30) as f64
+                || libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3) > (1u64 << 29) as f64
+            {
                 return Err(TableError::OutOfRange);
             }
-            *c = [a0 as i32, c1 as i32, c2 as i32];
+            // |dF/dτ| ≤ |c1| + 2|c2| + 3|c3|, in the unit.
+            slope_bound = libm::fmax(
+                slope_bound,
+                libm::fabs(c1) / 2.0 + libm::fabs(c2) / 2.0 + 3.0 * libm::fabs(c3) / 8.0,
+            );
+            *c = [a0 as i32, c1 as i32, c2 as i32, c3 as i32];
             (a0, m0) = (a1, m1_above);
         }
+        // Stiffness: dF/dε (Q16) = (D / 2) · sps · 2^(16 − 20 − shift) for D = 2 dF/dτ,
+        // sps = 1/step segments per strain: ⌊D · M / 2³²⌋ with M = sps · 2^(27 − shift)
+        // (at least sps · 2¹⁵ significant: `shift` ≤ 12), a power of two moved into
+        // `stiff_post` while M would not fit.
+        let sps = 1.0 / step;
+        if !(slope_bound / (scale * unit) * sps * (1u64 << STIFF_FRAC) as f64
+            <= (1u64 << 30) as f64)
+        {
+            return Err(TableError::OutOfRange);
+        }
+        let mut v = sps * libm::ldexp(1.0, 27 - shift as i32);
+        let mut post = 0u32;
+        while v >= (1u64 << 31) as f64 - 1.0 && post < 30 {
+            v /= 2.0;
+            post += 1;
+        }
+        if v >= (1u64 << 31) as f64 - 1.0 {
+            return Err(TableError::OutOfRange);
+        }
+        let stiff_scale = libm::round(v) as i32;
+        let stiff_post = 1i32 << post;
         // The lines are anchored on the end knots floored to Q20: the table's own values
         // floor the same way, so the curve stays monotone across the anchors.
-        let first_q20 = (a_first as i32) >> value_shift;
-        let last_q20 = (a0 as i32) >> value_shift;
+        let first_q20 = (a_first as i32) >> shift;
+        let last_q20 = (a0 as i32) >> shift;
         let e_hi = lo + S as f64 * step;
-        let strain_hi = q(e_hi, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         // Below the table: at the kink, the exact line `k ε` through zero, with `k` rounded
         // down so that the line never passes above the first knot (the curve stays
         // monotone; the step up at the knot is `(k − k_q) ε_lo` ≤ 2^-16 ε_lo N). Otherwise
@@ -354,16 +390,17 @@ impl<const S: usize> ForceTable<S> {
         let raw = RawTable {
             strain_lo,
             strain_hi,
-            segments_per_strain: per_strain,
+            index_pre: 1 << index_shift,
+            index_scale,
             anchor_lo,
             force_lo,
             stiffness_lo,
             force_hi: last_q20,
             stiffness_hi: q(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
-            value_shift,
-            poly_shift,
+            shift,
+            stiff_scale,
+            stiff_post,
             segments,
-            knot_last: a0 as i32,
         };
         Ok(Self { raw })
     }
@@ -410,13 +447,13 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
-            return line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
+            return Force::from_bits(line(r.force_lo, r.stiffness_lo, e, r.anchor_lo));
         }
         if e >= r.strain_hi {
-            return line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
+            return Force::from_bits(line(r.force_hi, r.stiffness_hi, e, r.strain_hi));
         }
         let (c, t) = self.segment(e);
-        Force::from_bits(value(r, &c, poly(&c, t)))
+        Force::from_bits(value(r, c, t))
     }
 
     /// Force (N) and tangent stiffness `dF/dε` (N per unit strain) at `strain`;
@@ -427,62 +464,62 @@ impl<const S: usize> ForceTable<S> {
         let e = strain.to_bits();
         if e <= r.strain_lo {
             let f = line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
-            return (f, Stiffness::from_bits(r.stiffness_lo));
+            return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_lo));
         }
         if e >= r.strain_hi {
             let f = line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
-            return (f, Stiffness::from_bits(r.stiffness_hi));
+            return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_hi));
         }
         let (c, t) = self.segment(e);
-        let f = value(r, &c, poly(&c, t));
-        // dF/dt = c1 + 2 c2 t + 3 c3 t², then dF/dε = dF/dt · segments per strain.
-        let c2x2 = c[2].saturating_mul(2);
-        let c3x3 = c[3].saturating_mul(3);
-        let dfdt = c[1].saturating_add(mul_q16(c2x2.saturating_add(mul_q16(c3x3, t)), t));
-        let k = (dfdt as i64 * r.segments_per_strain as i64)
-            >> (FORCE_FRAC + U_FRAC - STIFF_FRAC + r.poly_shift);
-        (Force::from_bits(f), Stiffness::from_bits(sat_i32(k)))
+        let f = value(r, c, t);
+        // D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ², in the same halving Horner form.
+        let c3x3 = c[3].wrapping_mul(3);
+        let c2x2 = c[2].wrapping_mul(2);
+        let d = c[1].wrapping_add(mul_t(c2x2.wrapping_add(mul_t(c3x3, t)), t));
+        let k = mulhi(d, r.stiff_scale).wrapping_mul(r.stiff_post);
+        (Force::from_bits(f), Stiffness::from_bits(k))
     }
 
-    /// The segment holding `e` (strictly inside the table) and the Q16 position in it.
+    /// The segment holding `e` (`strain_lo < e < strain_hi`) and the Q15 position in it.
     #[inline(always)]
-    fn segment(&self, e: i32) -> ([i32; 4], i32) {
+    fn segment(&self, e: i32) -> (&[i32; 4], u32) {
         let r = &self.raw;
-        // e > strain_lo and segments_per_strain > 0: an unsigned 32 × 32 → 64 product.
-        let u = (e.wrapping_sub(r.strain_lo) as u32 as u64 * r.segments_per_strain as u32 as u64)
-            >> STRAIN_FRAC;
-        let i = ((u >> U_FRAC) as usize).min(S - 1);
-        let t = (u - ((i as u64) << U_FRAC)).min((1 << U_FRAC) - 1) as i32;
-        let [c0, c1, c2] = r.segments[i];
-        let next = if i + 1 < S {
-            r.segments[i + 1][0]
+        let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
+        let pos = mulhi_u(de, r.index_scale);
+        // strain_hi is placed so that pos < S · 2¹⁵ here: the mask (or min) only keeps
+        // the compiler from adding a bounds check.
+        let i = (pos >> 15) as usize;
+        let i = if S.is_power_of_two() {
+            i & (S - 1)
         } else {
-            r.knot_last
+            i.min(S - 1)
         };
-        let secant = next.wrapping_sub(c0) << (r.poly_shift - r.value_shift);
-        ([c0, c1, c2, secant.wrapping_sub(c1).wrapping_sub(c2)], t)
+        (&r.segments[i], pos & 0x7FFF)
     }
 }
 
-/// `c1 t + c2 t² + c3 t³` in the polynomial's scale, Q(20 + `poly_shift`).
+/// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.
 #[inline(always)]
-fn poly(c: &[i32; 4], t: i32) -> i32 {
-    let a = c[2].saturating_add(mul_q16(c[3], t));
-    let a = c[1].saturating_add(mul_q16(a, t));
-    mul_q16(a, t)
-}
-
-/// `c0 + poly` in Q20 N.
-#[inline(always)]
-fn value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], poly: i32) -> i32 {
-    c[0].saturating_add(poly >> (r.poly_shift - r.value_shift)) >> r.value_shift
+fn value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32) -> i32 {
+    let a = c[2].wrapping_add(mul_t(c[3], t));
+    let a = c[1].wrapping_add(mul_t(a, t));
+    c[0].wrapping_add(mul_t(a, t)).wrapping_shr(r.shift)
 }
 
 /// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;
-/// saturating. `k ≥ 0` and `|e − e0| < 2^32` keep the product within `i64`.
+/// saturating: the high and low words of the product, combined only when they fit.
 #[inline(always)]
-fn line(f0: i32, k: i32, e: i32, e0: i32) -> Force {
-    let de = e as i64 - e0 as i64;
-    let df = (k as i64 * de) >> (STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC);
-    Force::from_bits(sat_i32(f0 as i64 + df))
+fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
+    let de = e.saturating_sub(e0);
+    let hi = mulhi(k, de);
+    let lo = k.wrapping_mul(de) as u32;
+    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let df = if (hi >> (SH - 1)) == (hi >> 31) {
+        (hi << (32 - SH)) | (lo >> SH) as i32
+    } else if hi < 0 {
+        i32::MIN
+    } else {
+        i32::MAX
+    };
+    f0.saturating_add(df)
 }

@@ -439,25 +439,29 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
         "mccs::ForceTable::<{S}>::from_raw(mccs::RawTable {{\n"
     ));
     for (name, v) in [
-        ("strain_lo", r.strain_lo),
-        ("strain_hi", r.strain_hi),
-        ("segments_per_strain", r.segments_per_strain),
-        ("anchor_lo", r.anchor_lo),
-        ("force_lo", r.force_lo),
-        ("stiffness_lo", r.stiffness_lo),
-        ("force_hi", r.force_hi),
-        ("stiffness_hi", r.stiffness_hi),
+        ("strain_lo", r.strain_lo as i64),
+        ("strain_hi", r.strain_hi as i64),
+        ("index_pre", r.index_pre as i64),
+        ("index_scale", r.index_scale as i64),
+        ("anchor_lo", r.anchor_lo as i64),
+        ("force_lo", r.force_lo as i64),
+        ("stiffness_lo", r.stiffness_lo as i64),
+        ("force_hi", r.force_hi as i64),
+        ("stiffness_hi", r.stiffness_hi as i64),
+        ("shift", r.shift as i64),
+        ("stiff_scale", r.stiff_scale as i64),
+        ("stiff_post", r.stiff_post as i64),
     ] {
-        s.push_str(&format!("    {name}: {v},\n"));
-    }
-    for (name, v) in [("value_shift", r.value_shift), ("poly_shift", r.poly_shift)] {
         s.push_str(&format!("    {name}: {v},\n"));
     }
     s.push_str("    segments: [\n");
     for c in &r.segments {
-        s.push_str(&format!("        [{}, {}, {}],\n", c[0], c[1], c[2]));
+        s.push_str(&format!(
+            "        [{}, {}, {}, {}],\n",
+            c[0], c[1], c[2], c[3]
+        ));
     }
-    s.push_str(&format!("    ],\n    knot_last: {},\n}})\n", r.knot_last));
+    s.push_str("    ],\n})\n");
     s
 }
 

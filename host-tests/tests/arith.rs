@@ -1,0 +1,61 @@
+//! The Cortex-M0 has no 32 × 32 → 64 multiply: its products are built from 16 × 16
+//! pieces (`mccs::q::*_split`). They must give the same bits as the long multiply the
+//! other cores use, over the whole input range, so that the host tests (long multiply)
+//! also hold for the M0 firmware.
+
+use mccs::q::{mul_t, mul_t_split, mulhi, mulhi_split, mulhi_u, mulhi_u_split};
+use proptest::prelude::*;
+
+const EDGES: [i32; 12] = [
+    i32::MIN,
+    i32::MIN + 1,
+    -65537,
+    -65536,
+    -65535,
+    -1,
+    0,
+    1,
+    65535,
+    65536,
+    i32::MAX - 1,
+    i32::MAX,
+];
+
+#[test]
+fn split_products_match_at_the_edges() {
+    for a in EDGES {
+        for b in EDGES {
+            assert_eq!(
+                mulhi_split(a, b),
+                ((a as i64 * b as i64) >> 32) as i32,
+                "{a} {b}"
+            );
+            assert_eq!(mulhi(a, b), mulhi_split(a, b));
+            let (ua, ub) = (a as u32, b as u32);
+            assert_eq!(
+                mulhi_u_split(ua, ub),
+                ((ua as u64 * ub as u64) >> 32) as u32
+            );
+            assert_eq!(mulhi_u(ua, ub), mulhi_u_split(ua, ub));
+            for t in [0u32, 1, 0x4000, 0x7FFE, 0x7FFF] {
+                let want = ((a as i64 * t as i64) >> 16) as i32;
+                assert_eq!(mul_t_split(a, t), want, "{a} {t}");
+                assert_eq!(mul_t(a, t), want);
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(20_000))]
+
+    #[test]
+    fn split_products_match(a in any::<i32>(), b in any::<i32>(), t in 0u32..0x8000) {
+        prop_assert_eq!(mulhi_split(a, b), ((a as i64 * b as i64) >> 32) as i32);
+        prop_assert_eq!(mulhi(a, b), mulhi_split(a, b));
+        let (ua, ub) = (a as u32, b as u32);
+        prop_assert_eq!(mulhi_u_split(ua, ub), ((ua as u64 * ub as u64) >> 32) as u32);
+        prop_assert_eq!(mul_t_split(a, t), ((a as i64 * t as i64) >> 16) as i32);
+        prop_assert_eq!(mul_t(a, t), mul_t_split(a, t));
+    }
+}
