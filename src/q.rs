@@ -163,7 +163,14 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
 /// it is, so it cannot rewrite the arithmetic around it.
 #[inline(always)]
 fn opaque(mut x: u32) -> u32 {
-    // SAFETY: the template is empty: it reads and writes only `x`'s register.
-    unsafe { core::arch::asm!("/* {0} */", inout(reg) x, options(pure, nomem, nostack)) };
+    // SAFETY: the template is a comment: it reads and writes only `x`'s register.
+    #[cfg(target_arch = "arm")]
+    unsafe {
+        core::arch::asm!("/* {0} */", inout(reg) x, options(pure, nomem, nostack))
+    };
+    #[cfg(not(target_arch = "arm"))]
+    {
+        x = core::hint::black_box(x);
+    }
     x
 }

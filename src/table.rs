@@ -217,7 +217,7 @@ impl<const S: usize> ForceTable<S> {
         // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
         // scale keeps about 21 significant bits.
         let span = libm::ceil(width * (1u64 << STRAIN_FRAC) as f64) + 2.0;
-        if !(span < (1u64 << 32) as f64) {
+        if span.is_nan() || span >= (1u64 << 32) as f64 {
             return Err(TableError::BadDomain);
         }
         let mut index_shift = 0u32;
@@ -344,9 +344,8 @@ impl<const S: usize> ForceTable<S> {
         // (at least sps · 2¹⁵ significant: `shift` ≤ 12), a power of two moved into
         // `stiff_post` while M would not fit.
         let sps = 1.0 / step;
-        if !(slope_bound / (scale * unit) * sps * (1u64 << STIFF_FRAC) as f64
-            <= (1u64 << 30) as f64)
-        {
+        let k_bound = slope_bound / (scale * unit) * sps * (1u64 << STIFF_FRAC) as f64;
+        if k_bound.is_nan() || k_bound > (1u64 << 30) as f64 {
             return Err(TableError::OutOfRange);
         }
         let mut v = sps * libm::ldexp(1.0, 27 - shift as i32);
