@@ -97,7 +97,8 @@ pub fn mulhi(a: i32, b: i32) -> i32 {
 /// fit `i32`, and `⌊ab/2³²⌋ = a₁b₁ + ⌊m/2¹⁶⌋ + ⌊n/2¹⁶⌋`.
 #[inline(always)]
 pub fn mulhi_split(a: i32, b: i32) -> i32 {
-    let (a1, a0) = (a >> 16, (a & 0xFFFF) as u32);
+    // See `mulhi_u_split` on `opaque`.
+    let (a1, a0) = (a >> 16, opaque((a & 0xFFFF) as u32));
     let (b1, b0) = (b >> 16, (b & 0xFFFF) as u32);
     let m = a1
         .wrapping_mul(b0 as i32)
@@ -106,6 +107,27 @@ pub fn mulhi_split(a: i32, b: i32) -> i32 {
     a1.wrapping_mul(b1)
         .wrapping_add(m >> 16)
         .wrapping_add(n >> 16)
+}
+
+/// The full signed product `a · b`: one `smull` with a long multiply; on the M0 the high
+/// word from [`mulhi_split`] and the low word from one 32-bit multiply (the same bits,
+/// without the `__aeabi_lmul` call).
+#[inline(always)]
+pub fn mul_wide(a: i32, b: i32) -> i64 {
+    #[cfg(core = "m0")]
+    {
+        mul_wide_split(a, b)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        a as i64 * b as i64
+    }
+}
+
+/// [`mul_wide`] from [`mulhi_split`] and the low word, exact.
+#[inline(always)]
+pub fn mul_wide_split(a: i32, b: i32) -> i64 {
+    ((mulhi_split(a, b) as i64) << 32) | a.wrapping_mul(b) as u32 as i64
 }
 
 /// `⌊a · b / 2³²⌋` unsigned: one `umull` with a long multiply, else [`mulhi_u_split`].
@@ -162,7 +184,32 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
 /// `x`, through an empty `asm!` block: no instruction, but the optimiser cannot see what
 /// it is, so it cannot rewrite the arithmetic around it.
 #[inline(always)]
-fn opaque(mut x: u32) -> u32 {
+pub fn opaque<T: Opaque>(x: T) -> T {
+    x.opaque()
+}
+
+/// 32-bit values that [`opaque`] takes.
+pub trait Opaque: Copy {
+    /// See [`opaque`].
+    fn opaque(self) -> Self;
+}
+
+impl Opaque for i32 {
+    #[inline(always)]
+    fn opaque(self) -> Self {
+        opaque_u32(self as u32) as i32
+    }
+}
+
+impl Opaque for u32 {
+    #[inline(always)]
+    fn opaque(self) -> Self {
+        opaque_u32(self)
+    }
+}
+
+#[inline(always)]
+fn opaque_u32(mut x: u32) -> u32 {
     // SAFETY: the template is a comment: it reads and writes only `x`'s register.
     #[cfg(target_arch = "arm")]
     unsafe {

@@ -48,25 +48,29 @@ const ONE: i32 = 1 << LEN_FRAC;
 const VEL_FRAC: u32 = 16;
 /// Fraction bits of forces (N).
 const FORCE_FRAC: u32 = 20;
-/// Fraction bits of damping coefficients (N·s/mm).
-const DAMP_FRAC: u32 = 24;
-/// Fraction bits of `h/m` ((mm/s)/N).
+/// Fraction bits of the spring damping (N·s/mm): Q16 mm/s · Q28 = Q44, the format of
+/// the spring's `w · (f l0/l)` product (Q24 · Q20).
+const DAMP_FRAC: u32 = 28;
+/// Fraction bits of `h/m` ((mm/s)/N) and of `1 − h c/m` (the velocity kept through the
+/// node damping): Q20 N · Q20 and Q16 mm/s · Q24 are both Q40, shifted by 24 to Q16 mm/s.
 const HM_FRAC: u32 = 20;
-/// Fraction bits of `h/2` (s).
-const HALF_H_FRAC: u32 = 32;
-/// Bounds of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
-const R_MAX: i32 = 16 << LEN_FRAC;
-const R_MIN: i32 = 1 << (LEN_FRAC - 3);
-/// Largest law force of one spring, N in Q20: 64 N.
+const KEEP_FRAC: u32 = 24;
+/// Fraction bits of `h/2` (s): Q16 mm/s · Q40 s → high word Q24 mm.
+const HALF_H_FRAC: u32 = 40;
+/// Upper bound of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
+const R_MAX: i32 = (16 << LEN_FRAC) - 1;
+/// Largest force of one spring (law and damping together), N in Q20: 64 N.
 pub const SPRING_FORCE_LIMIT: i32 = 64 << FORCE_FRAC;
-/// Largest damping force of one spring, N in Q20: 32 N.
-pub const DAMP_FORCE_LIMIT: i32 = 32 << FORCE_FRAC;
+/// Largest law force per unit current length, `|f| · l0/l`, N in Q20: 512 N.
+pub const FORCE_PER_STRETCH_LIMIT: i32 = 512 << FORCE_FRAC;
 /// Most springs at one node: their summed forces cannot overflow the Q20 accumulator.
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
-/// Largest displacement from rest, mm in Q24: 60 mm.
-const DISP_LIMIT: i32 = 60 << LEN_FRAC;
-/// Largest speed, mm/s in Q16: 16384 mm/s.
+/// Largest displacement from rest, mm in Q24: just under 64 mm.
+const DISP_LIMIT: i32 = 1 << 30;
+/// Largest speed, mm/s in Q16: just under 16384 mm/s.
 const VEL_LIMIT: i32 = 1 << 30;
+/// Largest edge vector over the rest length, per axis: 2 (Q24).
+const W_LIMIT: i32 = 2 << LEN_FRAC;
 
 /// Runtime configuration of a [`Solver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,9 +79,9 @@ pub struct SolverConfig {
     pub tick_hz: f64,
     /// Haptic (scaled) mass of each free node, kg.
     pub node_mass: f64,
-    /// Relative-velocity damping of each spring (eq. 17), N·s/m (0 … 10).
+    /// Relative-velocity damping of each spring (eq. 17), N·s/m (0 … 30).
     pub spring_damping: f64,
-    /// Absolute damping of each node (eq. 21), N·s/m (≥ 0).
+    /// Absolute damping of each node (eq. 21), N·s/m (0 … 10,000).
     pub node_damping: f64,
     /// Largest number of substeps per tick the stability bound may ask for.
     pub max_substeps: u32,
@@ -178,12 +182,12 @@ enum Drive {
 struct Coeffs {
     /// `h/m`, (mm/s)/N, Q20.
     h_over_m: i32,
-    /// `h/2`, s, Q32.
+    /// `1 − h c_node / m`, dimensionless, Q24 (in [½, 1] by the stability bound).
+    keep: i32,
+    /// `h/2`, s, Q40.
     half_h: i32,
-    /// Spring damping, N·s/mm, Q24.
+    /// Spring damping, N·s/mm, Q28.
     spring_damping: i32,
-    /// Node damping, N·s/mm, Q24.
-    node_damping: i32,
     /// Tick rate, Hz (for the probe velocity).
     tick_hz: i32,
     coupling: CouplingQ,
@@ -219,12 +223,8 @@ pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
     c: Coeffs,
     substeps: u32,
     contact: usize,
-    /// Displacement from rest, Q24 mm.
-    disp: [V3; NODES],
-    /// Velocity, Q16 mm/s.
-    vel: [V3; NODES],
-    /// Force accumulator of the current substep, Q20 N.
-    force: [V3; NODES],
+    /// Per node: displacement, velocity, force accumulator.
+    nodes: [Node; NODES],
     /// Warm-started `l0 / l` of each spring, Q24.
     inv_stretch: [i32; EDGES],
     /// Last probe position, Q24 mm.
@@ -254,9 +254,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             c: set.c,
             substeps: set.substeps,
             contact,
-            disp: [[0; 3]; NODES],
-            vel: [[0; 3]; NODES],
-            force: [[0; 3]; NODES],
+            nodes: [Node::ZERO; NODES],
             inv_stretch: [ONE; EDGES],
             probe_prev: [0; 3],
             reaction: [0; 3],
@@ -295,13 +293,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         // N·s/m → N·s/mm: / 1000. h/m: (s/kg = m/(s·N)) · 1000 → (mm/s)/N.
         let c = Coeffs {
             h_over_m: q::from_f64(1000.0 * h / config.node_mass, HM_FRAC),
+            keep: q::from_f64(1.0 - h * config.node_damping / config.node_mass, KEEP_FRAC),
             half_h: q::from_f64(0.5 * h, HALF_H_FRAC),
             spring_damping: q::from_f64(config.spring_damping / 1000.0, DAMP_FRAC),
-            node_damping: q::from_f64(config.node_damping / 1000.0, DAMP_FRAC),
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ {
                 stiffness: q::from_f64(cp.stiffness, 16),
-                damping: q::from_f64(cp.damping / 1000.0, DAMP_FRAC),
+                damping: q::from_f64(cp.damping / 1000.0, 24),
                 max_force: q::from_f64(cp.max_force, FORCE_FRAC),
             },
         };
@@ -330,7 +328,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             K::NodeMass,
         )?;
         check(
-            (0.0..=1e4).contains(&config.spring_damping),
+            (0.0..=30.0).contains(&config.spring_damping),
             K::SpringDamping,
         )?;
         check((0.0..=1e4).contains(&config.node_damping), K::NodeDamping)?;
@@ -386,7 +384,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         // h/m must fit Q20 ((mm/s)/N < 2048) and h/2 must fit Q32 comfortably.
         let h = 1.0 / (config.tick_hz * n as f64);
         check(1000.0 * h / config.node_mass < 2000.0, K::NodeMass)?;
-        check(h < 0.004, K::TickHz)?;
+        check(
+            0.5 * h * ((1u64 << HALF_H_FRAC) as f64) < (i32::MAX as f64),
+            K::TickHz,
+        )?;
         Ok(n)
     }
 
@@ -430,7 +431,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
     /// node (N), `z` positive when it resists a downward indentation.
     pub fn step_held(&mut self, position: [Length; 3]) -> [Force; 3] {
         let target = position.map(Length::to_bits);
-        let prev = self.disp.get(self.contact).copied().unwrap_or([0; 3]);
+        let prev = self.node_disp(self.contact);
         // The held node moves linearly from where it was to the target over the tick.
         let vel = core::array::from_fn(|i| {
             q::sat(((target[i] as i64 - prev[i] as i64) * self.c.tick_hz as i64) >> 8)
@@ -447,30 +448,34 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
 
     /// Displacement of node `i` from rest (mm), `None` if it does not exist.
     pub fn displacement(&self, i: u16) -> Option<[Length; 3]> {
-        self.disp.get(i as usize).map(|d| d.map(Length::from_bits))
+        self.nodes
+            .get(i as usize)
+            .map(|n| n.u.map(Length::from_bits))
     }
 
     /// Velocity of node `i` (mm/s, as `I16F16`).
     pub fn velocity(&self, i: u16) -> Option<[Velocity; 3]> {
-        self.vel.get(i as usize).map(|v| v.map(Velocity::from_bits))
+        self.nodes
+            .get(i as usize)
+            .map(|n| n.v.map(Velocity::from_bits))
     }
 
-    /// Puts node `i` at displacement `disp` (mm) with velocity `vel` (mm/s); the ground
-    /// and missing nodes are ignored. For tests and for starting from a known state.
+    /// Puts node `i` at displacement `disp` (mm) with velocity `vel` (mm/s), clamped to
+    /// the solver's limits (±64 mm, ±16384 mm/s); the ground and missing nodes are ignored. For tests and for starting from a known state.
     pub fn set_state(&mut self, i: u16, disp: [Length; 3], vel: [Velocity; 3]) {
         if i == GROUND {
             return;
         }
-        if let (Some(d), Some(v)) = (self.disp.get_mut(i as usize), self.vel.get_mut(i as usize)) {
-            *d = disp.map(Length::to_bits);
-            *v = vel.map(Velocity::to_bits);
+        if let Some(n) = self.nodes.get_mut(i as usize) {
+            // Within the integrator's limits, which the spring's ranges rely on.
+            n.u = disp.map(|x| x.to_bits().clamp(-DISP_LIMIT, DISP_LIMIT - 1));
+            n.v = vel.map(|x| x.to_bits().clamp(-VEL_LIMIT, VEL_LIMIT - 1));
         }
     }
 
     /// Back to rest.
     pub fn reset(&mut self) {
-        self.disp = [[0; 3]; NODES];
-        self.vel = [[0; 3]; NODES];
+        self.nodes = [Node::ZERO; NODES];
         self.inv_stretch = [ONE; EDGES];
         self.probe_prev = [0; 3];
         self.reaction = [0; 3];
@@ -487,113 +492,136 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
 
     /// One substep: spring forces, then the improved Euler update of every free node.
     fn substep(&mut self, drive: Drive) {
-        self.force = [[0; 3]; NODES];
         self.spring_forces();
         let c = self.contact;
-        self.reaction = self.force.get(c).copied().unwrap_or([0; 3]);
+        self.reaction = self.nodes.get(c).map_or([0; 3], |n| n.f);
         match drive {
             Drive::Probe { probe, probe_vel } => {
                 let (node, node_vel) = (self.node_disp(c), self.node_vel(c));
                 self.coupling_force = self.c.coupling.force(probe, probe_vel, node, node_vel);
-                if let Some(f) = self.force.get_mut(c) {
-                    *f = q::add(*f, self.coupling_force);
+                if let Some(n) = self.nodes.get_mut(c) {
+                    n.f = q::add(n.f, self.coupling_force);
                 }
             }
             Drive::Hold { .. } => self.coupling_force = [0; 3],
         }
         let count = self.topo.node_count().min(NODES);
-        for i in 1..count {
-            self.integrate(i);
+        let coeffs = self.c;
+        if let Some(free) = self.nodes.get_mut(1..count) {
+            for n in free {
+                Self::integrate(&coeffs, n);
+            }
         }
         if let Drive::Hold { disp, vel } = drive {
-            if let (Some(d), Some(v)) = (self.disp.get_mut(c), self.vel.get_mut(c)) {
-                *d = disp;
-                *v = vel;
+            if let Some(n) = self.nodes.get_mut(c) {
+                n.u = disp.map(|x| x.clamp(-DISP_LIMIT, DISP_LIMIT - 1));
+                n.v = vel.map(|x| x.clamp(-VEL_LIMIT, VEL_LIMIT - 1));
             }
         }
     }
 
     fn node_disp(&self, i: usize) -> V3 {
-        self.disp.get(i).copied().unwrap_or([0; 3])
+        self.nodes.get(i).map_or([0; 3], |n| n.u)
     }
 
     fn node_vel(&self, i: usize) -> V3 {
-        self.vel.get(i).copied().unwrap_or([0; 3])
+        self.nodes.get(i).map_or([0; 3], |n| n.v)
     }
 
     /// Accumulates every spring's force (law + damping) on its two nodes.
+    #[inline(always)]
     fn spring_forces(&mut self) {
-        let c = self.c;
-        for (k, e) in self.topo.edges().iter().enumerate() {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let (ua, ub) = (self.node_disp(a), self.node_disp(b));
-            let (va, vb) = (self.node_vel(a), self.node_vel(b));
-            let Some(r) = self.inv_stretch.get_mut(k) else {
-                continue;
-            };
+        let damping = self.c.spring_damping;
+        let nodes = self.nodes.as_mut_ptr();
+        for (e, r) in self.topo.edges().iter().zip(self.inv_stretch.iter_mut()) {
+            // SAFETY: `Topology::add_edge` only stores node indices below its node count,
+            // which is at most NODES, and the edges cannot change afterwards. The shared
+            // reads end before the writes; `a = b` only for the ground, whose accumulator
+            // is never read.
+            let (na, nb) = unsafe { (&*nodes.add(e.a as usize), &*nodes.add(e.b as usize)) };
             let f_on_a = spring_force(
                 &self.table,
                 e.dir,
                 e.inv_len,
-                ua,
-                ub,
-                va,
-                vb,
+                na.u,
+                nb.u,
+                na.v,
+                nb.v,
                 r,
-                c.spring_damping,
+                damping,
             );
-            // At most MAX_SPRINGS_PER_NODE springs of ≤ 96 N each: the sums fit.
-            if let Some(f) = self.force.get_mut(a) {
-                *f = core::array::from_fn(|k| f[k].wrapping_add(f_on_a[k]));
-            }
-            if let Some(f) = self.force.get_mut(b) {
-                *f = core::array::from_fn(|k| f[k].wrapping_sub(f_on_a[k]));
+            // At most MAX_SPRINGS_PER_NODE springs of ≤ 64 N each: the sums fit.
+            // SAFETY: as above.
+            unsafe {
+                let fa = &mut (*nodes.add(e.a as usize)).f;
+                *fa = core::array::from_fn(|k| fa[k].wrapping_add(f_on_a[k]));
+                let fb = &mut (*nodes.add(e.b as usize)).f;
+                *fb = core::array::from_fn(|k| fb[k].wrapping_sub(f_on_a[k]));
             }
         }
     }
 
-    /// Improved Euler for node `i` (eqs. 21, 22).
-    fn integrate(&mut self, i: usize) {
-        let c = self.c;
-        let (Some(u), Some(v), Some(f)) =
-            (self.disp.get_mut(i), self.vel.get_mut(i), self.force.get(i))
-        else {
-            return;
-        };
+    /// Improved Euler for one node (eqs. 21, 22), and the node's force accumulator
+    /// cleared for the next substep.
+    #[inline(always)]
+    fn integrate(c: &Coeffs, n: &mut Node) {
         for j in 0..3 {
-            // Q16 mm/s · Q24 N·s/mm → Q20 N.
-            let drag = q::mul(v[j], c.node_damping, VEL_FRAC + DAMP_FRAC - FORCE_FRAC);
-            let net = f[j].saturating_sub(drag);
-            // Q20 N · Q20 (mm/s)/N → Q16 mm/s.
-            let dv = q::mul(net, c.h_over_m, FORCE_FRAC + HM_FRAC - VEL_FRAC);
-            let v_new = v[j].saturating_add(dv).clamp(-VEL_LIMIT, VEL_LIMIT);
-            // (Q16 mm/s) · Q32 s → Q24 mm; |v + v'| < 2^31.
-            let du = q::mul(
-                v[j].wrapping_add(v_new),
-                c.half_h,
-                VEL_FRAC + HALF_H_FRAC - LEN_FRAC,
-            );
-            u[j] = u[j].saturating_add(du).clamp(-DISP_LIMIT, DISP_LIMIT);
-            v[j] = v_new;
+            let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
+            // v' = (1 − h c/m) v + (h/m) f: Q16 · Q24 and Q20 · Q20, both Q40. Held within
+            // ±2³⁰ (±16384 mm/s) through the high word; the low bits of a held value are
+            // the product's own (below 0.004 mm/s).
+            let p = q::mul_wide(v, c.keep) + q::mul_wide(f, c.h_over_m);
+            let hi = ((p >> 32) as i32).clamp(-(1 << 22), (1 << 22) - 1);
+            let v_new = (hi << 8) | ((p as u32) >> 24) as i32;
+            // u' = u + (v + v') h/2: |v + v'| < 2³¹ and h/2 < 2³¹ in Q40, so |du| < 2³⁰ and
+            // the sum cannot overflow before the clamp.
+            let du = q::mulhi(v.wrapping_add(v_new), c.half_h);
+            n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
+            n.v[j] = v_new;
         }
+        n.f = [0; 3];
     }
+}
+
+/// One node's state: displacement from rest (Q24 mm), velocity (Q16 mm/s) and the force
+/// accumulator of the current substep (Q20 N), together so that a spring reaches all of
+/// an end through one address.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Node {
+    u: V3,
+    v: V3,
+    f: V3,
+}
+
+impl Node {
+    const ZERO: Self = Self {
+        u: [0; 3],
+        v: [0; 3],
+        f: [0; 3],
+    };
 }
 
 /// The force on end `a` of one spring (Q20 N): the law along the edge plus the relative
 /// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
-/// `r` is the spring's warm-started `l0/l` (Q24), advanced by one guarded Newton step.
+/// `r` is the spring's warm-started `l0/l` (Q24), advanced by one guarded Newton step;
+/// `inv_len` is `1/l0` (Q31), `damping` the spring damping (Q28 N·s/mm).
 ///
-/// Ranges that let most steps skip saturation: displacements within ±60 mm and velocities
+/// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
 /// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
-/// [`MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 10
+/// [`MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 30
 /// N·s/m (the configuration checks). Limits that follow, documented behaviour:
-/// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±4 per axis: a spring
-///   stretched further pulls as if stretched 4 `l0` along that axis;
-/// - `l0/l` stays within [1/8, 16]: a spring crushed below `l0/16` keeps it at 16, so its
+/// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±2 per axis: a spring
+///   stretched further pulls as if stretched to 2 `l0` along that axis;
+/// - `l0/l` stays below 16: a spring crushed below `l0/16` keeps it at 16, so its
 ///   direction vector shortens with the spring and the force fades to zero at zero length
 ///   instead of flipping;
-/// - one spring's law force is limited to ±64 N and its damping force to ±32 N, so a
-///   node's sum cannot overflow.
+/// - the law force is limited to ±64 N, and `|f| l0/l` to 512 N (a spring at 64 N
+///   compressed past `l0/8` pushes as if at `l0/8`);
+/// - one spring's force (law and damping) is limited to ±64 N, so that a node's sum
+///   cannot overflow.
+///
+/// Every product is one long multiply (the M0 builds it from 16-bit pieces with the same
+/// bits, [`crate::q`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn spring_force<const S: usize>(
@@ -607,39 +635,48 @@ pub fn spring_force<const S: usize>(
     r: &mut i32,
     damping: i32,
 ) -> V3 {
-    const W_LIMIT: i32 = 4 << LEN_FRAC;
-    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24; |u_b − u_a| ≤ 120 mm, l0 ≥ 1 mm.
+    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24: the high word of Q24 · Q31 is
+    // Q23, doubled; |u_b − u_a| < 2³¹ (the displacement clamp).
     let w: V3 = core::array::from_fn(|k| {
+        let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len);
         dir[k]
-            .wrapping_add(q::mulsh::<LEN_FRAC>(ub[k].wrapping_sub(ua[k]), inv_len))
+            .wrapping_add(q.wrapping_mul(2))
             .clamp(-W_LIMIT, W_LIMIT - 1)
     });
-    // |w|² ≤ 48, Q24.
-    let a = ((w[0] as i64 * w[0] as i64 + w[1] as i64 * w[1] as i64 + w[2] as i64 * w[2] as i64)
-        >> LEN_FRAC) as i32;
-    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2), the factor kept
-    // within [1/4, 3/2]. With a stale `r`, `a r` may be large: held at 8 (|w| ≤ 6.93 when
-    // converged), which still drives the factor to its floor.
-    let s0 = ((a as i64 * *r as i64) >> LEN_FRAC).min((8 * ONE) as i64) as i32;
-    let half_x = ((s0 as i64 * *r as i64) >> (LEN_FRAC + 1)) as i32; // a r² / 2 ≤ 64
-    let factor = (3 * ONE / 2 - half_x).max(ONE / 4);
-    let rn = q::mulsh::<LEN_FRAC>(*r, factor).clamp(R_MIN, R_MAX);
+    // a = |w|² ≤ 12, Q24. (`opaque`: plain 32-bit values from here, so that the products
+    // below stay single long multiplies.)
+    let a =
+        (q::mul_wide(w[0], w[0]) + q::mul_wide(w[1], w[1]) + q::mul_wide(w[2], w[2])) >> LEN_FRAC;
+    let a = q::opaque(a as i32);
+    let r0 = q::opaque(*r);
+    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23;
+    // held at 8 (|w| ≤ 8/r when converged), which already drives the factor to its floor.
+    let ar = q::opaque(((q::mul_wide(a, r0) >> (LEN_FRAC + 1)) as i32).clamp(0, (8 << 23) - 1));
+    // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰.
+    let half_x = (q::mul_wide(ar, r0) >> LEN_FRAC) as i32;
+    let factor = q::opaque((3 * ONE / 2 - half_x).max(ONE / 4));
+    // r' ≤ 3/2 r, held below 16. No floor is needed: |w| ≤ 2√3 keeps 1/|w| ≥ 0.29, and a
+    // step from above lands at ≥ r/4 > √3/4 · 1/|w| ≥ 1/8.
+    let rn = q::opaque(((q::mul_wide(r0, factor) >> LEN_FRAC) as i32).clamp(0, R_MAX));
     *r = rn;
-    // |w| = l / l0 = a r; beyond 8 (tension past ε = −7) it is held at 8.
-    let stretch = ((a as i64 * rn as i64) >> LEN_FRAC).min((8 * ONE) as i64) as i32;
+    // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
+    let stretch = (q::mul_wide(ar, factor) >> 23) as i32;
     let strain = Strain::from_bits(ONE - stretch);
     let f = table
         .force(strain)
         .to_bits()
         .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = −w (f r).
-    let fr = q::mulsh::<LEN_FRAC>(f, rn); // |fr| ≤ 2^30
+    // f r: Q20 · Q24 >> 24 → Q20, ≤ 2³⁰ before the clamp.
+    let fr = ((q::mul_wide(f, rn) >> LEN_FRAC) as i32)
+        .clamp(-FORCE_PER_STRETCH_LIMIT, FORCE_PER_STRETCH_LIMIT - 1);
+    // C (v_b − v_a) − w (f r): Q16 · Q28 and Q24 · Q20, both Q44 → Q20; each term is
+    // within 1024 N, so the sum fits before the clamp.
+    let neg_fr = -fr;
     core::array::from_fn(|k| {
-        let push = q::mul(w[k], fr, LEN_FRAC).clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1);
-        // Damping: C (v_b − v_a); Q16 mm/s · Q24 N·s/mm → Q20 N, ≤ 2^29 before the clamp.
         let dv = vb[k].wrapping_sub(va[k]);
-        let drag = q::mulsh::<{ VEL_FRAC + DAMP_FRAC - FORCE_FRAC }>(dv, damping)
-            .clamp(-DAMP_FORCE_LIMIT, DAMP_FORCE_LIMIT - 1);
-        drag - push
+        let p = q::mul_wide(dv, damping) + q::mul_wide(w[k], neg_fr);
+        ((p >> (VEL_FRAC + DAMP_FRAC - FORCE_FRAC)) as i32)
+            .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })
 }

@@ -16,6 +16,9 @@ pub const GROUND: u16 = 0;
 /// Fraction bits of lengths (mm) and dimensionless ratios in the patch: Q24.
 pub const LEN_FRAC: u32 = 24;
 
+/// Fraction bits of an edge's `1 / l0` (1/mm): Q31.
+pub const INV_LEN_FRAC: u32 = 31;
+
 /// One spring of the patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Edge {
@@ -25,7 +28,7 @@ pub struct Edge {
     pub b: u16,
     /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q24.
     pub dir: V3,
-    /// `1 / l0` in 1/mm, Q24.
+    /// `1 / l0` in 1/mm, Q31 (`l0 ≥ 1 mm`; 1 mm is stored as `i32::MAX`).
     pub inv_len: i32,
 }
 
@@ -155,7 +158,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
                 a: ia,
                 b: ib,
                 dir,
-                inv_len: q::from_f64(1.0 / len, LEN_FRAC),
+                inv_len: q::from_f64(1.0 / len, INV_LEN_FRAC),
             })
             .map_err(|_| TopologyError::EdgeCapacity)
     }
@@ -250,7 +253,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
 
     /// Rest length of edge `e` (mm), from its stored `1/l0`.
     pub fn rest_length(e: &Edge) -> f64 {
-        (1u64 << LEN_FRAC) as f64 / e.inv_len as f64
+        (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64
     }
 }
 

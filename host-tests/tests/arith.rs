@@ -3,7 +3,9 @@
 //! other cores use, over the whole input range, so that the host tests (long multiply)
 //! also hold for the M0 firmware.
 
-use mccs::q::{mul_t, mul_t_split, mulhi, mulhi_split, mulhi_u, mulhi_u_split};
+use mccs::q::{
+    mul_t, mul_t_split, mul_wide, mul_wide_split, mulhi, mulhi_split, mulhi_u, mulhi_u_split,
+};
 use proptest::prelude::*;
 
 const EDGES: [i32; 12] = [
@@ -31,6 +33,8 @@ fn split_products_match_at_the_edges() {
                 "{a} {b}"
             );
             assert_eq!(mulhi(a, b), mulhi_split(a, b));
+            assert_eq!(mul_wide_split(a, b), a as i64 * b as i64);
+            assert_eq!(mul_wide(a, b), a as i64 * b as i64);
             let (ua, ub) = (a as u32, b as u32);
             assert_eq!(
                 mulhi_u_split(ua, ub),
@@ -53,6 +57,8 @@ proptest! {
     fn split_products_match(a in any::<i32>(), b in any::<i32>(), t in 0u32..0x8000) {
         prop_assert_eq!(mulhi_split(a, b), ((a as i64 * b as i64) >> 32) as i32);
         prop_assert_eq!(mulhi(a, b), mulhi_split(a, b));
+        prop_assert_eq!(mul_wide_split(a, b), a as i64 * b as i64);
+        prop_assert_eq!(mul_wide(a, b), a as i64 * b as i64);
         let (ua, ub) = (a as u32, b as u32);
         prop_assert_eq!(mulhi_u_split(ua, ub), ((ua as u64 * ub as u64) >> 32) as u32);
         prop_assert_eq!(mul_t_split(a, t), ((a as i64 * t as i64) >> 16) as i32);
