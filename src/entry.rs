@@ -31,7 +31,7 @@ pub fn spring(
     r: &mut i32,
     damping: i32,
 ) -> [i32; 3] {
-    crate::solver::spring_force(table, dir, inv_len, ua, ub, va, vb, r, damping)
+    crate::solver::spring_force(table, dir, inv_len, ua, ub, &va, &vb, r, damping)
 }
 
 /// One substep of a solver with the probe held at `probe`, never inlined.

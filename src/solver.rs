@@ -545,8 +545,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
                 e.inv_len,
                 na.u,
                 nb.u,
-                na.v,
-                nb.v,
+                &na.v,
+                &nb.v,
                 r,
                 damping,
             );
@@ -630,8 +630,8 @@ pub fn spring_force<const S: usize>(
     inv_len: i32,
     ua: V3,
     ub: V3,
-    va: V3,
-    vb: V3,
+    va: &V3,
+    vb: &V3,
     r: &mut i32,
     damping: i32,
 ) -> V3 {
@@ -662,10 +662,8 @@ pub fn spring_force<const S: usize>(
     // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
     let stretch = (q::mul_wide(ar, factor) >> 23) as i32;
     let strain = Strain::from_bits(ONE - stretch);
-    let f = table
-        .force(strain)
-        .to_bits()
-        .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1);
+    // ±64 N: 2²⁶ in Q20.
+    let f = table.force_within::<26>(strain);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = −w (f r).
     // f r: Q20 · Q24 >> 24 → Q20, ≤ 2³⁰ before the clamp.
     let fr = ((q::mul_wide(f, rn) >> LEN_FRAC) as i32)
@@ -673,6 +671,9 @@ pub fn spring_force<const S: usize>(
     // C (v_b − v_a) − w (f r): Q16 · Q28 and Q24 · Q20, both Q44 → Q20; each term is
     // within 1024 N, so the sum fits before the clamp.
     let neg_fr = -fr;
+    // The velocities are read only now (no instruction: it keeps the compiler from
+    // loading them early and spilling them around the table lookup).
+    core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
     core::array::from_fn(|k| {
         let dv = vb[k].wrapping_sub(va[k]);
         let p = q::mul_wide(dv, damping) + q::mul_wide(w[k], neg_fr);

@@ -40,7 +40,7 @@
 
 use crate::law::Law;
 use crate::params::{ParamError, Params};
-use crate::q::{mul_t, mulhi, mulhi_u};
+use crate::q::{mul_t, mul_wide, mulhi, mulhi_u};
 use crate::{Force, Stiffness, Strain};
 use core::fmt;
 
@@ -455,6 +455,25 @@ impl<const S: usize> ForceTable<S> {
         Force::from_bits(value(r, c, t))
     }
 
+    /// [`ForceTable::force`] clamped to `[−2^BITS, 2^BITS)` in raw Q20 (`BITS` ≤ 30, i.e.
+    /// within ±1024 N), as the solver needs it: the same values, a few instructions
+    /// less (the clamp makes the saturation of the straight lines exact).
+    #[inline]
+    pub fn force_within<const BITS: u32>(&self, strain: Strain) -> i32 {
+        const { assert!(BITS <= 30) };
+        let r = &self.raw;
+        let e = strain.to_bits();
+        let f = if e <= r.strain_lo {
+            line_held(r.force_lo, r.stiffness_lo, e, r.anchor_lo)
+        } else if e >= r.strain_hi {
+            line_held(r.force_hi, r.stiffness_hi, e, r.strain_hi)
+        } else {
+            let (c, t) = self.segment(e);
+            value(r, c, t)
+        };
+        f.clamp(-(1 << BITS), (1 << BITS) - 1)
+    }
+
     /// Force (N) and tangent stiffness `dF/dε` (N per unit strain) at `strain`;
     /// constant time, saturating, no panic.
     #[inline]
@@ -506,19 +525,30 @@ fn value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32) -> i32 {
 }
 
 /// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;
-/// saturating: the high and low words of the product, combined only when they fit.
+/// saturating exactly.
 #[inline(always)]
 fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
-    let de = e.saturating_sub(e0);
-    let hi = mulhi(k, de);
-    let lo = k.wrapping_mul(de) as u32;
     const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let p = mul_wide(k, e.saturating_sub(e0));
+    let hi = (p >> 32) as i32;
     let df = if (hi >> (SH - 1)) == (hi >> 31) {
-        (hi << (32 - SH)) | (lo >> SH) as i32
+        (hi << (32 - SH)) | ((p as u32) >> SH) as i32
     } else if hi < 0 {
         i32::MIN
     } else {
         i32::MAX
     };
+    f0.saturating_add(df)
+}
+
+/// [`line`] for callers that clamp the result to well inside ±2048 N: the product's high
+/// word is held within ±2¹⁹ before the words are joined, so a held value is ±2048 N to
+/// within its low 12 bits (4 mN) — beyond any such clamp.
+#[inline(always)]
+fn line_held(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
+    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let p = mul_wide(k, e.saturating_sub(e0));
+    let hi = ((p >> 32) as i32).clamp(-(1 << (SH - 1)), (1 << (SH - 1)) - 1);
+    let df = (hi << (32 - SH)) | ((p as u32) >> SH) as i32;
     f0.saturating_add(df)
 }
