@@ -164,7 +164,7 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             *s = Spring {
                 a: e.a,
                 b: e.b,
-                rest: e.dir.map(|d| T::of(q(d, 24) * l0)),
+                rest: e.dir.map(|d| T::of(q(d, 29) * l0)),
                 l0: T::of(l0),
                 inv_l0: T::of(1.0 / l0),
             };

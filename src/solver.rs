@@ -48,9 +48,16 @@ const ONE: i32 = 1 << LEN_FRAC;
 const VEL_FRAC: u32 = 16;
 /// Fraction bits of forces (N).
 const FORCE_FRAC: u32 = 20;
-/// Fraction bits of the spring damping (N·s/mm): Q16 mm/s · Q28 = Q44, the format of
-/// the spring's `w · (f l0/l)` product (Q24 · Q20).
-const DAMP_FRAC: u32 = 28;
+/// Fraction bits of the spring damping (N·s/mm): Q16 mm/s · Q36 = Q52, the format of
+/// the spring's `w · (f l0/l)` product (Q29 · Q23), whose high word is Q20 N.
+const DAMP_FRAC: u32 = 36;
+/// Fraction bits of the edge vector over the rest length, `w`: Q29 (±2 held).
+const W_FRAC: u32 = 29;
+/// Fraction bits of `f l0/l`: Q23 (±256 N held).
+const FR_FRAC: u32 = 23;
+// The spring's two products share Q52, whose high word is Q20 N.
+const _: () = assert!(VEL_FRAC + DAMP_FRAC == 32 + FORCE_FRAC);
+const _: () = assert!(W_FRAC + FR_FRAC == 32 + FORCE_FRAC);
 /// Fraction bits of `h/m` ((mm/s)/N) and of `1 − h c/m` (the velocity kept through the
 /// node damping): Q20 N · Q20 and Q16 mm/s · Q24 are both Q40, shifted by 24 to Q16 mm/s.
 const HM_FRAC: u32 = 20;
@@ -61,16 +68,16 @@ const HALF_H_FRAC: u32 = 40;
 const R_MAX: i32 = (16 << LEN_FRAC) - 1;
 /// Largest force of one spring (law and damping together), N in Q20: 64 N.
 pub const SPRING_FORCE_LIMIT: i32 = 64 << FORCE_FRAC;
-/// Largest law force per unit current length, `|f| · l0/l`, N in Q20: 512 N.
-pub const FORCE_PER_STRETCH_LIMIT: i32 = 512 << FORCE_FRAC;
+/// Largest law force per unit current length, `|f| · l0/l`: 256 N.
+pub const FORCE_PER_STRETCH_LIMIT_N: i32 = 256;
 /// Most springs at one node: their summed forces cannot overflow the Q20 accumulator.
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
 /// Largest displacement from rest, mm in Q24: just under 64 mm.
 const DISP_LIMIT: i32 = 1 << 30;
 /// Largest speed, mm/s in Q16: just under 16384 mm/s.
 const VEL_LIMIT: i32 = 1 << 30;
-/// Largest edge vector over the rest length, per axis: 2 (Q24).
-const W_LIMIT: i32 = 2 << LEN_FRAC;
+/// Largest edge vector over the rest length, per axis: 2 (Q29).
+const W_LIMIT: i32 = 2 << W_FRAC;
 
 /// Runtime configuration of a [`Solver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,7 +193,7 @@ struct Coeffs {
     keep: i32,
     /// `h/2`, s, Q40.
     half_h: i32,
-    /// Spring damping, N·s/mm, Q28.
+    /// Spring damping, N·s/mm, Q36.
     spring_damping: i32,
     /// Tick rate, Hz (for the probe velocity).
     tick_hz: i32,
@@ -603,8 +610,9 @@ impl Node {
 
 /// The force on end `a` of one spring (Q20 N): the law along the edge plus the relative
 /// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
-/// `r` is the spring's warm-started `l0/l` (Q24), advanced by one guarded Newton step;
-/// `inv_len` is `1/l0` (Q31), `damping` the spring damping (Q28 N·s/mm).
+/// `dir` is the unit rest vector (Q29), `inv_len` is `1/l0` (Q31), `r` the spring's
+/// warm-started `l0/l` (Q24), advanced by one guarded Newton step, and `damping` the
+/// spring damping (Q36 N·s/mm).
 ///
 /// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
 /// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
@@ -615,13 +623,13 @@ impl Node {
 /// - `l0/l` stays below 16: a spring crushed below `l0/16` keeps it at 16, so its
 ///   direction vector shortens with the spring and the force fades to zero at zero length
 ///   instead of flipping;
-/// - the law force is limited to ±64 N, and `|f| l0/l` to 512 N (a spring at 64 N
-///   compressed past `l0/8` pushes as if at `l0/8`);
+/// - the law force is limited to ±64 N, and `|f| l0/l` to 256 N (a spring at 64 N
+///   compressed past `l0/4` pushes as if at `l0/4`);
 /// - one spring's force (law and damping) is limited to ±64 N, so that a node's sum
 ///   cannot overflow.
 ///
 /// Every product is one long multiply (the M0 builds it from 16-bit pieces with the same
-/// bits, [`crate::q`]).
+/// bits, [`crate::q`]); the formats are chosen so that most need no shift after it.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn spring_force<const S: usize>(
@@ -635,23 +643,23 @@ pub fn spring_force<const S: usize>(
     r: &mut i32,
     damping: i32,
 ) -> V3 {
-    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q24: the high word of Q24 · Q31 is
-    // Q23, doubled; |u_b − u_a| < 2³¹ (the displacement clamp).
+    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q29: the high word of Q24 · Q31 is
+    // Q23, times 64; |u_b − u_a| < 2³¹ (the displacement clamp).
     let w: V3 = core::array::from_fn(|k| {
         let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len);
         dir[k]
-            .wrapping_add(q.wrapping_mul(2))
+            .wrapping_add(q.wrapping_mul(1 << (W_FRAC - 23)))
             .clamp(-W_LIMIT, W_LIMIT - 1)
     });
-    // a = |w|² ≤ 12, Q24. (`opaque`: plain 32-bit values from here, so that the products
-    // below stay single long multiplies.)
-    let a =
-        (q::mul_wide(w[0], w[0]) + q::mul_wide(w[1], w[1]) + q::mul_wide(w[2], w[2])) >> LEN_FRAC;
+    // a = |w|² ≤ 12: Q58, so the high word is Q26. (`opaque`: plain 32-bit values from
+    // here, so that the products below stay single long multiplies.)
+    let a = (q::mul_wide(w[0], w[0]) + q::mul_wide(w[1], w[1]) + q::mul_wide(w[2], w[2])) >> 32;
     let a = q::opaque(a as i32);
     let r0 = q::opaque(*r);
-    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23;
-    // held at 8 (|w| ≤ 8/r when converged), which already drives the factor to its floor.
-    let ar = q::opaque(((q::mul_wide(a, r0) >> (LEN_FRAC + 1)) as i32).clamp(0, (8 << 23) - 1));
+    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23
+    // (Q26 · Q24 >> 27); held at 8 (|w| ≤ 8/r when converged), which already drives the
+    // factor to its floor.
+    let ar = q::opaque(((q::mul_wide(a, r0) >> 27) as i32).clamp(0, (8 << 23) - 1));
     // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰.
     let half_x = (q::mul_wide(ar, r0) >> LEN_FRAC) as i32;
     let factor = q::opaque((3 * ONE / 2 - half_x).max(ONE / 4));
@@ -664,20 +672,20 @@ pub fn spring_force<const S: usize>(
     let strain = Strain::from_bits(ONE - stretch);
     // ±64 N: 2²⁶ in Q20.
     let f = table.force_within::<26>(strain);
-    // A compressed spring (f > 0) pushes a away from b: −f w/|w| = −w (f r).
-    // f r: Q20 · Q24 >> 24 → Q20, ≤ 2³⁰ before the clamp.
-    let fr = ((q::mul_wide(f, rn) >> LEN_FRAC) as i32)
-        .clamp(-FORCE_PER_STRETCH_LIMIT, FORCE_PER_STRETCH_LIMIT - 1);
-    // C (v_b − v_a) − w (f r): Q16 · Q28 and Q24 · Q20, both Q44 → Q20; each term is
-    // within 1024 N, so the sum fits before the clamp.
-    let neg_fr = -fr;
+    // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
+    // −f r: Q20 · Q24 = Q44; Q23 is `>> 21`, held within ±256 N through the high word
+    // (the low bits of a held value are the product's own, below 2⁻¹² N).
+    let p = q::mul_wide(-f, rn);
+    let hi = ((p >> 32) as i32).clamp(-(1 << 20), (1 << 20) - 1);
+    let neg_fr = (hi << 11) | ((p as u32) >> 21) as i32;
     // The velocities are read only now (no instruction: it keeps the compiler from
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
+    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52: the high word is Q20 N;
+    // |C (v_b − v_a)| < 2⁶² and |w f r| < 2⁶¹, so the sum fits.
     core::array::from_fn(|k| {
         let dv = vb[k].wrapping_sub(va[k]);
         let p = q::mul_wide(dv, damping) + q::mul_wide(w[k], neg_fr);
-        ((p >> (VEL_FRAC + DAMP_FRAC - FORCE_FRAC)) as i32)
-            .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
+        ((p >> 32) as i32).clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })
 }

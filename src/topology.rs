@@ -16,6 +16,9 @@ pub const GROUND: u16 = 0;
 /// Fraction bits of lengths (mm) and dimensionless ratios in the patch: Q24.
 pub const LEN_FRAC: u32 = 24;
 
+/// Fraction bits of an edge's unit rest vector: Q29.
+pub const DIR_FRAC: u32 = 29;
+
 /// Fraction bits of an edge's `1 / l0` (1/mm): Q31.
 pub const INV_LEN_FRAC: u32 = 31;
 
@@ -26,7 +29,7 @@ pub struct Edge {
     pub a: u16,
     /// Second node (0 = ground).
     pub b: u16,
-    /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q24.
+    /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q29.
     pub dir: V3,
     /// `1 / l0` in 1/mm, Q31 (`l0 ≥ 1 mm`; 1 mm is stored as `i32::MAX`).
     pub inv_len: i32,
@@ -152,7 +155,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
                 return Err(TopologyError::TooManySprings);
             }
         }
-        let dir = d.map(|x| q::from_f64(x / len, LEN_FRAC));
+        let dir = d.map(|x| q::from_f64(x / len, DIR_FRAC));
         self.edges
             .push(Edge {
                 a: ia,

@@ -111,27 +111,27 @@ mod firmware {
         let harness = measure(cpk, 256, || {
             black_box((
                 black_box(&table),
-                black_box([0, 0, -(1 << 24)]),
+                black_box([0, 0, -(1 << 29)]),
                 black_box(1 << 29),
                 black_box([0; 3]),
                 black_box([1 << 20, -(1 << 20), 2 << 24]),
                 black_box([10, -20, 30]),
                 black_box([0; 3]),
                 &mut r,
-                black_box(268_435),
+                black_box(68_719_477),
             ));
         });
         let spring = measure(cpk, 256, || {
             black_box(e::spring(
                 black_box(&table),
-                black_box([0, 0, -(1 << 24)]),
+                black_box([0, 0, -(1 << 29)]),
                 black_box(1 << 29),
                 black_box([0; 3]),
                 black_box([1 << 20, -(1 << 20), 2 << 24]),
                 black_box([10, -20, 30]),
                 black_box([0; 3]),
                 &mut r,
-                black_box(268_435),
+                black_box(68_719_477),
             ));
         }) - (harness - empty);
         defmt::println!(
