@@ -1,22 +1,36 @@
 #!/usr/bin/env bash
-# Instruction counts per core from QEMU under -icount (src/bin/bench.rs), compared with
-# the committed baseline bench/baseline.txt: fails if any figure grew by more than 5 %.
-# `scripts/bench.sh --update` rewrites the baseline instead.
+# Instruction counts per core from QEMU under -icount (src/bin/bench.rs). The firmware
+# checks its core's budgets in bench/budgets.txt and exits with failure on a breach of an
+# enforced one; this script then compares every figure with the committed baseline
+# bench/baseline.txt and fails if any grew by more than 5 %.
+# `scripts/bench.sh --update` rewrites the baseline instead of comparing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:-check}
 mkdir -p target/qemu
 out=target/qemu/bench.txt
 : > "$out"
+status=0
 for spec in "m4f thumbv7em-none-eabihf" "m3 thumbv7m-none-eabi" "m0 thumbv6m-none-eabi"; do
   set -- $spec
   cargo build --quiet --release --target "$2" --bin bench
+  log="target/qemu/bench-$1.log"
+  set +e
   timeout 300 cargo run --quiet --release --target "$2" --bin bench 2> >(grep -v "Timer with period zero" >&2) \
-    | defmt-print -e "target/$2/release/bench" | grep -E "^(BENCH|MEM) " >> "$out"
+    | defmt-print -e "target/$2/release/bench" > "$log"
+  rc=${PIPESTATUS[0]}
+  set -e
+  grep -E "^(BENCH|MEM|FIT|BUDGET|RATIO|MEMORY) " "$log" >> "$out" || true
+  if [ "$rc" != 0 ]; then
+    echo "bench: the $1 firmware exited with status $rc (a budget breached, or a fault: see $log)" >&2
+    grep -E "result=(OVER|missing)|malformed|panic" "$log" >&2 || true
+    status=1
+  fi
 done
 cat "$out"
+[ "$status" = 0 ] || exit 1
 if [ "$mode" = "--update" ]; then
-  cp "$out" bench/baseline.txt
+  grep -E "^(BENCH|MEM) " "$out" > bench/baseline.txt
   echo "bench: baseline updated"
   exit 0
 fi
@@ -25,15 +39,20 @@ import sys
 def load(path):
     out = {}
     for line in open(path):
+        if not line.startswith("BENCH "):
+            continue
         f = dict(kv.split("=", 1) for kv in line.split()[1:])
-        if line.startswith("BENCH "):
-            out[(f["core"], f["case"])] = int(f["instructions"])
+        out[(f["core"], f["case"])] = int(f["instructions"])
     return out
 now, base = load(sys.argv[1]), load(sys.argv[2])
-bad = [f"{c} {k}: {now[(c, k)]} > {base[(c, k)]} + 5 %" for (c, k) in base
+bad = [f"{c} {k}: {now.get((c, k))} > {base[(c, k)]} + 5 %" for (c, k) in base
        if (c, k) not in now or now[(c, k)] > base[(c, k)] * 1.05]
 for b in bad:
     print("bench regression:", b)
-print(f"bench: {len(base) - len(bad)} passed, {len(bad)} failed against bench/baseline.txt")
+budgets = [l for l in open(sys.argv[1]) if l.startswith(("BUDGET ", "RATIO ", "MEMORY "))]
+met = sum("result=ok" in l for l in budgets)
+open_ = sum("result=open" in l for l in budgets)
+print(f"bench: {len(base) - len(bad)} passed, {len(bad)} failed against bench/baseline.txt; "
+      f"budgets: {met} enforced and met, {open_} open (bench/budgets.txt)")
 sys.exit(1 if bad else 0)
 PY

@@ -49,8 +49,36 @@ if python3 scripts/check_tick_path.py target/thumbv7em-none-eabihf/release/hapti
   exit 1
 fi
 
-step "instruction counts in QEMU against bench/baseline.txt (no figure may grow by more than 5 %)"
+step "instruction counts in QEMU: budgets (bench/budgets.txt) and bench/baseline.txt (+5 % at most)"
 bash scripts/bench.sh
+
+step "bench in QEMU: a breached budget exits with failure"
+if timeout 300 cargo run --quiet --release --target thumbv7em-none-eabihf --bin bench --features budget-test \
+    2>/dev/null | defmt-print -e target/thumbv7em-none-eabihf/release/bench > target/qemu/budget-test.log; then
+  echo "test.sh: the bench firmware passed an impossible budget" >&2
+  exit 1
+fi
+grep "result=OVER" target/qemu/budget-test.log
+
+step "memory of the demo firmware (defmt, release): flash ≤ 64 KiB"
+size_tool="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin/llvm-size"
+for t in thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi; do
+  cargo build --quiet --release --target "$t" --bin haptic
+  "$size_tool" -A "target/$t/release/haptic" | python3 -c '
+import sys
+target = sys.argv[1]
+sec = {}
+for line in sys.stdin:
+    p = line.split()
+    if len(p) >= 3 and p[0].startswith(".") and p[1].isdigit():
+        sec[p[0]] = int(p[1])
+flash = sum(sec.get(s, 0) for s in (".vector_table", ".text", ".rodata", ".data", ".gnu.sgstubs"))
+ram = sum(sec.get(s, 0) for s in (".data", ".bss", ".uninit"))
+print(f"SIZE target={target} flash={flash} ram={ram} (static; the stack comes on top)")
+if flash > 64 * 1024:
+    sys.exit(f"test.sh: {target} demo firmware flash {flash} B > 64 KiB")
+' "$t"
+done
 
 step "host tests"
 log=$(mktemp)
