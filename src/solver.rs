@@ -15,10 +15,10 @@
 //! [`spring_force`]).
 //!
 //! # Units and formats
-//! Displacements from rest in mm, Q24, kept within ±60 mm; velocities in mm/s, Q16, kept
-//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's law force within ±64 N,
-//! its damping within ±32 N). Positions are in the patch frame (origin at the contact
-//! node's rest position, `z` up).
+//! Displacements from rest in mm, Q24, kept within ±64 mm; velocities in mm/s, Q16, kept
+//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's force, law and damping,
+//! within ±64 N). Positions are in the patch frame (origin at the contact node's rest
+//! position, `z` up). The spring's own formats are in [`spring_force`].
 //!
 //! # Stability (the substep count)
 //! For one mass `m` on a spring `K` with damping rate `γ = C/m`, the improved Euler step

@@ -13,30 +13,36 @@
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
 //! the law bends harder than the grid resolves, so that the curve stays monotone), as
-//! power-basis coefficients in `t ∈ [0, 1)`: `3 × i32` per segment, the cubic coefficient
-//! implied by the next knot (812 bytes in all for 65 knots), so each segment ends
-//! bit-exactly on the next knot; the straight lines are anchored on the end knots (at the
-//! kink, the line through zero with `k` rounded down), so the curve is continuous and
+//! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
+//! per segment, 1072 bytes in all for 65 knots) so that each Horner step is one product
+//! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
+//! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
+//! the kink, the line through zero with `k` rounded down), so the curve is continuous and
 //! monotone.
 //!
 //! # Formats and ranges
 //! - strain: [`Strain`] = `I8F24`, range ±128, resolution 6.0e-8;
 //! - force: [`Force`] = `I12F20` in N, range ±2048 N, resolution 9.5e-7 N;
 //! - stiffness: [`Stiffness`] = `I16F16` in N per unit strain, range ±32768, resolution 1.5e-5;
-//! - coefficients: knot values Q(20 + `value_shift`), `c1, c2` Q(20 + `poly_shift`), the
-//!   shifts chosen per table.
+//! - position in a segment `τ`: Q15;
+//! - coefficients: Q(20 + `shift`) N, the shift (0 … 12) chosen per table so that the
+//!   knots use most of an `i32` and no Horner step can overflow.
 //!
 //! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`).
 //!
 //! # Cost
-//! Segment lookup is one subtract and one multiply (no search, no division); the value is
-//! a 3-multiply Horner step in a Q16 segment parameter ([`mul_q16`]), the stiffness 2 more
-//! and one scaling multiply. No loop; the only branch is which of the three pieces the
-//! strain falls in. Measured: 88 instructions on a Cortex-M4F, 211 on a Cortex-M0 (QEMU).
+//! The segment and `τ` come from one subtract, one multiply by a power of two and one
+//! unsigned high-word product (no search, no division); the value is three Horner steps
+//! (one `smmla` each on the M3/M4), the stiffness two more and one scaling product. No
+//! loop; the only branch is which of the three pieces the strain falls in. Every product
+//! has exact floor semantics, and the Cortex-M0 builds them from 16-bit pieces with the
+//! same bits ([`crate::q`]). Measured (QEMU, averaged over strains on both lines and the
+//! cubic part, the call included): 36 instructions on a Cortex-M4F, 40 on an M3, 96 on an
+//! M0.
 //!
 //! # Accuracy (measured by `host-tests/tests/table_accuracy.rs`, see README)
-//! Table 2 spring, domain [−0.5, 0.95], 65 knots: max |ΔF| 5.6e-7 · F(0.95), stiffness
-//! within 9.0e-6 relative.
+//! Table 2 spring, domain [−0.5, 0.95], 65 knots: max |ΔF| 9.4e-7 · F(0.95), stiffness
+//! within 1.0e-5 relative.
 
 use crate::law::Law;
 use crate::params::{ParamError, Params};
