@@ -651,20 +651,24 @@ pub fn spring_force<const S: usize>(
             .wrapping_add(q.wrapping_mul(1 << (W_FRAC - 23)))
             .clamp(-W_LIMIT, W_LIMIT - 1)
     });
-    // a = |w|² ≤ 12: Q58, so the high word is Q26. (`opaque`: plain 32-bit values from
-    // here, so that the products below stay single long multiplies.)
-    let a = (q::mul_wide(w[0], w[0]) + q::mul_wide(w[1], w[1]) + q::mul_wide(w[2], w[2])) >> 32;
-    let a = q::opaque(a as i32);
+    // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high
+    // words is within 2 LSB (3e-8) of the high word of the sum, and costs the M0 no low
+    // words. (`opaque`: a plain 32-bit value from here, so that the products below stay
+    // single long multiplies.)
+    let a = q::mulhi(w[0], w[0]) + q::mulhi(w[1], w[1]) + q::mulhi(w[2], w[2]);
+    let a = q::opaque(a);
     let r0 = q::opaque(*r);
     // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23
     // (Q26 · Q24 >> 27); held at 8 (|w| ≤ 8/r when converged), which already drives the
     // factor to its floor.
     let ar = q::opaque(((q::mul_wide(a, r0) >> 27) as i32).clamp(0, (8 << 23) - 1));
-    // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰.
-    let half_x = (q::mul_wide(ar, r0) >> LEN_FRAC) as i32;
-    let factor = q::opaque((3 * ONE / 2 - half_x).max(ONE / 4));
+    // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰, held
+    // below 1 (one `usat`), so that the factor 3/2 − a r²/2 stays in (1/2, 3/2]: a step
+    // from far above at most halves `r`.
+    let half_x = ((q::mul_wide(ar, r0) >> LEN_FRAC) as i32).clamp(0, ONE - 1);
+    let factor = q::opaque(3 * ONE / 2 - half_x);
     // r' ≤ 3/2 r, held below 16. No floor is needed: |w| ≤ 2√3 keeps 1/|w| ≥ 0.29, and a
-    // step from above lands at ≥ r/4 > √3/4 · 1/|w| ≥ 1/8.
+    // step from above lands at ≥ r/2 > 1/(2|w|) ≥ 1/7.
     let rn = q::opaque(((q::mul_wide(r0, factor) >> LEN_FRAC) as i32).clamp(0, R_MAX));
     *r = rn;
     // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
@@ -681,11 +685,13 @@ pub fn spring_force<const S: usize>(
     // The velocities are read only now (no instruction: it keeps the compiler from
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
-    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52: the high word is Q20 N;
-    // |C (v_b − v_a)| < 2⁶² and |w f r| < 2⁶¹, so the sum fits.
+    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52, whose high words are
+    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| < 2²⁹: the sum fits). The sum of the two high
+    // words is within 1 LSB (1e-6 N) of the high word of the sum: one `smmul` and one
+    // `smmla` on the M3/M4, no low words on the M0.
     core::array::from_fn(|k| {
         let dv = vb[k].wrapping_sub(va[k]);
-        let p = q::mul_wide(dv, damping) + q::mul_wide(w[k], neg_fr);
-        ((p >> 32) as i32).clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
+        let p = q::mulhi(dv, damping) + q::mulhi(w[k], neg_fr);
+        p.clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })
 }
