@@ -535,36 +535,54 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         self.nodes.get(i).map_or([0; 3], |n| n.v)
     }
 
-    /// Accumulates every spring's force (law + damping) on its two nodes.
+    /// Accumulates every spring's force (law + damping) on its two nodes. A spring to a
+    /// fixed point has the ground as `b` (the topology sees to it): its branch reads no
+    /// second node and writes only the first (the ground's displacement and velocity are
+    /// zero, its accumulator is never read).
     #[inline(always)]
     fn spring_forces(&mut self) {
         let damping = self.c.spring_damping;
         let nodes = self.nodes.as_mut_ptr();
         for (e, r) in self.topo.edges().iter().zip(self.inv_stretch.iter_mut()) {
             // SAFETY: `Topology::add_edge` only stores node indices below its node count,
-            // which is at most NODES, and the edges cannot change afterwards. The shared
-            // reads end before the writes; `a = b` only for the ground, whose accumulator
-            // is never read.
-            let (na, nb) = unsafe { (&*nodes.add(e.a as usize), &*nodes.add(e.b as usize)) };
-            let f_on_a = spring_force(
-                &self.table,
-                e.dir,
-                e.inv_len,
-                na.u,
-                nb.u,
-                &na.v,
-                &nb.v,
-                r,
-                damping,
-            );
-            // At most MAX_SPRINGS_PER_NODE springs of ≤ 64 N each: the sums fit.
+            // which is at most NODES, and `a` is never the ground, so `a ≠ b`; the edges
+            // cannot change afterwards. The shared reads end before the writes.
+            let na = unsafe { &*nodes.add(e.a as usize) };
+            let f_on_a = if e.b == GROUND {
+                spring_force(
+                    &self.table,
+                    e.dir,
+                    e.inv_len,
+                    na.u,
+                    [0; 3],
+                    &na.v,
+                    &[0; 3],
+                    r,
+                    damping,
+                )
+            } else {
+                // SAFETY: as above.
+                let nb = unsafe { &*nodes.add(e.b as usize) };
+                let f = spring_force(
+                    &self.table,
+                    e.dir,
+                    e.inv_len,
+                    na.u,
+                    nb.u,
+                    &na.v,
+                    &nb.v,
+                    r,
+                    damping,
+                );
+                // At most MAX_SPRINGS_PER_NODE springs of ≤ 64 N each: the sums fit.
+                // SAFETY: as above.
+                let fb = unsafe { &mut (*nodes.add(e.b as usize)).f };
+                *fb = core::array::from_fn(|k| fb[k].wrapping_sub(f[k]));
+                f
+            };
             // SAFETY: as above.
-            unsafe {
-                let fa = &mut (*nodes.add(e.a as usize)).f;
-                *fa = core::array::from_fn(|k| fa[k].wrapping_add(f_on_a[k]));
-                let fb = &mut (*nodes.add(e.b as usize)).f;
-                *fb = core::array::from_fn(|k| fb[k].wrapping_sub(f_on_a[k]));
-            }
+            let fa = unsafe { &mut (*nodes.add(e.a as usize)).f };
+            *fa = core::array::from_fn(|k| fa[k].wrapping_add(f_on_a[k]));
         }
     }
 

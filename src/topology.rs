@@ -25,9 +25,9 @@ pub const INV_LEN_FRAC: u32 = 31;
 /// One spring of the patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Edge {
-    /// First node (0 = ground).
+    /// First node: always a free one.
     pub a: u16,
-    /// Second node (0 = ground).
+    /// Second node (0 = ground: a spring to a fixed point has its fixed end here).
     pub b: u16,
     /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q29.
     pub dir: V3,
@@ -140,6 +140,13 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         if ia == GROUND && ib == GROUND {
             return Err(TopologyError::BadEnd);
         }
+        // A spring to a fixed point keeps the ground as `b`: the solver's loop then skips
+        // the ground's loads and its force accumulator.
+        let ((ia, pa), (ib, pb)) = if ia == GROUND {
+            ((ib, pb), (ia, pa))
+        } else {
+            ((ia, pa), (ib, pb))
+        };
         let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
         let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if len < 1.0 {
