@@ -109,6 +109,27 @@ pub fn mulhi_split(a: i32, b: i32) -> i32 {
         .wrapping_add(n >> 16)
 }
 
+/// `⌊(a · b + 2³¹) / 2³²⌋`: the high word of the product, rounded to nearest (`smmulr`
+/// on cores with a long multiply). The M0 adds the low word's top bit to
+/// [`mulhi_split`]: the same bits.
+#[inline(always)]
+pub fn mulhi_round(a: i32, b: i32) -> i32 {
+    #[cfg(core = "m0")]
+    {
+        mulhi_round_split(a, b)
+    }
+    #[cfg(not(core = "m0"))]
+    {
+        ((a as i64 * b as i64 + (1 << 31)) >> 32) as i32
+    }
+}
+
+/// [`mulhi_round`] from [`mulhi_split`] and the low word, exact.
+#[inline(always)]
+pub fn mulhi_round_split(a: i32, b: i32) -> i32 {
+    mulhi_split(a, b).wrapping_add((a.wrapping_mul(b) as u32 >> 31) as i32)
+}
+
 /// The full signed product `a · b`: one `smull` with a long multiply; on the M0 the high
 /// word from [`mulhi_split`] and the low word from one 32-bit multiply (the same bits,
 /// without the `__aeabi_lmul` call).

@@ -704,12 +704,13 @@ pub fn spring_force<const S: usize>(
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
     // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52, whose high words are
-    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| < 2²⁹: the sum fits). The sum of the two high
-    // words is within 1 LSB (1e-6 N) of the high word of the sum: one `smmul` and one
-    // `smmla` on the M3/M4, no low words on the M0.
+    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| < 2²⁹: the sum fits). The two high words are
+    // rounded to nearest, so that their sum has no bias against the high word of the sum
+    // (floors would pull every spring by −1 LSB): one `smmulr` and one `smmlar` on the
+    // M3/M4, no 64-bit sum on the M0.
     core::array::from_fn(|k| {
         let dv = vb[k].wrapping_sub(va[k]);
-        let p = q::mulhi(dv, damping) + q::mulhi(w[k], neg_fr);
+        let p = q::mulhi_round(dv, damping) + q::mulhi_round(w[k], neg_fr);
         p.clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })
 }

@@ -4,7 +4,8 @@
 //! also hold for the M0 firmware.
 
 use mccs::q::{
-    mul_t, mul_t_split, mul_wide, mul_wide_split, mulhi, mulhi_split, mulhi_u, mulhi_u_split,
+    mul_t, mul_t_split, mul_wide, mul_wide_split, mulhi, mulhi_round, mulhi_round_split,
+    mulhi_split, mulhi_u, mulhi_u_split,
 };
 use proptest::prelude::*;
 
@@ -35,6 +36,9 @@ fn split_products_match_at_the_edges() {
             assert_eq!(mulhi(a, b), mulhi_split(a, b));
             assert_eq!(mul_wide_split(a, b), a as i64 * b as i64);
             assert_eq!(mul_wide(a, b), a as i64 * b as i64);
+            let round = ((a as i64 * b as i64 + (1 << 31)) >> 32) as i32;
+            assert_eq!(mulhi_round_split(a, b), round, "{a} {b}");
+            assert_eq!(mulhi_round(a, b), round);
             let (ua, ub) = (a as u32, b as u32);
             assert_eq!(
                 mulhi_u_split(ua, ub),
@@ -59,6 +63,9 @@ proptest! {
         prop_assert_eq!(mulhi(a, b), mulhi_split(a, b));
         prop_assert_eq!(mul_wide_split(a, b), a as i64 * b as i64);
         prop_assert_eq!(mul_wide(a, b), a as i64 * b as i64);
+        let round = ((a as i64 * b as i64 + (1 << 31)) >> 32) as i32;
+        prop_assert_eq!(mulhi_round_split(a, b), round);
+        prop_assert_eq!(mulhi_round(a, b), round);
         let (ua, ub) = (a as u32, b as u32);
         prop_assert_eq!(mulhi_u_split(ua, ub), ((ua as u64 * ub as u64) >> 32) as u32);
         prop_assert_eq!(mul_t_split(a, t), ((a as i64 * t as i64) >> 16) as i32);
