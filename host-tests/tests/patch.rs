@@ -131,6 +131,28 @@ fn standard_patch_spring_counts() {
     );
 }
 
+/// A spring to a fixed point keeps its free end as `a` and the ground as `b` (the solver's
+/// loop relies on it), whichever order the ends were given in; its rest vector points
+/// from the free end to the fixed point.
+#[test]
+fn springs_to_fixed_points_have_the_ground_as_b() {
+    let t = Topology::<37, 214>::standard_patch(8, 2.5).unwrap();
+    let ground = t
+        .edges()
+        .iter()
+        .filter(|e| e.b == mccs::topology::GROUND)
+        .count();
+    assert_eq!(ground, 104);
+    assert!(t.edges().iter().all(|e| e.a != mccs::topology::GROUND));
+    let mut t = Topology::<3, 2>::new();
+    let n = t.add_free_node([0.0, 0.0, 0.0]).unwrap();
+    t.add_edge(mccs::End::Fixed([0.0, 0.0, -2.0]), mccs::End::Free(n))
+        .unwrap();
+    let e = t.edges()[0];
+    assert_eq!((e.a, e.b), (n, mccs::topology::GROUND));
+    assert_eq!(e.dir, [0, 0, -(1 << mccs::topology::DIR_FRAC)]);
+}
+
 #[test]
 fn steady_state_matches_static_equilibrium_and_twin() {
     for (n, s, d) in [(5, 2.5, 0.3), (5, 2.5, 0.8), (7, 2.0, 1.0)] {

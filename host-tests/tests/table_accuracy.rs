@@ -356,6 +356,32 @@ proptest! {
     }
 }
 
+/// The solver's `force_within` is `force` clamped, over the whole strain range, on the
+/// Table 2 spring and on springs with large forces (whose lines saturate).
+#[test]
+fn force_within_is_force_clamped() {
+    let mut springs = vec![Params::TABLE2];
+    let mut big = Params::TABLE2;
+    big.cone.shear_modulus *= 30.0;
+    big.linear.shear_modulus *= 30.0;
+    springs.push(big);
+    for p in springs {
+        let t = ForceTable::<64>::new(&p).unwrap();
+        let mut bits = i32::MIN;
+        loop {
+            let e = Strain::from_bits(bits);
+            let want = t.force(e).to_bits().clamp(-(1 << 26), (1 << 26) - 1);
+            assert_eq!(t.force_within::<26>(e), want, "{bits}");
+            let want = t.force(e).to_bits().clamp(-(1 << 30), (1 << 30) - 1);
+            assert_eq!(t.force_within::<30>(e), want, "{bits}");
+            match bits.checked_add(1 << 16) {
+                Some(b) => bits = b,
+                None => break,
+            }
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
