@@ -40,6 +40,9 @@ pub(crate) struct CouplingQ {
 }
 
 impl CouplingQ {
+    /// Fraction bits of `damping`.
+    pub const DAMP_FRAC: u32 = 24;
+
     /// Force on the contact node (Q20 N) from the probe at `probe` (Q24 mm) moving at
     /// `probe_vel` (Q16 mm/s), the node at `node` moving at `node_vel`. Zero when the
     /// probe is not below the node.

@@ -1,9 +1,28 @@
-//! Fixed-point helpers for the per-tick path: saturating products of raw `i32` values in
-//! different Q formats, and 3-vectors of them. Every product is 32 × 32 → 64 bits, shifted
-//! back and clamped to `i32`: never wrapping, never panicking.
+//! Fixed-point helpers for the per-tick path: long products of raw `i32` values in mixed
+//! Q formats, with exact floor (or round-to-nearest) semantics, and 3-vectors of them.
+//!
+//! Cores with a 32 × 32 → 64 multiply (M3, M4F) compute each product with one
+//! instruction; the Cortex-M0 has none and builds it from 16 × 16 pieces (the `*_split`
+//! functions, always compiled, so that the host tests hold them to the long multiply:
+//! `host-tests/tests/arith.rs`). Both give the same bits, so a table or a solver gives
+//! the same results on every core.
 
 /// A 3-vector of raw fixed-point values (x, y, z).
 pub type V3 = [i32; 3];
+
+/// The long-multiply form of a product, or its 16-bit-piece form on the Cortex-M0.
+macro_rules! long_or_split {
+    ($split:expr, $long:expr) => {{
+        #[cfg(core = "m0")]
+        {
+            $split
+        }
+        #[cfg(not(core = "m0"))]
+        {
+            $long
+        }
+    }};
+}
 
 /// Clamps an `i64` into `i32`.
 #[inline(always)]
@@ -11,16 +30,16 @@ pub fn sat(x: i64) -> i32 {
     x.clamp(i32::MIN as i64, i32::MAX as i64) as i32
 }
 
-/// `(a · b) >> shift`, saturated to `i32` (floor).
+/// `⌊p / 2^SH⌋` held within `±2^L` (`L` ≤ 31) through the high word alone: the high word
+/// is clamped before the two words are joined, so a held value is the limit to within
+/// its low `32 − SH` bits (which are the product's own). One `ssat` instead of a 64-bit
+/// comparison; exact for every value inside the limit.
 #[inline(always)]
-pub fn mul(a: i32, b: i32, shift: u32) -> i32 {
-    sat((a as i64 * b as i64) >> shift)
-}
-
-/// `(a · b) >> S`, not saturated: for products the caller knows to fit.
-#[inline(always)]
-pub fn mulsh<const S: u32>(a: i32, b: i32) -> i32 {
-    ((a as i64 * b as i64) >> S) as i32
+pub fn shr_held<const SH: u32, const L: u32>(p: i64) -> i32 {
+    const { assert!(SH >= 1 && SH <= 32 && L <= 31 && L + SH >= 32 && L + SH - 32 <= 30) };
+    let bound = 1i32 << (L + SH - 32);
+    let hi = ((p >> 32) as i32).clamp(-bound, bound - 1);
+    (hi << (32 - SH)) | ((p as u32) >> SH) as i32
 }
 
 /// Component-wise saturating `a + b`.
@@ -31,34 +50,6 @@ pub fn add(a: V3, b: V3) -> V3 {
         a[1].saturating_add(b[1]),
         a[2].saturating_add(b[2]),
     ]
-}
-
-/// Component-wise saturating `a − b`.
-#[inline(always)]
-pub fn sub(a: V3, b: V3) -> V3 {
-    [
-        a[0].saturating_sub(b[0]),
-        a[1].saturating_sub(b[1]),
-        a[2].saturating_sub(b[2]),
-    ]
-}
-
-/// `v · s >> shift` for each component, saturating.
-#[inline(always)]
-pub fn scale(v: V3, s: i32, shift: u32) -> V3 {
-    [
-        mul(v[0], s, shift),
-        mul(v[1], s, shift),
-        mul(v[2], s, shift),
-    ]
-}
-
-/// `|v|² >> shift`, saturating.
-#[inline(always)]
-pub fn norm2(v: V3, shift: u32) -> i32 {
-    let s = v[0] as i64 * v[0] as i64 + v[1] as i64 * v[1] as i64;
-    // Each square is < 2^62; the sum of two fits, the third is added after the shift.
-    sat((s >> shift) + ((v[2] as i64 * v[2] as i64) >> shift))
 }
 
 /// Rounds an `f64` to the nearest raw value with `frac` fraction bits, saturating
@@ -82,14 +73,7 @@ pub fn from_f64(x: f64, frac: u32) -> i32 {
 /// [`mulhi_split`], which gives the same bits.
 #[inline(always)]
 pub fn mulhi(a: i32, b: i32) -> i32 {
-    #[cfg(core = "m0")]
-    {
-        mulhi_split(a, b)
-    }
-    #[cfg(not(core = "m0"))]
-    {
-        ((a as i64 * b as i64) >> 32) as i32
-    }
+    long_or_split!(mulhi_split(a, b), ((a as i64 * b as i64) >> 32) as i32)
 }
 
 /// [`mulhi`] from four 16 × 16 products, exact: with `a = a₁2¹⁶ + a₀`, `b = b₁2¹⁶ + b₀`
@@ -98,7 +82,7 @@ pub fn mulhi(a: i32, b: i32) -> i32 {
 #[inline(always)]
 pub fn mulhi_split(a: i32, b: i32) -> i32 {
     // See `mulhi_u_split` on `opaque`.
-    let (a1, a0) = (a >> 16, opaque((a & 0xFFFF) as u32));
+    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF) as u32);
     let (b1, b0) = (b >> 16, (b & 0xFFFF) as u32);
     let m = a1
         .wrapping_mul(b0 as i32)
@@ -114,14 +98,10 @@ pub fn mulhi_split(a: i32, b: i32) -> i32 {
 /// [`mulhi_split`]: the same bits.
 #[inline(always)]
 pub fn mulhi_round(a: i32, b: i32) -> i32 {
-    #[cfg(core = "m0")]
-    {
-        mulhi_round_split(a, b)
-    }
-    #[cfg(not(core = "m0"))]
-    {
+    long_or_split!(
+        mulhi_round_split(a, b),
         ((a as i64 * b as i64 + (1 << 31)) >> 32) as i32
-    }
+    )
 }
 
 /// [`mulhi_round`] from [`mulhi_split`] and the low word, exact.
@@ -135,14 +115,7 @@ pub fn mulhi_round_split(a: i32, b: i32) -> i32 {
 /// without the `__aeabi_lmul` call).
 #[inline(always)]
 pub fn mul_wide(a: i32, b: i32) -> i64 {
-    #[cfg(core = "m0")]
-    {
-        mul_wide_split(a, b)
-    }
-    #[cfg(not(core = "m0"))]
-    {
-        a as i64 * b as i64
-    }
+    long_or_split!(mul_wide_split(a, b), a as i64 * b as i64)
 }
 
 /// [`mul_wide`] from [`mulhi_split`] and the low word, exact.
@@ -154,14 +127,7 @@ pub fn mul_wide_split(a: i32, b: i32) -> i64 {
 /// `⌊a · b / 2³²⌋` unsigned: one `umull` with a long multiply, else [`mulhi_u_split`].
 #[inline(always)]
 pub fn mulhi_u(a: u32, b: u32) -> u32 {
-    #[cfg(core = "m0")]
-    {
-        mulhi_u_split(a, b)
-    }
-    #[cfg(not(core = "m0"))]
-    {
-        ((a as u64 * b as u64) >> 32) as u32
-    }
+    long_or_split!(mulhi_u_split(a, b), ((a as u64 * b as u64) >> 32) as u32)
 }
 
 /// [`mulhi_u`] from four 16 × 16 products, exact (the unsigned [`mulhi_split`]).
@@ -169,7 +135,7 @@ pub fn mulhi_u(a: u32, b: u32) -> u32 {
 pub fn mulhi_u_split(a: u32, b: u32) -> u32 {
     // LLVM recognises this pattern and would fold it back into a 64-bit product, which
     // on the M0 is a library call (`__aeabi_lmul`): an empty `asm!` hides one half.
-    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF));
+    let (a1, a0) = (a >> 16, opaque((a & 0xFFFF) as i32) as u32);
     let (b1, b0) = (b >> 16, b & 0xFFFF);
     let m = a1.wrapping_mul(b0).wrapping_add(a0.wrapping_mul(b0) >> 16);
     let n = a0.wrapping_mul(b1).wrapping_add(m & 0xFFFF);
@@ -183,14 +149,10 @@ pub fn mulhi_u_split(a: u32, b: u32) -> u32 {
 /// multiply, else [`mul_t_split`]; the same bits. Larger `t` are masked to 15 bits.
 #[inline(always)]
 pub fn mul_t(a: i32, t: u32) -> i32 {
-    #[cfg(core = "m0")]
-    {
-        mul_t_split(a, t)
-    }
-    #[cfg(not(core = "m0"))]
-    {
+    long_or_split!(
+        mul_t_split(a, t),
         ((a as i64 * (((t & 0x7FFF) << 16) as i32) as i64) >> 32) as i32
-    }
+    )
 }
 
 /// [`mul_t`] from two 16 × 16 products, exact: `⌊at/2¹⁶⌋ = a₁t + ⌊a₀t/2¹⁶⌋`.
@@ -203,34 +165,10 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
 }
 
 /// `x`, through an empty `asm!` block: no instruction, but the optimiser cannot see what
-/// it is, so it cannot rewrite the arithmetic around it.
+/// it is, so it cannot rewrite the arithmetic around it (fold a split product back into
+/// a library call, or widen a value it cannot prove fits 32 bits).
 #[inline(always)]
-pub fn opaque<T: Opaque>(x: T) -> T {
-    x.opaque()
-}
-
-/// 32-bit values that [`opaque`] takes.
-pub trait Opaque: Copy {
-    /// See [`opaque`].
-    fn opaque(self) -> Self;
-}
-
-impl Opaque for i32 {
-    #[inline(always)]
-    fn opaque(self) -> Self {
-        opaque_u32(self as u32) as i32
-    }
-}
-
-impl Opaque for u32 {
-    #[inline(always)]
-    fn opaque(self) -> Self {
-        opaque_u32(self)
-    }
-}
-
-#[inline(always)]
-fn opaque_u32(mut x: u32) -> u32 {
+pub fn opaque(mut x: i32) -> i32 {
     // SAFETY: the template is a comment: it reads and writes only `x`'s register.
     #[cfg(target_arch = "arm")]
     unsafe {

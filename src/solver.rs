@@ -34,7 +34,7 @@
 use crate::coupling::{Coupling, CouplingQ};
 use crate::q::{self, V3};
 use crate::table::ForceTable;
-use crate::topology::{Topology, GROUND, LEN_FRAC};
+use crate::topology::{Topology, GROUND, INV_LEN_FRAC, LEN_FRAC};
 use crate::{Force, Strain};
 use fixed::types::I8F24;
 
@@ -62,14 +62,18 @@ const _: () = assert!(W_FRAC + FR_FRAC == 32 + FORCE_FRAC);
 /// node damping): Q20 N · Q20 and Q16 mm/s · Q24 are both Q40, shifted by 24 to Q16 mm/s.
 const HM_FRAC: u32 = 20;
 const KEEP_FRAC: u32 = 24;
+const _: () = assert!(VEL_FRAC + KEEP_FRAC == FORCE_FRAC + HM_FRAC);
 /// Fraction bits of `h/2` (s): Q16 mm/s · Q40 s → high word Q24 mm.
 const HALF_H_FRAC: u32 = 40;
 /// Upper bound of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
 const R_MAX: i32 = (16 << LEN_FRAC) - 1;
-/// Largest force of one spring (law and damping together), N in Q20: 64 N.
-pub const SPRING_FORCE_LIMIT: i32 = 64 << FORCE_FRAC;
-/// Largest law force per unit current length, `|f| · l0/l`: 256 N.
+/// Largest force of one spring (law and damping together), N in Q20: 64 N = 2²⁶.
+pub const SPRING_FORCE_LIMIT: i32 = 1 << SPRING_FORCE_BITS;
+const SPRING_FORCE_BITS: u32 = 26;
+const _: () = assert!(SPRING_FORCE_LIMIT == 64 << FORCE_FRAC);
+/// Largest law force per unit current length, `|f| · l0/l`: 256 N = 2³¹ in Q23.
 pub const FORCE_PER_STRETCH_LIMIT_N: i32 = 256;
+const _: () = assert!(FORCE_PER_STRETCH_LIMIT_N as i64 == 1 << (31 - FR_FRAC));
 /// Most springs at one node: their summed forces cannot overflow the Q20 accumulator.
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
 /// Largest displacement from rest, mm in Q24: just under 64 mm.
@@ -306,7 +310,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ {
                 stiffness: q::from_f64(cp.stiffness, 16),
-                damping: q::from_f64(cp.damping / 1000.0, 24),
+                damping: q::from_f64(cp.damping / 1000.0, CouplingQ::DAMP_FRAC),
                 max_force: q::from_f64(cp.max_force, FORCE_FRAC),
             },
         };
@@ -548,32 +552,25 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             // which is at most NODES, and `a` is never the ground, so `a ≠ b`; the edges
             // cannot change afterwards. The shared reads end before the writes.
             let na = unsafe { &*nodes.add(e.a as usize) };
-            let f_on_a = if e.b == GROUND {
+            let mut force = |ub: V3, vb: &V3| {
                 spring_force(
                     &self.table,
                     e.dir,
                     e.inv_len,
                     na.u,
-                    [0; 3],
+                    ub,
                     &na.v,
-                    &[0; 3],
+                    vb,
                     r,
                     damping,
                 )
+            };
+            let f_on_a = if e.b == GROUND {
+                force([0; 3], &[0; 3])
             } else {
                 // SAFETY: as above.
                 let nb = unsafe { &*nodes.add(e.b as usize) };
-                let f = spring_force(
-                    &self.table,
-                    e.dir,
-                    e.inv_len,
-                    na.u,
-                    nb.u,
-                    &na.v,
-                    &nb.v,
-                    r,
-                    damping,
-                );
+                let f = force(nb.u, &nb.v);
                 // At most MAX_SPRINGS_PER_NODE springs of ≤ 64 N each: the sums fit.
                 // SAFETY: as above.
                 let fb = unsafe { &mut (*nodes.add(e.b as usize)).f };
@@ -596,8 +593,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             // ±2³⁰ (±16384 mm/s) through the high word; the low bits of a held value are
             // the product's own (below 0.004 mm/s).
             let p = q::mul_wide(v, c.keep) + q::mul_wide(f, c.h_over_m);
-            let hi = ((p >> 32) as i32).clamp(-(1 << 22), (1 << 22) - 1);
-            let v_new = (hi << 8) | ((p as u32) >> 24) as i32;
+            let v_new = q::shr_held::<{ FORCE_FRAC + HM_FRAC - VEL_FRAC }, 30>(p);
             // u' = u + (v + v') h/2: |v + v'| < 2³¹ and h/2 < 2³¹ in Q40, so |du| < 2³⁰ and
             // the sum cannot overflow before the clamp.
             let du = q::mulhi(v.wrapping_add(v_new), c.half_h);
@@ -663,10 +659,11 @@ pub fn spring_force<const S: usize>(
 ) -> V3 {
     // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q29: the high word of Q24 · Q31 is
     // Q23, times 64; |u_b − u_a| < 2³¹ (the displacement clamp).
+    const Q_FRAC: u32 = LEN_FRAC + INV_LEN_FRAC - 32;
     let w: V3 = core::array::from_fn(|k| {
         let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len);
         dir[k]
-            .wrapping_add(q.wrapping_mul(1 << (W_FRAC - 23)))
+            .wrapping_add(q.wrapping_mul(1 << (W_FRAC - Q_FRAC)))
             .clamp(-W_LIMIT, W_LIMIT - 1)
     });
     // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high
@@ -692,14 +689,11 @@ pub fn spring_force<const S: usize>(
     // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
     let stretch = (q::mul_wide(ar, factor) >> 23) as i32;
     let strain = Strain::from_bits(ONE - stretch);
-    // ±64 N: 2²⁶ in Q20.
-    let f = table.force_within::<26>(strain);
+    let f = table.force_within::<SPRING_FORCE_BITS>(strain);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
     // −f r: Q20 · Q24 = Q44; Q23 is `>> 21`, held within ±256 N through the high word
     // (the low bits of a held value are the product's own, below 2⁻¹² N).
-    let p = q::mul_wide(-f, rn);
-    let hi = ((p >> 32) as i32).clamp(-(1 << 20), (1 << 20) - 1);
-    let neg_fr = (hi << 11) | ((p as u32) >> 21) as i32;
+    let neg_fr = q::shr_held::<{ FORCE_FRAC + LEN_FRAC - FR_FRAC }, 31>(q::mul_wide(-f, rn));
     // The velocities are read only now (no instruction: it keeps the compiler from
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);

@@ -46,7 +46,7 @@
 
 use crate::law::Law;
 use crate::params::{ParamError, Params};
-use crate::q::{mul_t, mul_wide, mulhi, mulhi_u};
+use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
 use crate::{Force, Stiffness, Strain};
 use core::fmt;
 
@@ -547,14 +547,12 @@ fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
     f0.saturating_add(df)
 }
 
-/// [`line`] for callers that clamp the result to well inside ±2048 N: the product's high
-/// word is held within ±2¹⁹ before the words are joined, so a held value is ±2048 N to
-/// within its low 12 bits (4 mN) — beyond any such clamp.
+/// [`line`] for callers that clamp the result to well inside ±2048 N: the product is held
+/// through its high word ([`shr_held`]), so a held value is ±2048 N to within its low 12
+/// bits (4 mN) — beyond any such clamp.
 #[inline(always)]
 fn line_held(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
     const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
-    let p = mul_wide(k, e.saturating_sub(e0));
-    let hi = ((p >> 32) as i32).clamp(-(1 << (SH - 1)), (1 << (SH - 1)) - 1);
-    let df = (hi << (32 - SH)) | ((p as u32) >> SH) as i32;
+    let df = shr_held::<SH, 31>(mul_wide(k, e.saturating_sub(e0)));
     f0.saturating_add(df)
 }

@@ -54,6 +54,40 @@ fn split_products_match_at_the_edges() {
     }
 }
 
+/// `shr_held`: exact inside the limit, and the limit to within the low bits outside.
+#[test]
+fn shr_held_is_exact_inside_and_held_outside() {
+    use mccs::q::shr_held;
+    for p in [
+        0i64,
+        1,
+        -1,
+        1 << 40,
+        -(1 << 40),
+        (1 << 50) - 1,
+        -(1 << 50),
+        i64::MAX,
+        i64::MIN,
+    ] {
+        for (got, sh, l) in [
+            (shr_held::<20, 31>(p), 20, 31),
+            (shr_held::<24, 30>(p), 24, 30),
+        ] {
+            let exact = p >> sh;
+            let limit = 1i64 << l;
+            if (-limit..limit).contains(&exact) {
+                assert_eq!(got as i64, exact, "{p} >> {sh}");
+            } else {
+                let held = if exact < 0 { -limit } else { limit - 1 };
+                assert!(
+                    (got as i64 - held).abs() < 1 << (32 - sh),
+                    "{p} >> {sh}: {got}"
+                );
+            }
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(20_000))]
 

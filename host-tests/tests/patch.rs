@@ -373,6 +373,14 @@ fn bad_configurations_are_typed_errors() {
             mccs::ConfigKey::SpringDamping,
         ),
         (
+            // Above 30 N·s/m a spring's damping term could overflow its Q52 sum.
+            SolverConfig {
+                spring_damping: 31.0,
+                ..base
+            },
+            mccs::ConfigKey::SpringDamping,
+        ),
+        (
             SolverConfig {
                 max_substeps: 0,
                 ..base

@@ -81,6 +81,7 @@ mod firmware {
         cp.SYST.enable_counter();
         while now() == 0 {}
         let cpk = calibrate();
+        let mut figs = Figures(heapless::Vec::new());
         defmt::info!("calibration: {=u32} counts per 1024 instructions", cpk);
         let empty = measure(cpk, 64, || {
             black_box(0u32);
@@ -100,7 +101,7 @@ mod firmware {
             let eps = Strain::from_bits((k & 0x00FF_FFFF) - 0x0040_0000);
             black_box(e::force_and_stiffness(black_box(&table), eps));
         }) - (harness - empty);
-        report("force_and_stiffness", fs - empty);
+        figs.report("force_and_stiffness", fs - empty);
         // A 4 mm spring along −z compressed by 2 mm (strain 0.5: the table's cubic part,
         // the longest path), its ends moving, 1 N·s/m of damping.
         let mut r = 1 << 24;
@@ -121,39 +122,39 @@ mod firmware {
                 damping,
             ));
         }) - (harness - empty);
-        report("spring", spring - empty);
+        figs.report("spring", spring - empty);
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
         let sub3 = substep_case::<2, 9>(cpk, 3, &table, probe);
-        report("substep_n3", sub3 - empty);
+        figs.report("substep_n3", sub3 - empty);
         let sub4 = substep_case::<5, 30>(cpk, 4, &table, probe);
-        report("substep_n4", sub4 - empty);
+        figs.report("substep_n4", sub4 - empty);
         let sub5 = substep_case::<10, 61>(cpk, 5, &table, probe);
-        report("substep_n5", sub5 - empty);
+        figs.report("substep_n5", sub5 - empty);
         #[cfg(not(core = "m0"))]
         {
             let sub6 = substep_case::<17, 102>(cpk, 6, &table, probe);
-            report("substep_n6", sub6 - empty);
+            figs.report("substep_n6", sub6 - empty);
             let sub7 = substep_case::<26, 153>(cpk, 7, &table, probe);
-            report("substep_n7", sub7 - empty);
+            figs.report("substep_n7", sub7 - empty);
             let sub8 = substep_case::<37, 214>(cpk, 8, &table, probe);
-            report("substep_n8", sub8 - empty);
+            figs.report("substep_n8", sub8 - empty);
         }
         // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
         // in f64 (software everywhere).
         let f32_5 = float_case::<f32, 10, 61>(cpk, 5, &table);
-        report("substep_n5_f32", f32_5 - empty);
+        figs.report("substep_n5_f32", f32_5 - empty);
         let f64_5 = float_case::<f64, 10, 61>(cpk, 5, &table);
-        report("substep_n5_f64", f64_5 - empty);
+        figs.report("substep_n5_f64", f64_5 - empty);
         #[cfg(not(core = "m0"))]
         {
             let f32_8 = float_case::<f32, 37, 214>(cpk, 8, &table);
-            report("substep_n8_f32", f32_8 - empty);
+            figs.report("substep_n8_f32", f32_8 - empty);
             let f64_8 = float_case::<f64, 37, 214>(cpk, 8, &table);
-            report("substep_n8_f64", f64_8 - empty);
+            figs.report("substep_n8_f64", f64_8 - empty);
         }
         // One whole tick of this core's demo configuration, in contact.
         let tick = tick_case(cpk, &table, probe);
-        report("tick", tick - empty);
+        figs.report("tick", tick - empty);
         let mem = [
             ("solver_n4", core::mem::size_of::<Solver<5, 30, 64>>()),
             ("solver_n5", core::mem::size_of::<Solver<10, 61, 64>>()),
@@ -169,10 +170,10 @@ mod firmware {
             mem[3].1
         );
         for (case, bytes) in mem {
-            record(case, bytes as u32);
+            figs.record(case, bytes as u32);
         }
-        fits(&table);
-        let ok = check_budgets();
+        fits(&figs, &table);
+        let ok = check_budgets(&figs);
         exit(ok)
     }
 
@@ -185,28 +186,6 @@ mod firmware {
     const CLOCK: (u32, u32) = (50, 125);
     #[cfg(core = "m0")]
     const CLOCK: (u32, u32) = (48, 150);
-
-    /// The figures measured so far in this run.
-    static FIGURES: critical_section::Mutex<
-        core::cell::RefCell<heapless::Vec<(&'static str, u32), 32>>,
-    > = critical_section::Mutex::new(core::cell::RefCell::new(heapless::Vec::new()));
-
-    fn record(case: &'static str, value: u32) {
-        critical_section::with(|cs| {
-            // 32 slots for at most 20 figures: a full list only drops the report.
-            let _ = FIGURES.borrow_ref_mut(cs).push((case, value));
-        });
-    }
-
-    fn figure(case: &str) -> Option<u32> {
-        critical_section::with(|cs| {
-            FIGURES
-                .borrow_ref(cs)
-                .iter()
-                .find(|(c, _)| *c == case)
-                .map(|(_, v)| *v)
-        })
-    }
 
     /// The spring case's inputs (raw formats of `mccs::solver::spring_force`), each
     /// through `black_box`.
@@ -224,19 +203,34 @@ mod firmware {
         )
     }
 
-    fn report(case: &'static str, instructions: u32) {
-        record(case, instructions);
-        defmt::println!(
-            "BENCH core={=str} case={=str} instructions={=u32}",
-            CORE,
-            case,
-            instructions
-        );
+    /// The figures measured in this run, by case name (20 at most; a full list only
+    /// drops the budget check's view of the rest, which then reports them missing).
+    struct Figures(heapless::Vec<(&'static str, u32), 32>);
+
+    impl Figures {
+        fn record(&mut self, case: &'static str, value: u32) {
+            let _ = self.0.push((case, value));
+        }
+
+        fn get(&self, case: &str) -> Option<u32> {
+            self.0.iter().find(|(c, _)| *c == case).map(|(_, v)| *v)
+        }
+
+        /// Records and prints one instruction count.
+        fn report(&mut self, case: &'static str, instructions: u32) {
+            self.record(case, instructions);
+            defmt::println!(
+                "BENCH core={=str} case={=str} instructions={=u32}",
+                CORE,
+                case,
+                instructions
+            );
+        }
     }
 
     /// The largest standard patch whose ticks (substeps × one substep, default
     /// configuration) fit in half a tick at 1 kHz and at 10 kHz, at `CLOCK`.
-    fn fits(table: &ForceTable64) {
+    fn fits(figs: &Figures, table: &ForceTable64) {
         for tick_hz in [1_000u32, 10_000] {
             let half_tick =
                 (CLOCK.0 as u64 * 1_000_000 * 100 / CLOCK.1 as u64 / (2 * tick_hz as u64)) as u32;
@@ -248,7 +242,7 @@ mod firmware {
             for n in 3..=8u32 {
                 let (Some(substeps), Some(sub)) = (
                     substeps_for(n, table, &cfg),
-                    figure(SUBSTEP[n as usize - 3]),
+                    figs.get(SUBSTEP[n as usize - 3]),
                 ) else {
                     continue;
                 };
@@ -314,7 +308,7 @@ mod firmware {
 
     /// Checks this core's lines of bench/budgets.txt against the figures; prints one line
     /// each. False when an enforced budget is breached or its figure is missing.
-    fn check_budgets() -> bool {
+    fn check_budgets(figs: &Figures) -> bool {
         let mut ok = true;
         // The `budget-test` feature adds a budget no code can meet, to show that a breach
         // fails the run.
@@ -338,7 +332,7 @@ mod firmware {
                     .and_then(|m| m.parse::<u32>().ok())
                     .unwrap_or(u32::MAX);
                 // Tenths of the ratio.
-                let tenths = match (figure(num), figure(den)) {
+                let tenths = match (figs.get(num), figs.get(den)) {
                     (Some(a), Some(b)) if b > 0 => Some((a as u64 * 10 / b as u64) as u32),
                     _ => None,
                 };
@@ -357,7 +351,7 @@ mod firmware {
                 let max = field(line, "max")
                     .and_then(|m| m.parse::<u32>().ok())
                     .unwrap_or(0);
-                let value = figure(case);
+                let value = figs.get(case);
                 (case, value, max, value.map(|v| v <= max))
             };
             let result = match (within, enforced) {
