@@ -7,6 +7,7 @@
 
 use crate::device::HapticDevice;
 use crate::solver::{ParamSet, Solver};
+use crate::spring::{Arith, DefaultArith};
 use crate::Force;
 
 /// Why the controller is in its safe state.
@@ -60,19 +61,19 @@ impl Default for Telemetry {
 
 /// A solver driving a device.
 #[derive(Debug)]
-pub struct Controller<D, const NODES: usize, const EDGES: usize, const S: usize> {
-    solver: Solver<NODES, EDGES, S>,
+pub struct Controller<D, const NODES: usize, const EDGES: usize, const S: usize, A = DefaultArith> {
+    solver: Solver<NODES, EDGES, S, A>,
     device: D,
     steady_tick: u32,
     telemetry: Telemetry,
 }
 
-impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize>
-    Controller<D, NODES, EDGES, S>
+impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
+    Controller<D, NODES, EDGES, S, A>
 {
     /// A controller; the force along `z` at tick `steady_tick` (0-based) is recorded as
     /// the steady force.
-    pub fn new(solver: Solver<NODES, EDGES, S>, device: D, steady_tick: u32) -> Self {
+    pub fn new(solver: Solver<NODES, EDGES, S, A>, device: D, steady_tick: u32) -> Self {
         Self {
             solver,
             device,
@@ -132,7 +133,7 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize>
     }
 
     /// The solver.
-    pub fn solver(&self) -> &Solver<NODES, EDGES, S> {
+    pub fn solver(&self) -> &Solver<NODES, EDGES, S, A> {
         &self.solver
     }
 
@@ -142,7 +143,7 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize>
     }
 
     /// The solver and the device back.
-    pub fn into_parts(self) -> (Solver<NODES, EDGES, S>, D) {
+    pub fn into_parts(self) -> (Solver<NODES, EDGES, S, A>, D) {
         (self.solver, self.device)
     }
 }

@@ -9,6 +9,7 @@
 use crate::controller::Controller;
 use crate::device::SimulatedDevice;
 use crate::solver::{ParamSet, Solver, SolverConfig, SolverError};
+use crate::spring::{Arith, Narrow, Wide};
 use crate::table::ForceTable64;
 use crate::topology::{Topology, TopologyError};
 use crate::trajectory::{demo_path, PathError};
@@ -110,10 +111,10 @@ impl DemoSpec {
     /// The demo controller, starting from `table` (Table 2's). Out of line, like the
     /// other start-up builders, so that small-RAM cores do not pay for their stack
     /// frames at once.
-    pub fn controller<const N: usize, const E: usize>(
+    pub fn controller<const N: usize, const E: usize, A: Arith>(
         &self,
         table: ForceTable64,
-    ) -> Result<Controller<DemoDevice, N, E, 64>, DemoError> {
+    ) -> Result<Controller<DemoDevice, N, E, 64, A>, DemoError> {
         let mut slot = None;
         self.controller_into(table, &mut slot)?;
         slot.ok_or(DemoError::Path(PathError::Count))
@@ -121,14 +122,15 @@ impl DemoSpec {
 
     /// [`Self::controller`], built straight into `slot` (fewer copies on the stack).
     #[inline(never)]
-    pub fn controller_into<const N: usize, const E: usize>(
+    pub fn controller_into<const N: usize, const E: usize, A: Arith>(
         &self,
         table: ForceTable64,
-        slot: &mut Option<Controller<DemoDevice, N, E, 64>>,
+        slot: &mut Option<Controller<DemoDevice, N, E, 64, A>>,
     ) -> Result<(), DemoError> {
         let topo = Topology::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
         let device = SimulatedDevice::new(demo_path(self.tick_hz).map_err(DemoError::Path)?);
-        let solver = Solver::new(topo, table, &self.config()).map_err(DemoError::Solver)?;
+        let solver = Solver::with_arith(topo, table, &self.config(), A::default())
+            .map_err(DemoError::Solver)?;
         *slot = Some(Controller::new(solver, device, self.steady_tick()));
         Ok(())
     }
@@ -189,10 +191,19 @@ pub struct Summary {
 }
 
 /// Runs the whole demo on the host (no overruns: nothing is timed), with the swap handed
-/// over at [`DemoSpec::swap_tick`] exactly as the firmware does.
+/// over at [`DemoSpec::swap_tick`] exactly as the firmware does, in the spring
+/// arithmetic of the spec's core ([`crate::spring::Narrow`] for the M0).
 pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
+    if spec.core == "m0" {
+        run_on_host_in::<Narrow>(spec)
+    } else {
+        run_on_host_in::<Wide>(spec)
+    }
+}
+
+fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
     static TABLE2: ForceTable64 = include!("../tables/table2.rs");
-    let mut ctl: DemoController = spec.controller(TABLE2)?;
+    let mut ctl: Controller<DemoDevice, 10, 61, 64, A> = spec.controller(TABLE2)?;
     let mut swap = Some(spec.swapped_set::<10, 61>()?);
     for tick in 0..spec.ticks() {
         let s = if tick >= spec.swap_tick() {

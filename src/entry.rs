@@ -2,7 +2,8 @@
 //! the instructions of exactly one call (QEMU `-icount`, or DWT on hardware). They add
 //! nothing but the call itself.
 
-use crate::{Force, ForceTable64, Stiffness, Strain};
+use crate::spring::{Arith, Damping, DefaultArith};
+use crate::{Edge, Force, ForceTable64, Stiffness, Strain};
 
 /// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
 #[inline(never)]
@@ -16,22 +17,27 @@ pub fn force(table: &ForceTable64, strain: Strain) -> Force {
     table.force(strain)
 }
 
-/// One spring update (law + damping + Newton step), never inlined. Raw Q formats as in
-/// [`crate::solver::spring_force`].
+/// One spring update (law + damping + Newton step) in this core's arithmetic
+/// ([`crate::spring::DefaultArith`]), never inlined; the end states are read through
+/// references, as the solver reads them from its nodes. Raw formats as in
+/// [`crate::spring`].
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
 pub fn spring(
     table: &ForceTable64,
-    dir: [i32; 3],
-    inv_len: i32,
-    ua: [i32; 3],
-    ub: [i32; 3],
-    va: [i32; 3],
-    vb: [i32; 3],
-    r: &mut i32,
-    damping: i32,
+    edge: &Edge,
+    ua: &[i32; 3],
+    ub: &[i32; 3],
+    va: &[i32; 3],
+    vb: &[i32; 3],
+    warm: &mut i32,
+    damping: &Damping,
 ) -> [i32; 3] {
-    crate::solver::spring_force(table, dir, inv_len, ua, ub, &va, &vb, r, damping)
+    if damping.ratio == 1 << 15 {
+        DefaultArith::force::<64, true>(table, edge, *ua, *ub, va, vb, warm, damping)
+    } else {
+        DefaultArith::force::<64, false>(table, edge, *ua, *ub, va, vb, warm, damping)
+    }
 }
 
 /// One substep of a solver with the probe held at `probe`, never inlined.

@@ -34,6 +34,7 @@ pub mod one_dof;
 pub mod params;
 pub mod q;
 pub mod solver;
+pub mod spring;
 pub mod table;
 pub mod topology;
 pub mod trajectory;

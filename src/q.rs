@@ -164,6 +164,63 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
         .wrapping_add((a0.wrapping_mul(t) >> 16) as i32)
 }
 
+/// `⌊a · b / 2^SH⌋` for a 16-bit `b` (`|b| ≤ 2¹⁵`, `SH` ≤ 16): a product with one
+/// narrow operand. One long multiply and a shift on the M3/M4; on the Cortex-M0
+/// [`mul_s_split`], two 32-bit multiplies with the same bits. The caller's ranges must
+/// keep the result (and, for `SH` < 16, `⌊a/2¹⁶⌋ · b · 2^(16 − SH)`) within `i32`.
+#[inline(always)]
+pub fn mul_s<const SH: u32>(a: i32, b: i32) -> i32 {
+    long_or_split!(
+        mul_s_split::<SH>(a, b),
+        ((a as i64 * b as i64) >> SH) as i32
+    )
+}
+
+/// [`mul_s`] from two 32-bit products, exact: with `a = a₁2¹⁶ + a₀` (`a₀ ∈ [0, 2¹⁶)`),
+/// `⌊ab/2^SH⌋ = a₁b·2^(16 − SH) + ⌊a₀b/2^SH⌋` (`|a₀b| < 2³¹`).
+#[inline(always)]
+pub fn mul_s_split<const SH: u32>(a: i32, b: i32) -> i32 {
+    const { assert!(SH <= 16) };
+    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF));
+    (a1.wrapping_mul(b) << (16 - SH)).wrapping_add(a0.wrapping_mul(b) >> SH)
+}
+
+/// [`mul_s`] with the shift known only at run time (`sh` ≤ 16): two variable shifts
+/// on the M0 instead of immediates. The same conditions on the ranges.
+#[inline(always)]
+pub fn mul_s_by(a: i32, b: i32, sh: u32) -> i32 {
+    long_or_split!(
+        mul_s_by_split(a, b, sh),
+        ((a as i64 * b as i64) >> sh) as i32
+    )
+}
+
+/// [`mul_s_by`] from two 32-bit products, exact (see [`mul_s_split`]).
+#[inline(always)]
+pub fn mul_s_by_split(a: i32, b: i32, sh: u32) -> i32 {
+    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF));
+    (a1.wrapping_mul(b) << (16 - sh)).wrapping_add(a0.wrapping_mul(b) >> sh)
+}
+
+/// `(n, sh)` with `n = round(x · 2^(base + sh))` ≤ 2¹⁵ for the largest `sh` ≤ `max_sh`:
+/// a positive coefficient as the 16-bit operand of [`mul_s`], to 2⁻¹⁵ relative
+/// (start-up only; `x · 2^base` must be ≤ 2¹⁵ − ½).
+pub fn norm16(x: f64, base: u32, max_sh: u32) -> (i32, u32) {
+    let at = |sh: u32| libm::round(x * libm::ldexp(1.0, (base + sh) as i32));
+    let mut sh = 0;
+    while sh < max_sh && at(sh + 1) <= 32768.0 {
+        sh += 1;
+    }
+    (at(sh).clamp(0.0, 32768.0) as i32, sh)
+}
+
+/// `x` rounded to nearest and shifted right by `SH` (`SH` ≥ 1): the narrow operand of a
+/// [`mul_s`] from a wide value.
+#[inline(always)]
+pub fn narrow<const SH: u32>(x: i32) -> i32 {
+    x.wrapping_add(1 << (SH - 1)) >> SH
+}
+
 /// `x`, through an empty `asm!` block: no instruction, but the optimiser cannot see what
 /// it is, so it cannot rewrite the arithmetic around it (fold a split product back into
 /// a library call, or widen a value it cannot prove fits 32 bits).

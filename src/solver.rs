@@ -12,13 +12,13 @@
 //! over the springs and one over the nodes: constant time, no division, no square root
 //! (the length comes from a warm-started Newton step for `1/l`), no floating point, no
 //! heap, no panic; every step saturates or works within ranges the clamps bound (see
-//! [`spring_force`]).
+//! [`crate::spring`]).
 //!
 //! # Units and formats
 //! Displacements from rest in mm, Q24, kept within ±64 mm; velocities in mm/s, Q16, kept
 //! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's force, law and damping,
 //! within ±64 N). Positions are in the patch frame (origin at the contact node's rest
-//! position, `z` up). The spring's own formats are in [`spring_force`].
+//! position, `z` up). The spring's own formats are in [`crate::spring`].
 //!
 //! # Stability (the substep count)
 //! For one mass `m` on a spring `K` with damping rate `γ = C/m`, the improved Euler step
@@ -33,9 +33,11 @@
 
 use crate::coupling::{Coupling, CouplingQ};
 use crate::q::{self, V3};
+use crate::spring::{Arith, Damping, DefaultArith};
 use crate::table::ForceTable;
-use crate::topology::{Topology, GROUND, INV_LEN_FRAC, LEN_FRAC};
-use crate::{Force, Strain};
+use crate::topology::{Topology, GROUND};
+use crate::Force;
+use core::marker::PhantomData;
 use fixed::types::I8F24;
 
 /// Length in mm, Q24 (±128 mm).
@@ -43,21 +45,10 @@ pub type Length = I8F24;
 /// Velocity in mm/s, Q16 (±32768 mm/s).
 pub type Velocity = fixed::types::I16F16;
 
-const ONE: i32 = 1 << LEN_FRAC;
 /// Fraction bits of velocities (mm/s).
 const VEL_FRAC: u32 = 16;
 /// Fraction bits of forces (N).
 const FORCE_FRAC: u32 = 20;
-/// Fraction bits of the spring damping (N·s/mm): Q16 mm/s · Q36 = Q52, the format of
-/// the spring's `w · (f l0/l)` product (Q29 · Q23), whose high word is Q20 N.
-const DAMP_FRAC: u32 = 36;
-/// Fraction bits of the edge vector over the rest length, `w`: Q29 (±2 held).
-const W_FRAC: u32 = 29;
-/// Fraction bits of `f l0/l`: Q23 (±256 N held).
-const FR_FRAC: u32 = 23;
-// The spring's two products share Q52, whose high word is Q20 N.
-const _: () = assert!(VEL_FRAC + DAMP_FRAC == 32 + FORCE_FRAC);
-const _: () = assert!(W_FRAC + FR_FRAC == 32 + FORCE_FRAC);
 /// Fraction bits of `h/m` ((mm/s)/N) and of `1 − h c/m` (the velocity kept through the
 /// node damping): Q20 N · Q20 and Q16 mm/s · Q24 are both Q40, shifted by 24 to Q16 mm/s.
 const HM_FRAC: u32 = 20;
@@ -65,24 +56,12 @@ const KEEP_FRAC: u32 = 24;
 const _: () = assert!(VEL_FRAC + KEEP_FRAC == FORCE_FRAC + HM_FRAC);
 /// Fraction bits of `h/2` (s): Q16 mm/s · Q40 s → high word Q24 mm.
 const HALF_H_FRAC: u32 = 40;
-/// Upper bound of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
-const R_MAX: i32 = (16 << LEN_FRAC) - 1;
-/// Largest force of one spring (law and damping together), N in Q20: 64 N = 2²⁶.
-pub const SPRING_FORCE_LIMIT: i32 = 1 << SPRING_FORCE_BITS;
-const SPRING_FORCE_BITS: u32 = 26;
-const _: () = assert!(SPRING_FORCE_LIMIT == 64 << FORCE_FRAC);
-/// Largest law force per unit current length, `|f| · l0/l`: 256 N = 2³¹ in Q23.
-pub const FORCE_PER_STRETCH_LIMIT_N: i32 = 256;
-const _: () = assert!(FORCE_PER_STRETCH_LIMIT_N as i64 == 1 << (31 - FR_FRAC));
 /// Most springs at one node: their summed forces cannot overflow the Q20 accumulator.
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
 /// Largest displacement from rest, mm in Q24: just under 64 mm.
 const DISP_LIMIT: i32 = 1 << 30;
 /// Largest speed, mm/s in Q16: just under 16384 mm/s.
 const VEL_LIMIT: i32 = 1 << 30;
-/// Largest edge vector over the rest length, per axis: 2 (Q29).
-const W_LIMIT: i32 = 2 << W_FRAC;
-
 /// Runtime configuration of a [`Solver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverConfig {
@@ -188,6 +167,90 @@ enum Drive {
     Hold { disp: V3, vel: V3 },
 }
 
+/// The integrator's coefficients as 16-bit operands with run-time shifts, for
+/// [`crate::spring::Narrow`] (each to 2⁻¹⁵ relative). Its nodes store the velocity as
+/// `V = C_v v` (N, Q20; `C_v` from [`Damping::velocity_scale`]), so that a spring's
+/// damping force is a difference of stored values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct NarrowStep {
+    /// `h c_node / m` (≤ ½), Q(16 + `damp_sh`).
+    damp: i32,
+    damp_sh: u32,
+    /// `C_v h / m` (dimensionless), Q(`step_sh1` + `step_sh2`): `f · step` is Q20 N.
+    step: i32,
+    step_sh1: u32,
+    step_sh2: u32,
+    /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
+    f_hold: i32,
+    /// `h / (2 C_v)`, mm/N, Q(4 + `hh_sh1` + `hh_sh2`): `V · hh` is Q24 mm.
+    hh: i32,
+    hh_sh1: u32,
+    hh_sh2: u32,
+    /// `C_v` in N·s/mm, Q(20 + `cv_sh`): mm/s (Q16) to stored velocity (Q20 N).
+    cv: i32,
+    cv_sh: u32,
+    /// `1 / C_v`, Q(`inv_cv_sh` − 4): stored velocity (Q20 N) to mm/s (Q16).
+    inv_cv: i32,
+    inv_cv_sh: u32,
+    /// The velocity limit (16384 mm/s) as a stored velocity.
+    v_limit: i32,
+}
+
+/// `(sh1, sh2)` with `sh1 = min(sh, 16)`: a [`q::mul_s_by`] shift and the rest.
+fn split_shift(sh: u32) -> (u32, u32) {
+    (sh.min(16), sh.saturating_sub(16))
+}
+
+impl NarrowStep {
+    fn new(h: f64, config: &SolverConfig) -> Self {
+        let cv = Damping::velocity_scale(config.spring_damping);
+        let (damp, damp_sh) = q::norm16(h * config.node_damping / config.node_mass, 16, 30);
+        // C_v h/m ≤ 0.03 · 2000 (checked): 2¹⁵ / 60 leaves at least 9 bits of shift.
+        let (step, x) = q::norm16(cv * 1000.0 * h / config.node_mass, 0, 60);
+        let (step_sh1, step_sh2) = split_shift(x);
+        let f_hold = if step > 0 {
+            ((1i64 << (30 + step_sh1)) / step as i64).min(i32::MAX as i64) as i32
+        } else {
+            i32::MAX
+        };
+        // h/(2 C_v) ≤ 2⁻⁹ s / 10⁻⁴ N·s/mm < 20 mm/N: at least 10 bits of shift.
+        let (hh, y) = q::norm16(0.5 * h / cv, 0, 60);
+        let (hh_sh1, hh_sh2) = split_shift(y.saturating_sub(4));
+        let (cvq, cv_sh) = q::norm16(cv, FORCE_FRAC, 20);
+        // 1/C_v ≤ 10⁴ mm/(N·s): at least 1 bit of shift.
+        let (inv_cv, z) = q::norm16(1.0 / cv, 0, 30);
+        Self {
+            damp,
+            damp_sh,
+            step,
+            step_sh1,
+            step_sh2,
+            f_hold,
+            hh,
+            hh_sh1,
+            hh_sh2,
+            cv: cvq,
+            cv_sh,
+            inv_cv,
+            inv_cv_sh: z + 4,
+            v_limit: q::from_f64(16384.0 * cv, FORCE_FRAC),
+        }
+    }
+
+    /// A velocity (Q16 mm/s, within ±2³⁰) as the node stores it (Q20 N).
+    fn store(&self, v: i32) -> i32 {
+        (q::mul_s::<16>(v, self.cv) >> self.cv_sh)
+            .max(-self.v_limit)
+            .min(self.v_limit)
+    }
+
+    /// A stored velocity (Q20 N) in mm/s (Q16).
+    fn velocity(&self, stored: i32) -> i32 {
+        let (sh1, sh2) = split_shift(self.inv_cv_sh);
+        q::mul_s_by(stored, self.inv_cv, sh1) >> sh2
+    }
+}
+
 /// The fixed-point coefficients derived from a [`SolverConfig`] and the step size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Coeffs {
@@ -197,8 +260,10 @@ struct Coeffs {
     keep: i32,
     /// `h/2`, s, Q40.
     half_h: i32,
-    /// Spring damping, N·s/mm, Q36.
-    spring_damping: i32,
+    /// The same step in 16-bit coefficients ([`crate::spring::Narrow`]).
+    narrow: NarrowStep,
+    /// Spring damping in both arithmetics' formats.
+    spring_damping: Damping,
     /// Tick rate, Hz (for the probe velocity).
     tick_hz: i32,
     coupling: CouplingQ,
@@ -226,9 +291,11 @@ impl<const S: usize> ParamSet<S> {
     }
 }
 
-/// The patch solver: topology, force table and state. `NODES` counts the ground slot.
+/// The patch solver: topology, force table and state. `NODES` counts the ground slot;
+/// `A` is the spring arithmetic ([`crate::spring`]: [`crate::spring::Wide`] by default,
+/// [`crate::spring::Narrow`] on the Cortex-M0).
 #[derive(Clone, Debug)]
-pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
+pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize, A = DefaultArith> {
     topo: Topology<NODES, EDGES>,
     table: ForceTable<S>,
     c: Coeffs,
@@ -236,23 +303,40 @@ pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize> {
     contact: usize,
     /// Per node: displacement, velocity, force accumulator.
     nodes: [Node; NODES],
-    /// Warm-started `l0 / l` of each spring, Q24.
-    inv_stretch: [i32; EDGES],
+    /// Each spring's warm-started `l0 / l` in the arithmetic's format.
+    warm: [i32; EDGES],
     /// Last probe position, Q24 mm.
     probe_prev: V3,
     /// Spring force on the contact node in the last substep, Q20 N.
     reaction: V3,
     /// Coupling force on the contact node in the last substep, Q20 N.
     coupling_force: V3,
+    arith: PhantomData<A>,
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES, S> {
-    /// Builds a solver at rest; computes the substeps per tick from the stability bound.
+    /// Builds a solver at rest in this core's spring arithmetic
+    /// ([`crate::spring::DefaultArith`]); computes the substeps per tick from the
+    /// stability bound.
     #[inline(never)]
     pub fn new(
         topo: Topology<NODES, EDGES>,
         table: ForceTable<S>,
         config: &SolverConfig,
+    ) -> Result<Self, SolverError> {
+        Self::with_arith(topo, table, config, DefaultArith::default())
+    }
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
+    /// [`Solver::new`] in a chosen spring arithmetic (e.g. [`crate::spring::Narrow`] on a
+    /// host, to see what the M0 computes).
+    #[inline(never)]
+    pub fn with_arith(
+        topo: Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+        _arith: A,
     ) -> Result<Self, SolverError> {
         let contact = topo.contact() as usize;
         if contact == GROUND as usize {
@@ -266,10 +350,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             substeps: set.substeps,
             contact,
             nodes: [Node::ZERO; NODES],
-            inv_stretch: [ONE; EDGES],
+            warm: [A::REST; EDGES],
             probe_prev: [0; 3],
             reaction: [0; 3],
             coupling_force: [0; 3],
+            arith: PhantomData,
         })
     }
 
@@ -306,7 +391,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
             h_over_m: q::from_f64(1000.0 * h / config.node_mass, HM_FRAC),
             keep: q::from_f64(1.0 - h * config.node_damping / config.node_mass, KEEP_FRAC),
             half_h: q::from_f64(0.5 * h, HALF_H_FRAC),
-            spring_damping: q::from_f64(config.spring_damping / 1000.0, DAMP_FRAC),
+            narrow: NarrowStep::new(h, config),
+            spring_damping: Damping::new(config.spring_damping),
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ {
                 stiffness: q::from_f64(cp.stiffness, 16),
@@ -468,7 +554,16 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
     pub fn velocity(&self, i: u16) -> Option<[Velocity; 3]> {
         self.nodes
             .get(i as usize)
-            .map(|n| n.v.map(Velocity::from_bits))
+            .map(|_| self.node_vel(i as usize).map(Velocity::from_bits))
+    }
+
+    /// A velocity (Q16 mm/s, within the limit) as the nodes store it.
+    fn stored_velocity(&self, v: i32) -> i32 {
+        if A::NARROW {
+            self.c.narrow.store(v)
+        } else {
+            v
+        }
     }
 
     /// Puts node `i` at displacement `disp` (mm) with velocity `vel` (mm/s), clamped to
@@ -480,14 +575,17 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         if let Some(n) = self.nodes.get_mut(i as usize) {
             // Within the integrator's limits, which the spring's ranges rely on.
             n.u = disp.map(|x| x.to_bits().clamp(-DISP_LIMIT, DISP_LIMIT - 1));
-            n.v = vel.map(|x| x.to_bits().clamp(-VEL_LIMIT, VEL_LIMIT - 1));
+        }
+        let v = vel.map(|x| self.stored_velocity(x.to_bits().clamp(-VEL_LIMIT, VEL_LIMIT - 1)));
+        if let Some(n) = self.nodes.get_mut(i as usize) {
+            n.v = v;
         }
     }
 
     /// Back to rest.
     pub fn reset(&mut self) {
         self.nodes = [Node::ZERO; NODES];
-        self.inv_stretch = [ONE; EDGES];
+        self.warm = [A::REST; EDGES];
         self.probe_prev = [0; 3];
         self.reaction = [0; 3];
         self.coupling_force = [0; 3];
@@ -520,13 +618,18 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         let coeffs = self.c;
         if let Some(free) = self.nodes.get_mut(1..count) {
             for n in free {
-                Self::integrate(&coeffs, n);
+                if A::NARROW {
+                    Self::integrate_narrow(&coeffs.narrow, n);
+                } else {
+                    Self::integrate(&coeffs, n);
+                }
             }
         }
         if let Drive::Hold { disp, vel } = drive {
+            let v = vel.map(|x| self.stored_velocity(x.clamp(-VEL_LIMIT, VEL_LIMIT - 1)));
             if let Some(n) = self.nodes.get_mut(c) {
                 n.u = disp.map(|x| x.clamp(-DISP_LIMIT, DISP_LIMIT - 1));
-                n.v = vel.map(|x| x.clamp(-VEL_LIMIT, VEL_LIMIT - 1));
+                n.v = v;
             }
         }
     }
@@ -535,8 +638,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         self.nodes.get(i).map_or([0; 3], |n| n.u)
     }
 
+    /// Node `i`'s velocity in mm/s (Q16).
     fn node_vel(&self, i: usize) -> V3 {
-        self.nodes.get(i).map_or([0; 3], |n| n.v)
+        let v = self.nodes.get(i).map_or([0; 3], |n| n.v);
+        if A::NARROW {
+            v.map(|x| self.c.narrow.velocity(x))
+        } else {
+            v
+        }
     }
 
     /// Accumulates every spring's force (law + damping) on its two nodes. A spring to a
@@ -545,25 +654,25 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
     /// zero, its accumulator is never read).
     #[inline(always)]
     fn spring_forces(&mut self) {
+        if A::NARROW && self.c.spring_damping.ratio == 1 << 15 {
+            self.spring_loop::<true>();
+        } else {
+            self.spring_loop::<false>();
+        }
+    }
+
+    /// [`Self::spring_forces`], with `UNIT` as in [`Arith::force`].
+    #[inline(always)]
+    fn spring_loop<const UNIT: bool>(&mut self) {
         let damping = self.c.spring_damping;
         let nodes = self.nodes.as_mut_ptr();
-        for (e, r) in self.topo.edges().iter().zip(self.inv_stretch.iter_mut()) {
+        for (e, r) in self.topo.edges().iter().zip(self.warm.iter_mut()) {
             // SAFETY: `Topology::add_edge` only stores node indices below its node count,
             // which is at most NODES, and `a` is never the ground, so `a ≠ b`; the edges
             // cannot change afterwards. The shared reads end before the writes.
             let na = unsafe { &*nodes.add(e.a as usize) };
             let mut force = |ub: V3, vb: &V3| {
-                spring_force(
-                    &self.table,
-                    e.dir,
-                    e.inv_len,
-                    na.u,
-                    ub,
-                    &na.v,
-                    vb,
-                    r,
-                    damping,
-                )
+                A::force::<S, UNIT>(&self.table, e, na.u, ub, &na.v, vb, r, &damping)
             };
             let f_on_a = if e.b == GROUND {
                 force([0; 3], &[0; 3])
@@ -602,6 +711,32 @@ impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES
         }
         n.f = [0; 3];
     }
+
+    /// [`Self::integrate`] with 16-bit coefficients on the stored velocity `V = C_v v`
+    /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. The force is held
+    /// at `f_hold` so that the velocity step fits (16384 mm/s in one substep: never
+    /// reached by a stable patch).
+    #[inline(always)]
+    fn integrate_narrow(c: &NarrowStep, n: &mut Node) {
+        for j in 0..3 {
+            let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
+            // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
+            // so the sum fits before the clamp (max/min: no panic path).
+            let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
+            let f = f.max(-c.f_hold).min(c.f_hold);
+            let step = q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2;
+            let v_new = v
+                .wrapping_sub(drag)
+                .wrapping_add(step)
+                .max(-c.v_limit)
+                .min(c.v_limit);
+            // u' = u + (V + V') h/(2 C_v): Q20 N · Q(4 + shifts) = Q24 mm, |du| < 2³⁰.
+            let du = q::mul_s_by(v.wrapping_add(v_new), c.hh, c.hh_sh1) >> c.hh_sh2;
+            n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
+            n.v[j] = v_new;
+        }
+        n.f = [0; 3];
+    }
 }
 
 /// One node's state: displacement from rest (Q24 mm), velocity (Q16 mm/s) and the force
@@ -620,91 +755,4 @@ impl Node {
         v: [0; 3],
         f: [0; 3],
     };
-}
-
-/// The force on end `a` of one spring (Q20 N): the law along the edge plus the relative
-/// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
-/// `dir` is the unit rest vector (Q29), `inv_len` is `1/l0` (Q31), `r` the spring's
-/// warm-started `l0/l` (Q24), advanced by one guarded Newton step, and `damping` the
-/// spring damping (Q36 N·s/mm).
-///
-/// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
-/// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
-/// [`MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 30
-/// N·s/m (the configuration checks). Limits that follow, documented behaviour:
-/// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±2 per axis: a spring
-///   stretched further pulls as if stretched to 2 `l0` along that axis;
-/// - `l0/l` stays below 16: a spring crushed below `l0/16` keeps it at 16, so its
-///   direction vector shortens with the spring and the force fades to zero at zero length
-///   instead of flipping;
-/// - the law force is limited to ±64 N, and `|f| l0/l` to 256 N (a spring at 64 N
-///   compressed past `l0/4` pushes as if at `l0/4`);
-/// - one spring's force (law and damping) is limited to ±64 N, so that a node's sum
-///   cannot overflow.
-///
-/// Every product is one long multiply (the M0 builds it from 16-bit pieces with the same
-/// bits, [`crate::q`]); the formats are chosen so that most need no shift after it.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub fn spring_force<const S: usize>(
-    table: &ForceTable<S>,
-    dir: V3,
-    inv_len: i32,
-    ua: V3,
-    ub: V3,
-    va: &V3,
-    vb: &V3,
-    r: &mut i32,
-    damping: i32,
-) -> V3 {
-    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q29: the high word of Q24 · Q31 is
-    // Q23, times 64; |u_b − u_a| < 2³¹ (the displacement clamp).
-    const Q_FRAC: u32 = LEN_FRAC + INV_LEN_FRAC - 32;
-    let w: V3 = core::array::from_fn(|k| {
-        let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len);
-        dir[k]
-            .wrapping_add(q.wrapping_mul(1 << (W_FRAC - Q_FRAC)))
-            .clamp(-W_LIMIT, W_LIMIT - 1)
-    });
-    // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high
-    // words is within 2 LSB (3e-8) of the high word of the sum, and costs the M0 no low
-    // words. (`opaque`: a plain 32-bit value from here, so that the products below stay
-    // single long multiplies.)
-    let a = q::mulhi(w[0], w[0]) + q::mulhi(w[1], w[1]) + q::mulhi(w[2], w[2]);
-    let a = q::opaque(a);
-    let r0 = q::opaque(*r);
-    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23
-    // (Q26 · Q24 >> 27); held at 8 (|w| ≤ 8/r when converged), which already drives the
-    // factor to its floor.
-    let ar = q::opaque(((q::mul_wide(a, r0) >> 27) as i32).clamp(0, (8 << 23) - 1));
-    // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰, held
-    // below 1 (one `usat`), so that the factor 3/2 − a r²/2 stays in (1/2, 3/2]: a step
-    // from far above at most halves `r`.
-    let half_x = ((q::mul_wide(ar, r0) >> LEN_FRAC) as i32).clamp(0, ONE - 1);
-    let factor = q::opaque(3 * ONE / 2 - half_x);
-    // r' ≤ 3/2 r, held below 16. No floor is needed: |w| ≤ 2√3 keeps 1/|w| ≥ 0.29, and a
-    // step from above lands at ≥ r/2 > 1/(2|w|) ≥ 1/7.
-    let rn = q::opaque(((q::mul_wide(r0, factor) >> LEN_FRAC) as i32).clamp(0, R_MAX));
-    *r = rn;
-    // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
-    let stretch = (q::mul_wide(ar, factor) >> 23) as i32;
-    let strain = Strain::from_bits(ONE - stretch);
-    let f = table.force_within::<SPRING_FORCE_BITS>(strain);
-    // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
-    // −f r: Q20 · Q24 = Q44; Q23 is `>> 21`, held within ±256 N through the high word
-    // (the low bits of a held value are the product's own, below 2⁻¹² N).
-    let neg_fr = q::shr_held::<{ FORCE_FRAC + LEN_FRAC - FR_FRAC }, 31>(q::mul_wide(-f, rn));
-    // The velocities are read only now (no instruction: it keeps the compiler from
-    // loading them early and spilling them around the table lookup).
-    core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
-    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52, whose high words are
-    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| < 2²⁹: the sum fits). The two high words are
-    // rounded to nearest, so that their sum has no bias against the high word of the sum
-    // (floors would pull every spring by −1 LSB): one `smmulr` and one `smmlar` on the
-    // M3/M4, no 64-bit sum on the M0.
-    core::array::from_fn(|k| {
-        let dv = vb[k].wrapping_sub(va[k]);
-        let p = q::mulhi_round(dv, damping) + q::mulhi_round(w[k], neg_fr);
-        p.clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
-    })
 }

@@ -44,6 +44,15 @@ pub enum Backend {
     Fixed,
 }
 
+/// The fixed-point solver's spring arithmetic (`mccs::spring`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArithArg {
+    /// 32 × 32 → 64 products: the M3/M4F firmware.
+    Wide,
+    /// One 16-bit operand per product: the M0 firmware.
+    Narrow,
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Print F(ε) and dF/dε as CSV `strain,force_n,stiffness_n` for ε = FROM, FROM+STEP, … ≤ TO.
@@ -133,6 +142,9 @@ enum Command {
         /// Solver: the f64 twin or the no_std fixed-point core.
         #[arg(long, value_enum)]
         backend: Backend,
+        /// Spring arithmetic of the fixed-point core (`--backend fixed` only).
+        #[arg(long, value_enum, default_value_t = ArithArg::Wide)]
+        arith: ArithArg,
         /// Tick rate, Hz.
         #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
         rate: f64,
@@ -259,11 +271,16 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             spacing,
             indent,
             backend,
+            arith,
             rate,
             duration,
         } => {
             let p = paramfile::read(&params)?;
-            let run = PatchRun::new(grid, spacing, indent, backend, rate, duration)?;
+            if arith != ArithArg::Wide && backend != Backend::Fixed {
+                return Err(arg_error("--arith", "only with --backend fixed"));
+            }
+            let mut run = PatchRun::new(grid, spacing, indent, backend, rate, duration)?;
+            run.arith = arith;
             let rows = run.reactions(&p, &params)?;
             let mut w = csv::Writer::from_writer(out);
             let err = |e: csv::Error| CliError(format!("stdout: {e}"));
@@ -472,6 +489,8 @@ pub struct PatchRun {
     spacing: f64,
     depth: f64,
     backend: Backend,
+    /// The fixed backend's spring arithmetic.
+    pub arith: ArithArg,
     rate: f64,
     ticks: usize,
 }
@@ -530,6 +549,7 @@ impl PatchRun {
             spacing,
             depth,
             backend,
+            arith: ArithArg::Wide,
             rate,
             ticks,
         })
@@ -539,6 +559,24 @@ impl PatchRun {
     fn depth_at(&self, i: usize) -> f64 {
         let ramp = (self.ticks / 2).max(1);
         self.depth * ((i + 1) as f64 / ramp as f64).min(1.0)
+    }
+
+    /// `(time_s, reaction_n)` per tick of the fixed-point core in arithmetic `A`.
+    fn fixed_reactions<A: mccs::spring::Arith>(
+        &self,
+        topo: mccs::Topology<FIXED_NODES, FIXED_EDGES>,
+        table: mccs::ForceTable64,
+        cfg: &mccs::SolverConfig,
+        arith: A,
+    ) -> Result<Vec<(f64, f64)>, mccs::SolverError> {
+        let mut s = mccs::Solver::with_arith(topo, table, cfg, arith)?;
+        Ok((0..self.ticks)
+            .map(|i| {
+                let z = mccs::Length::from_num(-self.depth_at(i));
+                let r = s.step_held([mccs::Length::ZERO, mccs::Length::ZERO, z]);
+                ((i + 1) as f64 / self.rate, r[2].to_num::<f64>())
+            })
+            .collect())
     }
 
     /// `(time_s, reaction_n)` per tick.
@@ -570,14 +608,13 @@ impl PatchRun {
                     self.spacing,
                 )
                 .map_err(|e| arg_error("--grid", &e.to_string()))?;
-                let mut s = mccs::Solver::new(topo, table, &cfg).map_err(too_stiff)?;
-                Ok((0..self.ticks)
-                    .map(|i| {
-                        let z = mccs::Length::from_num(-self.depth_at(i));
-                        let r = s.step_held([mccs::Length::ZERO, mccs::Length::ZERO, z]);
-                        (time(i), r[2].to_num::<f64>())
-                    })
-                    .collect())
+                match self.arith {
+                    ArithArg::Wide => self.fixed_reactions(topo, table, &cfg, mccs::spring::Wide),
+                    ArithArg::Narrow => {
+                        self.fixed_reactions(topo, table, &cfg, mccs::spring::Narrow)
+                    }
+                }
+                .map_err(too_stiff)
             }
             Backend::Reference => {
                 let law = Reference::new(p).map_err(|e| file_error(file, e))?;

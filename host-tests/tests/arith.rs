@@ -4,8 +4,8 @@
 //! also hold for the M0 firmware.
 
 use mccs::q::{
-    mul_t, mul_t_split, mul_wide, mul_wide_split, mulhi, mulhi_round, mulhi_round_split,
-    mulhi_split, mulhi_u, mulhi_u_split,
+    mul_s, mul_s_by, mul_s_by_split, mul_s_split, mul_t, mul_t_split, mul_wide, mul_wide_split,
+    mulhi, mulhi_round, mulhi_round_split, mulhi_split, mulhi_u, mulhi_u_split,
 };
 use proptest::prelude::*;
 
@@ -88,8 +88,49 @@ fn shr_held_is_exact_inside_and_held_outside() {
     }
 }
 
+/// The narrow products (`mul_s`: one operand within ±2¹⁵) wherever their documented
+/// conditions hold: the result and `⌊a/2¹⁶⌋ · b · 2^(16 − SH)` within `i32`.
+fn check_narrow(a: i32, b: i32) {
+    let b = b.clamp(-(1 << 15), 1 << 15);
+    for sh in 0..=16u32 {
+        let exact = (a as i64 * b as i64) >> sh;
+        let piece = ((a >> 16) as i64 * b as i64) << (16 - sh);
+        if i32::try_from(exact).is_err() || i32::try_from(piece).is_err() {
+            continue;
+        }
+        assert_eq!(mul_s_by_split(a, b, sh) as i64, exact, "{a} {b} {sh}");
+        assert_eq!(mul_s_by(a, b, sh) as i64, exact, "{a} {b} {sh}");
+        let fixed = match sh {
+            9 => (mul_s::<9>(a, b), mul_s_split::<9>(a, b)),
+            11 => (mul_s::<11>(a, b), mul_s_split::<11>(a, b)),
+            12 => (mul_s::<12>(a, b), mul_s_split::<12>(a, b)),
+            14 => (mul_s::<14>(a, b), mul_s_split::<14>(a, b)),
+            15 => (mul_s::<15>(a, b), mul_s_split::<15>(a, b)),
+            16 => (mul_s::<16>(a, b), mul_s_split::<16>(a, b)),
+            _ => continue,
+        };
+        assert_eq!(fixed.0 as i64, exact, "{a} {b} {sh}");
+        assert_eq!(fixed.1 as i64, exact, "{a} {b} {sh}");
+    }
+}
+
+#[test]
+fn narrow_products_match_at_the_edges() {
+    for a in EDGES {
+        for b in [-(1 << 15), -32767, -1, 0, 1, 255, 32767, 1 << 15] {
+            check_narrow(a, b);
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(20_000))]
+
+    #[test]
+    fn narrow_products_match(a in any::<i32>(), b in -(1i32 << 15)..=(1 << 15), small in -(1i32 << 24)..(1 << 24)) {
+        check_narrow(a, b);
+        check_narrow(small, b);
+    }
 
     #[test]
     fn split_products_match(a in any::<i32>(), b in any::<i32>(), t in 0u32..0x8000) {

@@ -1,25 +1,26 @@
 //! The fixed-point patch solver against its f64 twin, and the twin against a static
 //! equilibrium solve: steady state, dynamics, energy, robustness.
 
+use mccs::spring::{Arith, Narrow, Wide};
 use mccs::{demo_path, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
 use mccs_host::patch::{substeps, Mesh, Twin, TwinConfig, V};
 use mccs_host::reference::Reference;
 use nalgebra::{DMatrix, DVector};
 
-type Fixed<const N: usize, const E: usize> = Solver<N, E, 64>;
+type Fixed<const N: usize, const E: usize, A = Wide> = Solver<N, E, 64, A>;
 
 fn twin_config(cfg: &SolverConfig, substeps: u32) -> TwinConfig {
     TwinConfig::from_solver(cfg, substeps)
 }
 
-fn fixed<const N: usize, const E: usize>(
+fn fixed<const N: usize, const E: usize, A: Arith>(
     n: usize,
     spacing: f64,
     cfg: &SolverConfig,
-) -> Fixed<N, E> {
+) -> Fixed<N, E, A> {
     let topo = Topology::<N, E>::standard_patch(n, spacing).unwrap();
     let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    Solver::new(topo, table, cfg).unwrap()
+    Solver::with_arith(topo, table, cfg, A::default()).unwrap()
 }
 
 fn twin(n: usize, spacing: f64, cfg: &SolverConfig, substeps: u32) -> Twin {
@@ -81,14 +82,14 @@ fn static_reaction(tw: &Twin, d: f64) -> f64 {
 }
 
 /// Ramp to depth `d` over `ramp` ticks, hold for `hold` ticks; (fixed, twin) reactions.
-fn indent<const N: usize, const E: usize>(
+fn indent<const N: usize, const E: usize, A: Arith>(
     n: usize,
     spacing: f64,
     d: f64,
     ticks: (usize, usize),
 ) -> (f64, f64, Twin) {
     let cfg = SolverConfig::default();
-    let mut f = fixed::<N, E>(n, spacing, &cfg);
+    let mut f = fixed::<N, E, A>(n, spacing, &cfg);
     let mut t = twin(n, spacing, &cfg, f.substeps());
     let (mut rf, mut rt) = (0.0, 0.0);
     for tick in 0..ticks.0 + ticks.1 {
@@ -153,25 +154,44 @@ fn springs_to_fixed_points_have_the_ground_as_b() {
     assert_eq!(e.dir, [0, 0, -(1 << mccs::topology::DIR_FRAC)]);
 }
 
+/// The three indentations of the issue, each arithmetic: the twin against the static
+/// solve (1e-6), the fixed point against the twin (0.5 %; the measured figures are in
+/// the README).
 #[test]
 fn steady_state_matches_static_equilibrium_and_twin() {
+    steady_state::<Wide>("wide");
+    steady_state::<Narrow>("narrow");
+}
+
+fn steady_state<A: Arith>(name: &str) {
     for (n, s, d) in [(5, 2.5, 0.3), (5, 2.5, 0.8), (7, 2.0, 1.0)] {
         let (rf, rt, tw) = if n == 5 {
-            indent::<10, 61>(n, s, d, (500, 1500))
+            indent::<10, 61, A>(n, s, d, (500, 1500))
         } else {
-            indent::<26, 153>(n, s, d, (500, 1500))
+            indent::<26, 153, A>(n, s, d, (500, 1500))
         };
         let rs = static_reaction(&tw, d);
-        println!("N={n} s={s} depth={d}: static {rs:.9} twin {rt:.9} fixed {rf:.9}");
+        println!(
+            "{name}: N={n} s={s} depth={d}: static {rs:.9} twin {rt:.9} fixed {rf:.9} ({:.2e} relative)",
+            (rf - rt) / rt
+        );
         assert!((rt - rs).abs() <= 1e-6 * rs, "twin {rt} vs static {rs}");
-        assert!((rf - rt).abs() <= 5e-3 * rt, "fixed {rf} vs twin {rt}");
+        assert!(
+            (rf - rt).abs() <= 5e-3 * rt,
+            "{name}: fixed {rf} vs twin {rt}"
+        );
     }
 }
 
 #[test]
 fn dynamics_track_the_twin() {
+    dynamics::<Wide>("wide");
+    dynamics::<Narrow>("narrow");
+}
+
+fn dynamics<A: Arith>(name: &str) {
     let cfg = SolverConfig::default();
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     let mut t = twin(5, 2.5, &cfg, f.substeps());
     let path = demo_path(1000).unwrap();
     let (mut peak, mut sum_sq, mut max_err, mut count) = (0.0f64, 0.0, 0.0f64, 0.0);
@@ -189,7 +209,7 @@ fn dynamics_track_the_twin() {
     }
     let rms = (sum_sq / count).sqrt();
     println!(
-        "demo path, N=5: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
+        "{name}: demo path, N=5: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
         rms / peak,
         max_err / peak
     );
@@ -231,7 +251,7 @@ fn perturbation(i: usize) -> [f64; 3] {
 #[test]
 fn energy_never_increases_with_damping() {
     let cfg = SolverConfig::default();
-    let f = fixed::<10, 61>(5, 2.5, &cfg);
+    let f = fixed::<10, 61, Wide>(5, 2.5, &cfg);
     let mut tw = twin(5, 2.5, &cfg, f.substeps());
     for i in 0..tw.x.len() {
         if !tw.mesh.fixed[i] {
@@ -258,10 +278,15 @@ fn energy_never_increases_with_damping() {
 
 #[test]
 fn fixed_energy_never_increases_with_damping() {
+    fixed_energy::<Wide>();
+    fixed_energy::<Narrow>();
+}
+
+fn fixed_energy<A: Arith>() {
     // The same perturbed start on the fixed-point solver, its energy measured with the
     // twin's f64 law from the fixed-point state.
     let cfg = SolverConfig::default();
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     let mut tw = twin(5, 2.5, &cfg, f.substeps());
     let topo = f.topology().clone();
     // Map core free nodes to twin nodes by rest position.
@@ -281,7 +306,7 @@ fn fixed_energy_never_increases_with_damping() {
         let p = perturbation(j).map(Length::from_num);
         f.set_state(i, p, [mccs::Velocity::ZERO; 3]);
     }
-    let energy = |f: &Fixed<10, 61>, tw: &mut Twin| -> f64 {
+    let energy = |f: &Fixed<10, 61, A>, tw: &mut Twin| -> f64 {
         for &(i, j) in &map {
             let d = f.displacement(i).unwrap();
             let v = f.velocity(i).unwrap();
@@ -327,7 +352,7 @@ fn core_and_twin_agree_on_substeps() {
 fn bad_configurations_are_typed_errors() {
     let table = ForceTable64::new(&Params::TABLE2).unwrap();
     let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
-    let mk = |cfg: SolverConfig| Solver::new(topo.clone(), table, &cfg).map(|_| ());
+    let mk = |cfg: SolverConfig| Fixed::<10, 61>::new(topo.clone(), table, &cfg).map(|_| ());
     let base = SolverConfig::default();
     let undamped = SolverConfig {
         spring_damping: 0.0,
@@ -399,10 +424,15 @@ fn bounded(f: [mccs::Force; 3], limit: f64) -> bool {
 
 #[test]
 fn robustness_never_panics_and_stays_bounded() {
+    robustness::<Wide>();
+    robustness::<Narrow>();
+}
+
+fn robustness<A: Arith>() {
     let cfg = SolverConfig::default();
     let max = cfg.coupling.max_force;
     // Probe far outside the patch, pressing.
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     for _ in 0..500 {
         let out = f.step([
             Length::from_num(90),
@@ -412,14 +442,14 @@ fn robustness_never_panics_and_stays_bounded() {
         assert!(bounded(out, max));
     }
     // Probe jumping 10 cm every tick.
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     for tick in 0..500 {
         let z = if tick % 2 == 0 { -50.0 } else { 50.0 };
         let out = f.step([Length::from_num(z / 2.0), Length::ZERO, Length::from_num(z)]);
         assert!(bounded(out, max));
     }
     // Extreme velocities on every node.
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     for i in 1..10u16 {
         let v = mccs::Velocity::from_num(if i % 2 == 0 { 30_000 } else { -30_000 });
         f.set_state(i, [Length::ZERO; 3], [v, -v, v]);
@@ -429,7 +459,7 @@ fn robustness_never_panics_and_stays_bounded() {
         assert!(bounded(out, max));
     }
     // A spring crushed to zero length (the contact node on its base node), and beyond.
-    let mut f = fixed::<10, 61>(5, 2.5, &cfg);
+    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     for depth in [2.5, 5.0, 2.5] {
         for _ in 0..200 {
             let r = f.step_held(down(depth));
@@ -445,5 +475,5 @@ fn robustness_never_panics_and_stays_bounded() {
         node_mass: 1e-7,
         ..cfg
     };
-    assert!(Solver::new(topo, table, &tiny).is_err());
+    assert!(Solver::with_arith(topo, table, &tiny, A::default()).is_err());
 }

@@ -23,7 +23,8 @@ mod firmware {
     use cortex_m_rt::entry;
     use fw_common::exit;
     use mccs::float_patch::{FloatPatch, Real};
-    use mccs::{entry as e, ForceTable64, Length, Solver, SolverConfig, Strain, Topology};
+    use mccs::spring::{Arith, Damping, DefaultArith};
+    use mccs::{entry as e, Edge, ForceTable64, Length, Solver, SolverConfig, Strain, Topology};
 
     #[cfg(core = "m4f")]
     const CORE: &str = "m4f";
@@ -102,24 +103,34 @@ mod firmware {
             black_box(e::force_and_stiffness(black_box(&table), eps));
         }) - (harness - empty);
         figs.report("force_and_stiffness", fs - empty);
-        // A 4 mm spring along −z compressed by 2 mm (strain 0.5: the table's cubic part,
-        // the longest path), its ends moving, 1 N·s/m of damping.
-        let mut r = 1 << 24;
+        // One spring (`spring_case`) through `e::spring`, less the same call to
+        // `no_spring` (the call, the arguments and the harness's black boxes).
+        let mut r = DefaultArith::REST;
+        let case = spring_case();
         let harness = measure(cpk, 256, || {
-            black_box((black_box(&table), spring_inputs(), &mut r));
+            let c = black_box(&case);
+            black_box(no_spring(
+                black_box(&table),
+                &c.edge,
+                &c.ua,
+                &c.ub,
+                &c.va,
+                &c.vb,
+                &mut r,
+                &c.damping,
+            ));
         });
         let spring = measure(cpk, 256, || {
-            let (dir, inv_len, ua, ub, va, vb, damping) = spring_inputs();
+            let c = black_box(&case);
             black_box(e::spring(
                 black_box(&table),
-                dir,
-                inv_len,
-                ua,
-                ub,
-                va,
-                vb,
+                &c.edge,
+                &c.ua,
+                &c.ub,
+                &c.va,
+                &c.vb,
                 &mut r,
-                damping,
+                &c.damping,
             ));
         }) - (harness - empty);
         figs.report("spring", spring - empty);
@@ -187,20 +198,68 @@ mod firmware {
     #[cfg(core = "m0")]
     const CLOCK: (u32, u32) = (48, 150);
 
-    /// The spring case's inputs (raw formats of `mccs::solver::spring_force`), each
-    /// through `black_box`.
-    #[inline(always)]
-    #[allow(clippy::type_complexity)]
-    fn spring_inputs() -> ([i32; 3], i32, [i32; 3], [i32; 3], [i32; 3], [i32; 3], i32) {
-        (
-            black_box([0, 0, -(1 << 29)]),
-            black_box(1 << 29),
-            black_box([0; 3]),
-            black_box([1 << 20, -(1 << 20), 2 << 24]),
-            black_box([10, -20, 30]),
-            black_box([0; 3]),
-            black_box(68_719_477),
-        )
+    /// The spring case's inputs (raw formats of `mccs::spring`).
+    struct SpringCase {
+        edge: Edge,
+        ua: [i32; 3],
+        ub: [i32; 3],
+        va: [i32; 3],
+        vb: [i32; 3],
+        damping: Damping,
+    }
+
+    /// A 4 mm spring along −z compressed by 2 mm (strain 0.5: the table's cubic part, the
+    /// longest path), its ends moving, 1 N·s/m of damping.
+    fn spring_case() -> SpringCase {
+        SpringCase {
+            edge: Edge {
+                a: 1,
+                b: 2,
+                dir: [0, 0, -(1 << 29)],
+                inv_len: 1 << 29,
+            },
+            ua: [0; 3],
+            ub: [1 << 20, -(1 << 20), 2 << 24],
+            va: [10, -20, 30],
+            vb: [0; 3],
+            damping: Damping::new(1.0),
+        }
+    }
+
+    /// [`e::spring`]'s signature, and nothing but taking its arguments into registers
+    /// (empty `asm!`) and returning zeros: the spring case's harness.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn no_spring(
+        table: &ForceTable64,
+        edge: &Edge,
+        ua: &[i32; 3],
+        ub: &[i32; 3],
+        va: &[i32; 3],
+        vb: &[i32; 3],
+        warm: &mut i32,
+        damping: &Damping,
+    ) -> [i32; 3] {
+        // SAFETY: the templates are comments; nothing is read or written.
+        unsafe {
+            core::arch::asm!(
+                "/* {0} {1} {2} {3} */",
+                in(reg) table,
+                in(reg) edge,
+                in(reg) ua,
+                in(reg) ub,
+                options(nomem, nostack, preserves_flags)
+            );
+            core::arch::asm!(
+                "/* {0} {1} {2} {3} */",
+                in(reg) va,
+                in(reg) vb,
+                in(reg) warm,
+                in(reg) damping,
+                options(nomem, nostack, preserves_flags)
+            );
+        }
+        [0; 3]
     }
 
     /// The figures measured in this run, by case name (20 at most; a full list only
