@@ -231,7 +231,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     let srho = q::mul_s::<15>(rn, q::narrow::<9>(s));
     let lm1 = s.wrapping_add(rn >> 4).wrapping_add(srho);
     let strain = Strain::from_bits(lm1.wrapping_neg().wrapping_mul(16));
-    let f = table.force_within::<SPRING_FORCE_BITS>(strain);
+    let f = table.force_narrow(strain);
     // −f r' (Q20 · Q12 / 2¹² = Q20, |f r'| < 448 N).
     let neg_fr = q::mul_s::<12>(f, q::narrow::<12>(rn.wrapping_add(ONE))).wrapping_neg();
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);

@@ -46,7 +46,7 @@
 
 use crate::law::Law;
 use crate::params::{ParamError, Params};
-use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
+use crate::q::{mul_s_by, mul_t, mul_wide, mulhi, mulhi_u, shr_held};
 use crate::{Force, Stiffness, Strain};
 use core::fmt;
 
@@ -100,6 +100,68 @@ pub struct RawTable<const S: usize> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ForceTable<const S: usize> {
     raw: RawTable<S>,
+    narrow: Narrow,
+}
+
+/// What [`ForceTable::force_narrow`] needs beyond the raw table, derived from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Narrow {
+    /// `index_scale` without its zero low bits (15 significant bits), and the shift that
+    /// takes `⌊de · scale / 2¹⁶⌋` to the Q15 segment coordinate.
+    scale: u32,
+    scale_sh: u32,
+    lo: NarrowLine,
+    hi: NarrowLine,
+}
+
+/// A straight line's slope in 15 bits: `⌊Δe · k / 2^sh1⌋ >> sh2` is Q20 N for a Q24 `Δe`,
+/// with `|Δe|` held at `hold` so that the product stays within 2³⁰ (1024 N).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct NarrowLine {
+    k: i32,
+    sh1: u32,
+    sh2: u32,
+    hold: i32,
+}
+
+impl NarrowLine {
+    /// From a Q16 slope.
+    const fn new(k: i32) -> Self {
+        let mag = k.unsigned_abs();
+        let kn = (32 - mag.leading_zeros()).saturating_sub(15);
+        // Q24 · Q(16 − kn) / 2^(20 − kn) = Q20.
+        let sh = 20 - kn;
+        let (sh1, sh2) = if sh > 16 { (16, sh - 16) } else { (sh, 0) };
+        // Rounded: within 2⁻¹⁵ of k, and at most 2¹⁵ in magnitude.
+        let k16 = if kn == 0 {
+            k
+        } else {
+            ((k as i64 + (1i64 << (kn - 1))) >> kn) as i32
+        };
+        let hold = if k16 == 0 {
+            i32::MAX
+        } else {
+            let h = (1i64 << (30 + sh)) / k16.unsigned_abs() as i64;
+            if h > i32::MAX as i64 {
+                i32::MAX
+            } else {
+                h as i32
+            }
+        };
+        Self {
+            k: k16,
+            sh1,
+            sh2,
+            hold,
+        }
+    }
+
+    /// `f0 + k (e − e0)` in Q20 N for `|e − e0|` held within `hold`.
+    #[inline(always)]
+    fn at(&self, f0: i32, e: i32, e0: i32) -> i32 {
+        let de = e.wrapping_sub(e0).max(-self.hold).min(self.hold);
+        f0.saturating_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
+    }
 }
 
 /// 16 segments, 17 knots, 256 bytes of coefficients.
@@ -234,7 +296,9 @@ impl<const S: usize> ForceTable<S> {
         if !(scale >= 1.0 && scale < (1u64 << 32) as f64) {
             return Err(TableError::TooNarrow);
         }
-        let index_scale = scale as u32;
+        // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index
+        // ([`ForceTable::force_narrow`]: two 32-bit multiplies) is the same number.
+        let index_scale = narrow_scale(scale as u32);
         // The evaluation places knot i at lo + i · step: build at exactly those strains.
         let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
         // Strains below strain_lo + d (in Q24 LSBs) have coordinates below S·2¹⁵.
@@ -407,12 +471,19 @@ impl<const S: usize> ForceTable<S> {
             stiff_post,
             segments,
         };
-        Ok(Self { raw })
+        Ok(Self::from_raw(raw))
     }
 
     /// Wraps raw contents (for tables emitted by `mccs table` and `include!`d).
     pub const fn from_raw(raw: RawTable<S>) -> Self {
-        Self { raw }
+        let k = (32 - raw.index_scale.leading_zeros()).saturating_sub(15);
+        let narrow = Narrow {
+            scale: raw.index_scale >> k,
+            scale_sh: 16 - k,
+            lo: NarrowLine::new(raw.stiffness_lo),
+            hi: NarrowLine::new(raw.stiffness_hi),
+        };
+        Self { raw, narrow }
     }
 
     /// The raw contents.
@@ -480,6 +551,39 @@ impl<const S: usize> ForceTable<S> {
         f.clamp(-(1 << BITS), (1 << BITS) - 1)
     }
 
+    /// [`ForceTable::force_within::<26>`] for the Cortex-M0's spring
+    /// ([`crate::spring::Narrow`]): the same segment, position and cubic (the index scale
+    /// has 15 significant bits, so its product is two 32-bit multiplies), and the straight
+    /// lines with their slopes to 15 bits (2⁻¹⁵ relative), held at ±1024 N. Raw Q24 strain
+    /// in, raw Q20 N out, within ±64 N.
+    #[inline(always)]
+    pub fn force_narrow(&self, strain: Strain) -> i32 {
+        let r = &self.raw;
+        let n = &self.narrow;
+        let e = strain.to_bits();
+        let f = if e <= r.strain_lo {
+            n.lo.at(r.force_lo, e, r.anchor_lo)
+        } else if e >= r.strain_hi {
+            n.hi.at(r.force_hi, e, r.strain_hi)
+        } else {
+            let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
+            // ⌊de · scale / 2¹⁶⌋ from 16-bit pieces (< 2³¹), then to Q15 segments.
+            let (d1, d0) = (de >> 16, de & 0xFFFF);
+            let p = d1
+                .wrapping_mul(n.scale)
+                .wrapping_add(d0.wrapping_mul(n.scale) >> 16);
+            let pos = p >> n.scale_sh;
+            let i = (pos >> 15) as usize;
+            let i = if S.is_power_of_two() {
+                i & (S - 1)
+            } else {
+                i.min(S - 1)
+            };
+            value(r, &r.segments[i], pos & 0x7FFF)
+        };
+        f.clamp(-(1 << 26), (1 << 26) - 1)
+    }
+
     /// Force (N) and tangent stiffness `dF/dε` (N per unit strain) at `strain`;
     /// constant time, saturating, no panic.
     #[inline]
@@ -520,6 +624,12 @@ impl<const S: usize> ForceTable<S> {
         };
         (&r.segments[i], pos & 0x7FFF)
     }
+}
+
+/// `x` with all but its 15 most significant bits cleared.
+const fn narrow_scale(x: u32) -> u32 {
+    let k = (32 - x.leading_zeros()).saturating_sub(15);
+    (x >> k) << k
 }
 
 /// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.

@@ -382,6 +382,50 @@ fn force_within_is_force_clamped() {
     }
 }
 
+/// The M0's `force_narrow`: on the cubic part the same bits as `force_within::<26>`; on
+/// the straight lines within 2⁻¹⁵ of the line's rise plus 1 LSB; over the whole strain
+/// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring.
+#[test]
+fn force_narrow_is_force_within_to_a_slope_lsb() {
+    let mut springs = vec![Params::TABLE2];
+    let mut stiff = Params::TABLE2;
+    stiff.cone.shear_modulus *= 30.0;
+    stiff.linear.shear_modulus *= 30.0;
+    springs.push(stiff);
+    let mut soft = Params::TABLE2;
+    soft.cone.shear_modulus /= 50.0;
+    soft.linear.shear_modulus /= 50.0;
+    springs.push(soft);
+    let mut worst = 0.0f64;
+    for p in springs {
+        let t = ForceTable::<64>::new(&p).unwrap();
+        let (lo, hi) = t.tabulated_range();
+        let (f_lo, f_hi) = (t.raw().force_lo as f64, t.raw().force_hi as f64);
+        let mut bits = -(8 << 24);
+        while bits < 8 << 24 {
+            let e = Strain::from_bits(bits);
+            let want = t.force_within::<26>(e);
+            let got = t.force_narrow(e);
+            if e > lo && e < hi {
+                assert_eq!(got, want, "{bits}");
+            } else {
+                let anchor = if e <= lo { f_lo } else { f_hi };
+                let rise = (want as f64 - anchor).abs();
+                let err = (got - want).abs() as f64;
+                assert!(
+                    err <= rise * 2f64.powi(-15) + 2.0,
+                    "{bits}: {got} vs {want}"
+                );
+                if rise >= 65536.0 {
+                    worst = worst.max(err / rise);
+                }
+            }
+            bits += 4099;
+        }
+    }
+    println!("force_narrow: lines within {worst:.2e} of their rise (rises ≥ 1/16 N)");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
