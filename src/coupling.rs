@@ -60,11 +60,15 @@ impl CouplingQ {
         }
         let mut out = [0; 3];
         for i in 0..3 {
-            let dx = probe[i] as i64 - node[i] as i64;
-            let dv = probe_vel[i] as i64 - node_vel[i] as i64;
-            // Q24 mm · Q16 N/mm → Q20 N; Q16 mm/s · Q24 N·s/mm → Q20 N.
-            let spring = (dx * self.stiffness as i64) >> 20;
-            let damper = (dv * self.damping as i64) >> 20;
+            // The stretch and the relative speed held within their formats (±128 mm,
+            // ±32768 mm/s): beyond, the force is at the device maximum anyway for any
+            // stiffness above 0.08 N/mm.
+            let dx = probe[i].saturating_sub(node[i]);
+            let dv = probe_vel[i].saturating_sub(node_vel[i]);
+            // Q24 mm · Q16 N/mm → Q20 N; Q16 mm/s · Q24 N·s/mm → Q20 N (long products: the
+            // M0 builds them from 16-bit pieces).
+            let spring = crate::q::mul_wide(dx, self.stiffness) >> 20;
+            let damper = crate::q::mul_wide(dv, self.damping) >> 20;
             let f = sat(spring + damper);
             // max/min, not clamp: clamp keeps a panic path for min > max.
             out[i] = f.max(-self.max_force).min(self.max_force);

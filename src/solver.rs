@@ -618,8 +618,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let coeffs = self.c;
         if let Some(free) = self.nodes.get_mut(1..count) {
             for n in free {
-                if A::NARROW {
-                    Self::integrate_narrow(&coeffs.narrow, n);
+                if A::NARROW && coeffs.spring_damping.ratio == 1 << 15 {
+                    Self::integrate_narrow::<true>(&coeffs.narrow, n);
+                } else if A::NARROW {
+                    Self::integrate_narrow::<false>(&coeffs.narrow, n);
                 } else {
                     Self::integrate(&coeffs, n);
                 }
@@ -714,16 +716,21 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 
     /// [`Self::integrate`] with 16-bit coefficients on the stored velocity `V = C_v v`
     /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. The force is held
-    /// at `f_hold` so that the velocity step fits (16384 mm/s in one substep: never
-    /// reached by a stable patch).
+    /// at `f_hold` so that the velocity step fits, except with `UNIT` (`C_v = C`): then
+    /// the stability bound (`h C_i / m ≤ ½`, `C_i ≥ C` at every node with a spring)
+    /// keeps `C_v h / m ≤ ½`, so the step is at most half the force and fits as it is.
     #[inline(always)]
-    fn integrate_narrow(c: &NarrowStep, n: &mut Node) {
+    fn integrate_narrow<const UNIT: bool>(c: &NarrowStep, n: &mut Node) {
         for j in 0..3 {
             let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
             // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
             // so the sum fits before the clamp (max/min: no panic path).
             let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
-            let f = f.max(-c.f_hold).min(c.f_hold);
+            let f = if UNIT {
+                f
+            } else {
+                f.max(-c.f_hold).min(c.f_hold)
+            };
             let step = q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2;
             let v_new = v
                 .wrapping_sub(drag)

@@ -215,20 +215,22 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     // e = s + a t (Q20 · Q11 / 2¹¹, a = 1 + s ≤ 12, so |e| < 600), held below 1 so that
     // the factor 1 − e/2 stays in (1/2, 3/2] (e ≥ −1 always: a r² ≥ 0).
     let r0 = q::opaque(*rho);
-    let t = q::mul_s::<16>(r0, q::narrow::<12>(r0.wrapping_add(2 * ONE)));
-    let a = q::narrow::<9>(s.wrapping_add(1 << FORCE_FRAC));
+    // r and 2 + ρ = 1 + r in Q12, s and a = 1 + s in Q11 (each rounded once).
+    let r12 = q::narrow::<12>(r0.wrapping_add(ONE));
+    let s11 = q::narrow::<9>(s);
+    let t = q::mul_s::<16>(r0, r12 + (1 << 12));
+    let a = s11 + (1 << 11);
     let e = s
         .wrapping_add(q::mul_s::<11>(t, a))
         .min((1 << FORCE_FRAC) - 1);
     // ρ' = ρ − r e / 2: Q20 · Q12 / 2⁹ = Q24 (|r e/2| < 4), held below 6 (r < 7).
-    let r12 = q::narrow::<12>(r0.wrapping_add(ONE));
     let rn = q::opaque(
         r0.wrapping_sub(q::mul_s::<9>(e, r12))
             .min(R_MAX_NARROW - ONE - 1),
     );
     *rho = rn;
     // ε = −(s + ρ' + s ρ') in Q20 (ρ' Q24 · s Q11 / 2¹⁵), then Q24 (|ε| < 7).
-    let srho = q::mul_s::<15>(rn, q::narrow::<9>(s));
+    let srho = q::mul_s::<15>(rn, s11);
     let lm1 = s.wrapping_add(rn >> 4).wrapping_add(srho);
     let strain = Strain::from_bits(lm1.wrapping_neg().wrapping_mul(16));
     let f = table.force_narrow(strain);
