@@ -33,7 +33,7 @@ pub fn spring(
     warm: &mut i32,
     damping: &Damping,
 ) -> [i32; 3] {
-    if damping.ratio == 1 << 15 {
+    if damping.unit {
         DefaultArith::force::<64, true>(table, edge, *ua, *ub, va, vb, warm, damping)
     } else {
         DefaultArith::force::<64, false>(table, edge, *ua, *ub, va, vb, warm, damping)

@@ -169,27 +169,28 @@ enum Drive {
 
 /// The integrator's coefficients as 16-bit operands with run-time shifts, for
 /// [`crate::spring::Narrow`] (each to 2⁻¹⁵ relative). Its nodes store the velocity as
-/// `V = C_v v` (N, Q20; `C_v` from [`Damping::velocity_scale`]), so that a spring's
+/// `V = C_v v` in N, Q(20 + g) (`C_v` and `g` from [`Damping`]), so that a spring's
 /// damping force is a difference of stored values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct NarrowStep {
     /// `h c_node / m` (≤ ½), Q(16 + `damp_sh`).
     damp: i32,
     damp_sh: u32,
-    /// `C_v h / m` (dimensionless), Q(`step_sh1` + `step_sh2`): `f · step` is Q20 N.
+    /// `C_v h / m` (dimensionless) as a 16-bit operand: `f · step` (f Q20 N) is a stored
+    /// velocity after the shifts.
     step: i32,
     step_sh1: u32,
     step_sh2: u32,
     /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
     f_hold: i32,
-    /// `h / (2 C_v)`, mm/N, Q(4 + `hh_sh1` + `hh_sh2`): `V · hh` is Q24 mm.
+    /// `h / (2 C_v)`, mm/N, as a 16-bit operand: `V · hh` is Q24 mm after the shifts.
     hh: i32,
     hh_sh1: u32,
     hh_sh2: u32,
-    /// `C_v` in N·s/mm, Q(20 + `cv_sh`): mm/s (Q16) to stored velocity (Q20 N).
+    /// `C_v` as a 16-bit operand: mm/s (Q16) to a stored velocity (`cv_sh` ≥ 8).
     cv: i32,
     cv_sh: u32,
-    /// `1 / C_v`, Q(`inv_cv_sh` − 4): stored velocity (Q20 N) to mm/s (Q16).
+    /// `1 / C_v` as a 16-bit operand: a stored velocity to mm/s (Q16).
     inv_cv: i32,
     inv_cv_sh: u32,
     /// The velocity limit (16384 mm/s) as a stored velocity.
@@ -204,20 +205,24 @@ fn split_shift(sh: u32) -> (u32, u32) {
 impl NarrowStep {
     fn new(h: f64, config: &SolverConfig) -> Self {
         let cv = Damping::velocity_scale(config.spring_damping);
+        // Stored velocities: Q(20 + g) N.
+        let vq = FORCE_FRAC + Damping::velocity_frac(config.spring_damping);
         let (damp, damp_sh) = q::norm16(h * config.node_damping / config.node_mass, 16, 30);
-        // C_v h/m ≤ 0.03 · 2000 (checked): 2¹⁵ / 60 leaves at least 9 bits of shift.
+        // C_v h/m ≤ 0.03 · 2000 (checked), as Q(x): f · step / 2^(x + 20 − vq).
         let (step, x) = q::norm16(cv * 1000.0 * h / config.node_mass, 0, 60);
-        let (step_sh1, step_sh2) = split_shift(x);
+        let (step_sh1, step_sh2) = split_shift((x + FORCE_FRAC).saturating_sub(vq));
         let f_hold = if step > 0 {
             ((1i64 << (30 + step_sh1)) / step as i64).min(i32::MAX as i64) as i32
         } else {
             i32::MAX
         };
-        // h/(2 C_v) ≤ 2⁻⁹ s / 10⁻⁴ N·s/mm < 20 mm/N: at least 10 bits of shift.
+        // h/(2 C_v) ≤ 2⁻⁹ s / 10⁻⁴ N·s/mm < 20 mm/N, as Q(y): V · hh / 2^(vq + y − 24).
         let (hh, y) = q::norm16(0.5 * h / cv, 0, 60);
-        let (hh_sh1, hh_sh2) = split_shift(y.saturating_sub(4));
-        let (cvq, cv_sh) = q::norm16(cv, FORCE_FRAC, 20);
-        // 1/C_v ≤ 10⁴ mm/(N·s): at least 1 bit of shift.
+        let (hh_sh1, hh_sh2) = split_shift((vq + y).saturating_sub(crate::topology::LEN_FRAC));
+        // mm/s Q16 · C_v Q(e) / 2^(16 + e − vq) = Q(vq).
+        let (cvq, e) = q::norm16(cv, 0, 60);
+        let cv_sh = (VEL_FRAC + e).saturating_sub(vq);
+        // Q(vq) · 1/C_v Q(z) / 2^(vq + z − 16) = Q16 (1/C_v ≤ 10⁴: z ≥ 1).
         let (inv_cv, z) = q::norm16(1.0 / cv, 0, 30);
         Self {
             damp,
@@ -232,19 +237,20 @@ impl NarrowStep {
             cv: cvq,
             cv_sh,
             inv_cv,
-            inv_cv_sh: z + 4,
-            v_limit: q::from_f64(16384.0 * cv, FORCE_FRAC),
+            inv_cv_sh: vq + z - VEL_FRAC,
+            v_limit: q::from_f64(16384.0 * cv, vq),
         }
     }
 
-    /// A velocity (Q16 mm/s, within ±2³⁰) as the node stores it (Q20 N).
+    /// A velocity (Q16 mm/s, within ±2³⁰) as the node stores it.
     fn store(&self, v: i32) -> i32 {
-        (q::mul_s::<16>(v, self.cv) >> self.cv_sh)
+        let (sh1, sh2) = split_shift(self.cv_sh);
+        (q::mul_s_by(v, self.cv, sh1) >> sh2)
             .max(-self.v_limit)
             .min(self.v_limit)
     }
 
-    /// A stored velocity (Q20 N) in mm/s (Q16).
+    /// A stored velocity in mm/s (Q16).
     fn velocity(&self, stored: i32) -> i32 {
         let (sh1, sh2) = split_shift(self.inv_cv_sh);
         q::mul_s_by(stored, self.inv_cv, sh1) >> sh2
@@ -618,10 +624,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let coeffs = self.c;
         if let Some(free) = self.nodes.get_mut(1..count) {
             for n in free {
-                if A::NARROW && coeffs.spring_damping.ratio == 1 << 15 {
-                    Self::integrate_narrow::<true>(&coeffs.narrow, n);
-                } else if A::NARROW {
-                    Self::integrate_narrow::<false>(&coeffs.narrow, n);
+                if A::NARROW {
+                    Self::integrate_narrow(&coeffs.narrow, n);
                 } else {
                     Self::integrate(&coeffs, n);
                 }
@@ -656,7 +660,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// zero, its accumulator is never read).
     #[inline(always)]
     fn spring_forces(&mut self) {
-        if A::NARROW && self.c.spring_damping.ratio == 1 << 15 {
+        if A::NARROW && self.c.spring_damping.unit {
             self.spring_loop::<true>();
         } else {
             self.spring_loop::<false>();
@@ -716,28 +720,23 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 
     /// [`Self::integrate`] with 16-bit coefficients on the stored velocity `V = C_v v`
     /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. The force is held
-    /// at `f_hold` so that the velocity step fits, except with `UNIT` (`C_v = C`): then
-    /// the stability bound (`h C_i / m ≤ ½`, `C_i ≥ C` at every node with a spring)
-    /// keeps `C_v h / m ≤ ½`, so the step is at most half the force and fits as it is.
+    /// at `f_hold` so that the velocity step fits (16384 mm/s in one substep: never
+    /// reached by a stable patch).
     #[inline(always)]
-    fn integrate_narrow<const UNIT: bool>(c: &NarrowStep, n: &mut Node) {
+    fn integrate_narrow(c: &NarrowStep, n: &mut Node) {
         for j in 0..3 {
             let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
             // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
             // so the sum fits before the clamp (max/min: no panic path).
             let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
-            let f = if UNIT {
-                f
-            } else {
-                f.max(-c.f_hold).min(c.f_hold)
-            };
+            let f = f.max(-c.f_hold).min(c.f_hold);
             let step = q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2;
             let v_new = v
                 .wrapping_sub(drag)
                 .wrapping_add(step)
                 .max(-c.v_limit)
                 .min(c.v_limit);
-            // u' = u + (V + V') h/(2 C_v): Q20 N · Q(4 + shifts) = Q24 mm, |du| < 2³⁰.
+            // u' = u + (V + V') h/(2 C_v): to Q24 mm by the shifts, |du| < 2³⁰.
             let du = q::mul_s_by(v.wrapping_add(v_new), c.hh, c.hh_sh1) >> c.hh_sh2;
             n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
             n.v[j] = v_new;

@@ -50,22 +50,44 @@ const W_LIMIT: i32 = 2 << W_FRAC;
 pub struct Damping {
     /// `C` in N·s/mm, Q36 ([`Wide`]).
     pub wide: i32,
-    /// `C / C_v` in Q15 ([`Narrow`], whose node velocities are stored as `C_v v`, in N:
-    /// see [`Damping::velocity_scale`]); 2¹⁵ (one) whenever `C ≥` [`NARROW_MIN_DAMPING`].
-    pub ratio: i32,
+    /// [`Narrow`] stores a node's velocity as `V = C_v v` in N, Q(20 + g)
+    /// ([`Damping::velocity_scale`], [`Damping::velocity_frac`]). With `unit`
+    /// (`C ≥` [`NARROW_MIN_DAMPING`], so `C_v = C`) the damping force is
+    /// `(V_b − V_a) >> sh`; else `⌊(V_b − V_a) · mul / 2¹⁶⌋ >> sh`, `mul` being `C / C_v`
+    /// to 15 bits (0 for no damping).
+    pub unit: bool,
+    /// See `unit`.
+    pub mul: i32,
+    /// See `mul`.
+    pub sh: u32,
 }
 
 /// The smallest spring damping, N·s/m, that [`Narrow`] applies without a product: its
 /// node velocities are stored as `C_v v` with `C_v = max(C, this)`.
 pub const NARROW_MIN_DAMPING: f64 = 0.1;
 
+/// The fastest velocity the solvers hold, mm/s.
+pub(crate) const VEL_LIMIT_MM_S: f64 = 16384.0;
+
 impl Damping {
     /// From `C` in N·s/m (0 … 30; start-up only).
     pub fn new(n_s_per_m: f64) -> Self {
-        let c = n_s_per_m / 1000.0;
+        let g = Self::velocity_frac(n_s_per_m);
+        let unit = n_s_per_m >= NARROW_MIN_DAMPING;
+        let (mul, sh) = if unit {
+            (0, g)
+        } else if n_s_per_m <= 0.0 {
+            (0, 0)
+        } else {
+            // C/C_v < 1 as a 16-bit operand: Q(16 + x) with x ≥ −1; then Q(20 + g + x).
+            let (m, x) = q::norm16(n_s_per_m / NARROW_MIN_DAMPING, 15, 30);
+            (m, g + x - 1)
+        };
         Self {
-            wide: q::from_f64(c, DAMP_FRAC),
-            ratio: q::from_f64(n_s_per_m / n_s_per_m.max(NARROW_MIN_DAMPING), 15),
+            wide: q::from_f64(n_s_per_m / 1000.0, DAMP_FRAC),
+            unit,
+            mul,
+            sh,
         }
     }
 
@@ -73,6 +95,18 @@ impl Damping {
     /// [`Narrow`]'s stored velocities (`C_v v`, N).
     pub fn velocity_scale(n_s_per_m: f64) -> f64 {
         n_s_per_m.max(NARROW_MIN_DAMPING) / 1000.0
+    }
+
+    /// The extra fraction bits `g` of [`Narrow`]'s stored velocities, Q(20 + g) N: the
+    /// most (up to 12) that keep the difference of two at the velocity limit within
+    /// 2³⁰.
+    pub fn velocity_frac(n_s_per_m: f64) -> u32 {
+        let v_max = VEL_LIMIT_MM_S * Self::velocity_scale(n_s_per_m) * (1u64 << FORCE_FRAC) as f64;
+        let mut g = 0;
+        while g < 12 && 2.0 * v_max * (2u64 << g) as f64 <= (1u64 << 30) as f64 {
+            g += 1;
+        }
+        g
     }
 }
 
@@ -85,7 +119,7 @@ pub trait Arith: Copy + core::fmt::Debug + Default + 'static {
     const NARROW: bool;
     /// The force on end `a` (Q20 N) from the ends' displacements (Q24 mm) and velocities
     /// (Q16 mm/s); advances the spring's warm-start value `warm`. `UNIT`: the caller has
-    /// checked that `damping.ratio` is one (see [`narrow`]).
+    /// checked that `damping.unit` holds (see [`narrow`]).
     #[allow(clippy::too_many_arguments)]
     fn force<const S: usize, const UNIT: bool>(
         table: &ForceTable<S>,
@@ -165,10 +199,10 @@ const R_MAX_NARROW: i32 = 7 << LEN_FRAC;
 
 /// [`wide`] with one 16-bit operand per product (the Cortex-M0's arithmetic). `rho` is
 /// the spring's warm-started `l0/l − 1` (Q24) and `damping` its [`Damping`]; the node
-/// velocities `va`, `vb` are stored as `C_v v` (N, Q20; `C_v` from
-/// [`Damping::velocity_scale`]), so that the damping force is their difference, with no
-/// product unless `C` is below [`NARROW_MIN_DAMPING`] (`UNIT`: the caller has checked
-/// that `damping.ratio` is one, and the loop is compiled without the product). The other arguments, the ranges
+/// velocities `va`, `vb` are stored as `C_v v` (N, Q(20 + g); see [`Damping`]), so that
+/// the damping force is their difference shifted, with no product unless `C` is below
+/// [`NARROW_MIN_DAMPING`] (`UNIT`: the caller has checked that `damping.unit` holds, and
+/// the loop is compiled without the product). The other arguments, the ranges
 /// and the limits are those of [`wide`], except that `l0/l` stays below 7 (a spring
 /// crushed below `l0/7` keeps it at 7).
 ///
@@ -237,13 +271,17 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     // −f r' (Q20 · Q12 / 2¹² = Q20, |f r'| < 448 N).
     let neg_fr = q::mul_s::<12>(f, q::narrow::<12>(rn.wrapping_add(ONE))).wrapping_neg();
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
-    let ratio = damping.ratio;
-    // w (−f r') + C (v_b − v_a): Q20 · Q14 / 2¹⁴, and C_v (v_b − v_a) in Q20 N (times
-    // C/C_v, Q15, when that is below one), each < 2³⁰.
+    let (mul, sh) = (damping.mul, damping.sh);
+    // w (−f r') + C (v_b − v_a): Q20 · Q14 / 2¹⁴, and C_v (v_b − v_a) from Q(20 + g) to
+    // Q20 N (times C/C_v when that is below one), each < 2³⁰.
     core::array::from_fn(|k| {
         let push = q::mul_s::<14>(neg_fr, q::narrow::<9>(w[k]));
         let dv = vb[k].wrapping_sub(va[k]);
-        let damp = if UNIT { dv } else { q::mul_s::<15>(dv, ratio) };
+        let damp = if UNIT {
+            dv >> sh
+        } else {
+            q::mul_s::<16>(dv, mul) >> sh
+        };
         push.wrapping_add(damp)
             .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })

@@ -185,12 +185,28 @@ fn steady_state<A: Arith>(name: &str) {
 
 #[test]
 fn dynamics_track_the_twin() {
-    dynamics::<Wide>("wide");
-    dynamics::<Narrow>("narrow");
+    dynamics::<Wide>("wide", SolverConfig::default());
+    dynamics::<Narrow>("narrow", SolverConfig::default());
 }
 
-fn dynamics<A: Arith>(name: &str) {
-    let cfg = SolverConfig::default();
+/// The narrow arithmetic's other damping path: spring damping below 0.1 N·s/m (stored
+/// velocities scaled by 0.1 N·s/m, the damping a product), none at all, and the most
+/// allowed (30 N·s/m: stored velocities with no extra fraction bits).
+#[test]
+fn narrow_dynamics_with_little_no_or_most_spring_damping() {
+    for (c, m) in [(0.05, 0.005), (0.0, 0.005), (30.0, 0.1)] {
+        let cfg = SolverConfig {
+            spring_damping: c,
+            node_damping: 5.0,
+            node_mass: m,
+            ..SolverConfig::default()
+        };
+        dynamics::<Wide>(&format!("wide, C = {c} N·s/m"), cfg);
+        dynamics::<Narrow>(&format!("narrow, C = {c} N·s/m"), cfg);
+    }
+}
+
+fn dynamics<A: Arith>(name: &str, cfg: SolverConfig) {
     let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     let mut t = twin(5, 2.5, &cfg, f.substeps());
     let path = demo_path(1000).unwrap();
