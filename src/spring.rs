@@ -270,7 +270,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     let f = table.force_narrow(strain);
     // −f r' (Q20 · Q12 / 2¹² = Q20, |f r'| < 448 N).
     let neg_fr = q::mul_s::<12>(f, q::narrow::<12>(rn.wrapping_add(ONE))).wrapping_neg();
-    core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
+
     let (mul, sh) = (damping.mul, damping.sh);
     // w (−f r') + C (v_b − v_a): Q20 · Q14 / 2¹⁴, and C_v (v_b − v_a) from Q(20 + g) to
     // Q20 N (times C/C_v when that is below one), each < 2³⁰.
