@@ -240,7 +240,7 @@ mod firmware {
         warm: &mut i32,
         damping: &Damping,
     ) -> [i32; 3] {
-        // SAFETY: the templates are comments; nothing is read or written.
+        // SAFETY: the templates are comments: nothing is read or written.
         unsafe {
             core::arch::asm!(
                 "/* {0} {1} {2} {3} */",
@@ -248,7 +248,7 @@ mod firmware {
                 in(reg) edge,
                 in(reg) ua,
                 in(reg) ub,
-                options(nomem, nostack, preserves_flags)
+                options(nostack, preserves_flags)
             );
             core::arch::asm!(
                 "/* {0} {1} {2} {3} */",
@@ -256,7 +256,7 @@ mod firmware {
                 in(reg) vb,
                 in(reg) warm,
                 in(reg) damping,
-                options(nomem, nostack, preserves_flags)
+                options(nostack, preserves_flags)
             );
         }
         [0; 3]
