@@ -206,7 +206,7 @@ impl NarrowStep {
     fn new(h: f64, config: &SolverConfig) -> Self {
         let cv = Damping::velocity_scale(config.spring_damping);
         // Stored velocities: Q(20 + g) N.
-        let vq = FORCE_FRAC + Damping::velocity_frac(config.spring_damping);
+        let vq = FORCE_FRAC + Damping::velocity_frac(config.spring_damping, h / config.node_mass);
         let (damp, damp_sh) = q::norm16(h * config.node_damping / config.node_mass, 16, 30);
         // C_v h/m ≤ 0.03 · 2000 (checked), as Q(x): f · step / 2^(x + 20 − vq).
         let (step, x) = q::norm16(cv * 1000.0 * h / config.node_mass, 0, 60);
@@ -398,7 +398,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             keep: q::from_f64(1.0 - h * config.node_damping / config.node_mass, KEEP_FRAC),
             half_h: q::from_f64(0.5 * h, HALF_H_FRAC),
             narrow: NarrowStep::new(h, config),
-            spring_damping: Damping::new(config.spring_damping),
+            spring_damping: Damping::with_frac(
+                config.spring_damping,
+                Damping::velocity_frac(config.spring_damping, h / config.node_mass),
+            ),
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ {
                 stiffness: q::from_f64(cp.stiffness, 16),
@@ -623,12 +626,15 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let count = self.topo.node_count().min(NODES);
         let coeffs = self.c;
         if let Some(free) = self.nodes.get_mut(1..count) {
-            for n in free {
-                if A::NARROW {
-                    Self::integrate_narrow(&coeffs.narrow, n);
-                } else {
-                    Self::integrate(&coeffs, n);
-                }
+            let c = &coeffs.narrow;
+            if !A::NARROW {
+                free.iter_mut().for_each(|n| Self::integrate(&coeffs, n));
+            } else if c.f_hold == i32::MAX {
+                free.iter_mut()
+                    .for_each(|n| Self::integrate_narrow::<false>(c, n));
+            } else {
+                free.iter_mut()
+                    .for_each(|n| Self::integrate_narrow::<true>(c, n));
             }
         }
         if let Drive::Hold { disp, vel } = drive {
@@ -719,17 +725,23 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// [`Self::integrate`] with 16-bit coefficients on the stored velocity `V = C_v v`
-    /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. The force is held
-    /// at `f_hold` so that the velocity step fits (16384 mm/s in one substep: never
-    /// reached by a stable patch).
+    /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. With `HOLD` the
+    /// force is held at `f_hold` so that the velocity step fits (16384 mm/s in one
+    /// substep: never reached by a stable patch); without, `f_hold` is `i32::MAX`: every
+    /// force fits (the stored velocities' fraction bits are chosen for it when they can
+    /// be, see [`Damping::velocity_frac`]).
     #[inline(always)]
-    fn integrate_narrow(c: &NarrowStep, n: &mut Node) {
+    fn integrate_narrow<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
         for j in 0..3 {
             let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
             // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
             // so the sum fits before the clamp (max/min: no panic path).
             let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
-            let f = f.max(-c.f_hold).min(c.f_hold);
+            let f = if HOLD {
+                f.max(-c.f_hold).min(c.f_hold)
+            } else {
+                f
+            };
             let step = q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2;
             let v_new = v
                 .wrapping_sub(drag)
@@ -761,4 +773,51 @@ impl Node {
         v: [0; 3],
         f: [0; 3],
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The narrow integrator's velocity step fits 2³⁰ for every force it may see: any
+    /// `i32` when `f_hold` is `i32::MAX` (no hold), else the held force; and the
+    /// configurations that allow it (the default among them) need no hold.
+    #[test]
+    fn narrow_velocity_step_fits() {
+        let mut no_hold = 0;
+        for c in [0.0, 0.05, 0.1, 1.0, 3.0, 30.0] {
+            for m in [0.001, 0.005, 0.03, 0.2] {
+                for hz in [250.0, 1000.0, 10_000.0] {
+                    for n in [1.0, 6.0] {
+                        let cfg = SolverConfig {
+                            spring_damping: c,
+                            node_mass: m,
+                            tick_hz: hz,
+                            ..SolverConfig::default()
+                        };
+                        let h = 1.0 / (hz * n);
+                        if 1000.0 * h / m >= 2000.0 {
+                            continue;
+                        }
+                        let s = NarrowStep::new(h, &cfg);
+                        let limit = if s.f_hold == i32::MAX {
+                            no_hold += 1;
+                            i32::MAX
+                        } else {
+                            s.f_hold
+                        };
+                        let lowest = if limit == i32::MAX { i32::MIN } else { -limit };
+                        for f in [lowest, limit, limit / 3] {
+                            let exact = (f as i64 * s.step as i64) >> s.step_sh1;
+                            assert!(exact.abs() <= 1 << 30, "C={c} m={m} {hz} Hz n={n}");
+                            assert_eq!(q::mul_s_by(f, s.step, s.step_sh1) as i64, exact);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(no_hold > 0);
+        let d = SolverConfig::default();
+        assert_eq!(NarrowStep::new(1.0 / 6000.0, &d).f_hold, i32::MAX);
+    }
 }

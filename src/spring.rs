@@ -70,9 +70,15 @@ pub const NARROW_MIN_DAMPING: f64 = 0.1;
 pub(crate) const VEL_LIMIT_MM_S: f64 = 16384.0;
 
 impl Damping {
-    /// From `C` in N·s/m (0 … 30; start-up only).
+    /// From `C` in N·s/m (0 … 30; start-up only), for stored velocities with as many
+    /// fraction bits as their range allows.
     pub fn new(n_s_per_m: f64) -> Self {
-        let g = Self::velocity_frac(n_s_per_m);
+        Self::with_frac(n_s_per_m, Self::velocity_frac(n_s_per_m, 0.0))
+    }
+
+    /// From `C` in N·s/m, for stored velocities in Q(20 + `g`) N
+    /// ([`Damping::velocity_frac`]).
+    pub fn with_frac(n_s_per_m: f64, g: u32) -> Self {
         let unit = n_s_per_m >= NARROW_MIN_DAMPING;
         let (mul, sh) = if unit {
             (0, g)
@@ -97,13 +103,23 @@ impl Damping {
         n_s_per_m.max(NARROW_MIN_DAMPING) / 1000.0
     }
 
-    /// The extra fraction bits `g` of [`Narrow`]'s stored velocities, Q(20 + g) N: the
-    /// most (up to 12) that keep the difference of two at the velocity limit within
-    /// 2³⁰.
-    pub fn velocity_frac(n_s_per_m: f64) -> u32 {
-        let v_max = VEL_LIMIT_MM_S * Self::velocity_scale(n_s_per_m) * (1u64 << FORCE_FRAC) as f64;
+    /// The extra fraction bits `g` of [`Narrow`]'s stored velocities, Q(20 + g) N, for a
+    /// substep `h` over the node mass `m` (`h_over_m`, s/kg; 0 if unknown): the most (up
+    /// to 12) that keep the difference of two at the velocity limit within 2³⁰, and,
+    /// where one bit can, any force's velocity step `f C_v h/m` within 2³⁰ (then the
+    /// integrator needs no hold on the force).
+    pub fn velocity_frac(n_s_per_m: f64, h_over_m: f64) -> u32 {
+        let cv = Self::velocity_scale(n_s_per_m);
+        let v_max = VEL_LIMIT_MM_S * cv * (1u64 << FORCE_FRAC) as f64;
+        // The velocity step per Q20 force, dimensionless (with a margin for its
+        // rounding to 15 bits).
+        let step = cv * 1000.0 * h_over_m * (1.0 + 1.0 / 8192.0);
+        let fits = |g: u32| {
+            let scale = (1u64 << g) as f64;
+            2.0 * v_max * scale <= (1u64 << 30) as f64 && (step * scale <= 0.5 || g == 0)
+        };
         let mut g = 0;
-        while g < 12 && 2.0 * v_max * (2u64 << g) as f64 <= (1u64 << 30) as f64 {
+        while g < 12 && fits(g + 1) {
             g += 1;
         }
         g
