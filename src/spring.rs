@@ -256,7 +256,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     let s = q::opaque(
         (0..3)
             .map(|k| {
-                let p = q::narrow::<10>(d[k].wrapping_add(w[k]));
+                let p = d[k].wrapping_add(w[k]) >> 10;
                 q::mul_s::<16>(w[k].wrapping_sub(d[k]), p)
             })
             .fold(0i32, i32::wrapping_add),
@@ -291,7 +291,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     // w (−f r') + C (v_b − v_a): Q20 · Q14 / 2¹⁴, and C_v (v_b − v_a) from Q(20 + g) to
     // Q20 N (times C/C_v when that is below one), each < 2³⁰.
     core::array::from_fn(|k| {
-        let push = q::mul_s::<14>(neg_fr, q::narrow::<9>(w[k]));
+        let push = q::mul_s::<14>(neg_fr, w[k] >> 9);
         let dv = vb[k].wrapping_sub(va[k]);
         let damp = if UNIT {
             dv >> sh
