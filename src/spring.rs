@@ -244,7 +244,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
 ) -> V3 {
     // Q23 geometry: d (Q29 → Q23) and 1/l0 rounded to Q15 (≤ 2¹⁵ for l0 ≥ 1 mm).
     const _: () = assert!(INV_LEN_FRAC == 31 && LEN_FRAC == 24);
-    let inv = q::narrow::<16>(inv_len);
+    let inv = inv_len >> 16;
     let d: V3 = dir.map(|x| x >> 6);
     // w = d + (u_b − u_a)/l0, Q24 · Q15 / 2¹⁶ = Q23, held within ±2 per axis; then q = w − d
     // (so that q and w agree where w is held) and the Q13 factor d + w (|d + w| < 3).
