@@ -183,6 +183,13 @@ struct NarrowStep {
     step_sh2: u32,
     /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
     f_hold: i32,
+    /// The fast path (`f_hold` is `i32::MAX`: `C_v h/m` in stored units ≤ ½, and
+    /// `h/(2 C_v)` in stored units to mm ≤ 1): the step as `⌊f · fast / 2¹⁶⌋ >> fast_sh`
+    /// and the position change as `⌊(V + V') · fast_hh / 2¹⁵⌋ >> fast_hh_sh`.
+    fast: i32,
+    fast_sh: u32,
+    fast_hh: i32,
+    fast_hh_sh: u32,
     /// `h / (2 C_v)`, mm/N, as a 16-bit operand: `V · hh` is Q24 mm after the shifts.
     hh: i32,
     hh_sh1: u32,
@@ -216,6 +223,17 @@ impl NarrowStep {
         } else {
             i32::MAX
         };
+        // Without the hold the step per unit force is ≤ ½ in stored units: one operand
+        // and one right shift after a 16-bit product.
+        let factor = cv * 1000.0 * h / config.node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
+        let factor_hh = 0.5 * h / cv * libm::ldexp(1.0, crate::topology::LEN_FRAC as i32 - vq as i32);
+        let ((fast, fast_sh), (fast_hh, fast_hh_sh), f_hold) =
+            if f_hold == i32::MAX && factor_hh < 1.0 - 1.0 / 32768.0 {
+                (q::norm16(factor, 16, 40), q::norm16(factor_hh, 15, 40), f_hold)
+            } else {
+                // The general path: a hold below i32::MAX selects it.
+                ((0, 0), (0, 0), f_hold.min(i32::MAX - 1))
+            };
         // h/(2 C_v) ≤ 2⁻⁹ s / 10⁻⁴ N·s/mm < 20 mm/N, as Q(y): V · hh / 2^(vq + y − 24).
         let (hh, y) = q::norm16(0.5 * h / cv, 0, 60);
         let (hh_sh1, hh_sh2) = split_shift((vq + y).saturating_sub(crate::topology::LEN_FRAC));
@@ -231,6 +249,10 @@ impl NarrowStep {
             step_sh1,
             step_sh2,
             f_hold,
+            fast,
+            fast_sh,
+            fast_hh,
+            fast_hh_sh,
             hh,
             hh_sh1,
             hh_sh2,
@@ -725,11 +747,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// [`Self::integrate`] with 16-bit coefficients on the stored velocity `V = C_v v`
-    /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. With `HOLD` the
-    /// force is held at `f_hold` so that the velocity step fits (16384 mm/s in one
-    /// substep: never reached by a stable patch); without, `f_hold` is `i32::MAX`: every
-    /// force fits (the stored velocities' fraction bits are chosen for it when they can
-    /// be, see [`Damping::velocity_frac`]).
+    /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. With `HOLD` (the
+    /// general path) the force is held at `f_hold` so that the velocity step fits (16384
+    /// mm/s in one substep: never reached by a stable patch), and the shifts are run-time;
+    /// without (`f_hold` is `i32::MAX`: every force fits, the stored velocities' fraction
+    /// bits being chosen for it where they can be, see [`Damping::velocity_frac`]), two
+    /// fixed-shift products with one run-time shift each.
     #[inline(always)]
     fn integrate_narrow<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
         for j in 0..3 {
@@ -737,19 +760,25 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
             // so the sum fits before the clamp (max/min: no panic path).
             let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
-            let f = if HOLD {
-                f.max(-c.f_hold).min(c.f_hold)
+            let step = if HOLD {
+                let f = f.max(-c.f_hold).min(c.f_hold);
+                q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2
             } else {
-                f
+                q::mul_s::<16>(f, c.fast) >> c.fast_sh
             };
-            let step = q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2;
             let v_new = v
                 .wrapping_sub(drag)
                 .wrapping_add(step)
                 .max(-c.v_limit)
                 .min(c.v_limit);
-            // u' = u + (V + V') h/(2 C_v): to Q24 mm by the shifts, |du| < 2³⁰.
-            let du = q::mul_s_by(v.wrapping_add(v_new), c.hh, c.hh_sh1) >> c.hh_sh2;
+            // u' = u + (V + V') h/(2 C_v): to Q24 mm by the shifts, |du| < 2³⁰ (the fast
+            // path: |V + V'| ≤ 2³⁰, so the 16-bit pieces stay within 2³⁰ too).
+            let vv = v.wrapping_add(v_new);
+            let du = if HOLD {
+                q::mul_s_by(vv, c.hh, c.hh_sh1) >> c.hh_sh2
+            } else {
+                q::mul_s::<15>(vv, c.fast_hh) >> c.fast_hh_sh
+            };
             n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
             n.v[j] = v_new;
         }
@@ -811,6 +840,26 @@ mod tests {
                             let exact = (f as i64 * s.step as i64) >> s.step_sh1;
                             assert!(exact.abs() <= 1 << 30, "C={c} m={m} {hz} Hz n={n}");
                             assert_eq!(q::mul_s_by(f, s.step, s.step_sh1) as i64, exact);
+                            if limit == i32::MAX {
+                                // The fast path: the same step to 2⁻¹⁴, within 2³⁰.
+                                let fast = (f as i64 * s.fast as i64) >> (16 + s.fast_sh);
+                                let general = exact >> s.step_sh2;
+                                assert!(fast.abs() <= 1 << 30);
+                                assert!((fast - general).abs() <= 2 + general.abs() / 16384);
+                                assert_eq!(q::mul_s::<16>(f, s.fast) as i64 >> s.fast_sh, fast);
+                            }
+                        }
+                        if limit == i32::MAX {
+                            // |V + V'| ≤ 2³⁰: the fast position step, within 2³⁰ and
+                            // equal to the general one to 2⁻¹⁴.
+                            for vv in [-(1 << 30), 1 << 30, 12345] {
+                                let fast = q::mul_s::<15>(vv, s.fast_hh) as i64 >> s.fast_hh_sh;
+                                let exact = ((vv as i64 * s.fast_hh as i64) >> 15) >> s.fast_hh_sh;
+                                assert_eq!(fast, exact);
+                                let general = ((vv as i64 * s.hh as i64) >> s.hh_sh1) >> s.hh_sh2;
+                                assert!((fast - general).abs() <= 2 + general.abs() / 16384);
+                                assert!(fast.abs() <= 1 << 30);
+                            }
                         }
                     }
                 }

@@ -115,7 +115,9 @@ struct Narrow {
 }
 
 /// A straight line's slope in 15 bits: `⌊Δe · k / 2^sh1⌋ >> sh2` is Q20 N for a Q24 `Δe`,
-/// with `|Δe|` held at `hold` so that the product stays within 2³⁰ (1024 N).
+/// with `Δe` held at `hold` on the side away from the table (below it for the line
+/// below, above it for the line above; the other side is the table's own range) so that
+/// the product stays within 2³⁰ (1024 N) and its sum with the line's anchor force fits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct NarrowLine {
     k: i32,
@@ -125,8 +127,8 @@ struct NarrowLine {
 }
 
 impl NarrowLine {
-    /// From a Q16 slope.
-    const fn new(k: i32) -> Self {
+    /// From a Q16 slope and the line's anchor force (Q20 N).
+    const fn new(k: i32, f0: i32) -> Self {
         let mag = k.unsigned_abs();
         let kn = (32 - mag.leading_zeros()).saturating_sub(15);
         // Q24 · Q(16 − kn) / 2^(20 − kn) = Q20.
@@ -141,7 +143,10 @@ impl NarrowLine {
         let hold = if k16 == 0 {
             i32::MAX
         } else {
-            let h = (1i64 << (30 + sh)) / k16.unsigned_abs() as i64;
+            // |product| ≤ min(2³⁰, 2³¹ − 1 − |f0|).
+            let room = i32::MAX as i64 - f0.unsigned_abs() as i64;
+            let cap = if room < (1i64 << 30) { room } else { 1i64 << 30 };
+            let h = (cap << sh) / k16.unsigned_abs() as i64;
             if h > i32::MAX as i64 {
                 i32::MAX
             } else {
@@ -156,11 +161,19 @@ impl NarrowLine {
         }
     }
 
-    /// `f0 + k (e − e0)` in Q20 N for `|e − e0|` held within `hold`.
+    /// `f0 + k (e − e0)` in Q20 N, `e − e0` held at `−hold` below (the line below the
+    /// table: `e ≤ strain_lo`, so `e − e0` is at most the table's own rise above).
     #[inline(always)]
-    fn at(&self, f0: i32, e: i32, e0: i32) -> i32 {
-        let de = e.wrapping_sub(e0).max(-self.hold).min(self.hold);
-        f0.saturating_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
+    fn below(&self, f0: i32, e: i32, e0: i32) -> i32 {
+        let de = e.wrapping_sub(e0).max(-self.hold);
+        f0.wrapping_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
+    }
+
+    /// `f0 + k (e − e0)` in Q20 N, `e − e0 ≥ 0` held at `hold` above (the line above).
+    #[inline(always)]
+    fn above(&self, f0: i32, e: i32, e0: i32) -> i32 {
+        let de = e.wrapping_sub(e0).min(self.hold);
+        f0.wrapping_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
     }
 }
 
@@ -480,8 +493,8 @@ impl<const S: usize> ForceTable<S> {
         let narrow = Narrow {
             scale: raw.index_scale >> k,
             scale_sh: 16 - k,
-            lo: NarrowLine::new(raw.stiffness_lo),
-            hi: NarrowLine::new(raw.stiffness_hi),
+            lo: NarrowLine::new(raw.stiffness_lo, raw.force_lo),
+            hi: NarrowLine::new(raw.stiffness_hi, raw.force_hi),
         };
         Self { raw, narrow }
     }
@@ -555,16 +568,17 @@ impl<const S: usize> ForceTable<S> {
     /// ([`crate::spring::Narrow`]): the same segment, position and cubic (the index scale
     /// has 15 significant bits, so its product is two 32-bit multiplies), and the straight
     /// lines with their slopes to 15 bits (2⁻¹⁵ relative), held at ±1024 N. Raw Q24 strain
-    /// in, raw Q20 N out, within ±64 N.
+    /// in, within ±8 (a spring's strain is within (−2.5, 1)); raw Q20 N out, within
+    /// ±64 N.
     #[inline(always)]
     pub fn force_narrow(&self, strain: Strain) -> i32 {
         let r = &self.raw;
         let n = &self.narrow;
         let e = strain.to_bits();
         let f = if e <= r.strain_lo {
-            n.lo.at(r.force_lo, e, r.anchor_lo)
+            n.lo.below(r.force_lo, e, r.anchor_lo)
         } else if e >= r.strain_hi {
-            n.hi.at(r.force_hi, e, r.strain_hi)
+            n.hi.above(r.force_hi, e, r.strain_hi)
         } else {
             let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
             // ⌊de · scale / 2¹⁶⌋ from 16-bit pieces (< 2³¹), then to Q15 segments.
