@@ -183,9 +183,10 @@ struct NarrowStep {
     step_sh2: u32,
     /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
     f_hold: i32,
-    /// The fast path (`f_hold` is `i32::MAX`: `C_v h/m` in stored units ≤ ½, and
-    /// `h/(2 C_v)` in stored units to mm ≤ 1): the step as `⌊f · fast / 2¹⁶⌋ >> fast_sh`
-    /// and the position change as `⌊(V + V') · fast_hh / 2¹⁵⌋ >> fast_hh_sh`.
+    /// The fast path (`f_hold` is `i32::MAX`: `C_v h/m` in stored units ≤ ½, `h/(2 C_v)`
+    /// in stored units to mm < 2, and stored velocities within ±2²⁸): the step as
+    /// `⌊f · fast / 2¹⁶⌋ >> fast_sh` and the position change as
+    /// `⌊(V + V') · fast_hh / 2¹⁴⌋ >> fast_hh_sh`.
     fast: i32,
     fast_sh: u32,
     fast_hh: i32,
@@ -223,13 +224,20 @@ impl NarrowStep {
         } else {
             i32::MAX
         };
+        let v_limit = q::from_f64(16384.0 * cv, vq);
         // Without the hold the step per unit force is ≤ ½ in stored units: one operand
         // and one right shift after a 16-bit product.
-        let factor = cv * 1000.0 * h / config.node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
-        let factor_hh = 0.5 * h / cv * libm::ldexp(1.0, crate::topology::LEN_FRAC as i32 - vq as i32);
+        let factor =
+            cv * 1000.0 * h / config.node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
+        let factor_hh =
+            0.5 * h / cv * libm::ldexp(1.0, crate::topology::LEN_FRAC as i32 - vq as i32);
         let ((fast, fast_sh), (fast_hh, fast_hh_sh), f_hold) =
-            if f_hold == i32::MAX && factor_hh < 1.0 - 1.0 / 32768.0 {
-                (q::norm16(factor, 16, 40), q::norm16(factor_hh, 15, 40), f_hold)
+            if f_hold == i32::MAX && factor_hh < 2.0 - 1.0 / 16384.0 && v_limit <= 1 << 28 {
+                (
+                    q::norm16(factor, 16, 40),
+                    q::norm16(factor_hh, 14, 40),
+                    f_hold,
+                )
             } else {
                 // The general path: a hold below i32::MAX selects it.
                 ((0, 0), (0, 0), f_hold.min(i32::MAX - 1))
@@ -260,7 +268,7 @@ impl NarrowStep {
             cv_sh,
             inv_cv,
             inv_cv_sh: vq + z - VEL_FRAC,
-            v_limit: q::from_f64(16384.0 * cv, vq),
+            v_limit,
         }
     }
 
@@ -772,12 +780,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 .max(-c.v_limit)
                 .min(c.v_limit);
             // u' = u + (V + V') h/(2 C_v): to Q24 mm by the shifts, |du| < 2³⁰ (the fast
-            // path: |V + V'| ≤ 2³⁰, so the 16-bit pieces stay within 2³⁰ too).
+            // path: |V + V'| ≤ 2²⁹ and the factor < 2, so its 16-bit pieces and its
+            // result stay within 2³⁰).
             let vv = v.wrapping_add(v_new);
             let du = if HOLD {
                 q::mul_s_by(vv, c.hh, c.hh_sh1) >> c.hh_sh2
             } else {
-                q::mul_s::<15>(vv, c.fast_hh) >> c.fast_hh_sh
+                q::mul_s::<14>(vv, c.fast_hh) >> c.fast_hh_sh
             };
             n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
             n.v[j] = v_new;
@@ -850,14 +859,16 @@ mod tests {
                             }
                         }
                         if limit == i32::MAX {
-                            // |V + V'| ≤ 2³⁰: the fast position step, within 2³⁰ and
-                            // equal to the general one to 2⁻¹⁴.
-                            for vv in [-(1 << 30), 1 << 30, 12345] {
-                                let fast = q::mul_s::<15>(vv, s.fast_hh) as i64 >> s.fast_hh_sh;
-                                let exact = ((vv as i64 * s.fast_hh as i64) >> 15) >> s.fast_hh_sh;
+                            // |V + V'| ≤ 2 v_limit ≤ 2²⁹: the fast position step, within
+                            // 2³⁰ and equal to the general one to 2⁻¹³.
+                            assert!(s.v_limit <= 1 << 28);
+                            let vm = 2 * s.v_limit;
+                            for vv in [-vm, vm, 12345] {
+                                let fast = q::mul_s::<14>(vv, s.fast_hh) as i64 >> s.fast_hh_sh;
+                                let exact = ((vv as i64 * s.fast_hh as i64) >> 14) >> s.fast_hh_sh;
                                 assert_eq!(fast, exact);
                                 let general = ((vv as i64 * s.hh as i64) >> s.hh_sh1) >> s.hh_sh2;
-                                assert!((fast - general).abs() <= 2 + general.abs() / 16384);
+                                assert!((fast - general).abs() <= 2 + general.abs() / 8192);
                                 assert!(fast.abs() <= 1 << 30);
                             }
                         }

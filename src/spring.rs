@@ -52,9 +52,9 @@ pub struct Damping {
     pub wide: i32,
     /// [`Narrow`] stores a node's velocity as `V = C_v v` in N, Q(20 + g)
     /// ([`Damping::velocity_scale`], [`Damping::velocity_frac`]). With `unit`
-    /// (`C ≥` [`NARROW_MIN_DAMPING`], so `C_v = C`) the damping force is
-    /// `(V_b − V_a) >> sh`; else `⌊(V_b − V_a) · mul / 2¹⁶⌋ >> sh`, `mul` being `C / C_v`
-    /// to 15 bits (0 for no damping).
+    /// (`C ≥` [`NARROW_MIN_DAMPING`], so `C_v = C` and `g = 0`) the damping force is
+    /// `V_b − V_a`; else `⌊(V_b − V_a) · mul / 2¹⁶⌋ >> sh`, `mul` being `C / C_v` to 15
+    /// bits (0 for no damping).
     pub unit: bool,
     /// See `unit`.
     pub mul: i32,
@@ -63,8 +63,9 @@ pub struct Damping {
 }
 
 /// The smallest spring damping, N·s/m, that [`Narrow`] applies without a product: its
-/// node velocities are stored as `C_v v` with `C_v = max(C, this)`.
-pub const NARROW_MIN_DAMPING: f64 = 0.1;
+/// node velocities are stored as `C_v v` with `C_v = max(C, this)`, in Q20 N from here
+/// up (1 N·s/m: a resolution of 0.001 mm/s), with extra fraction bits below.
+pub const NARROW_MIN_DAMPING: f64 = 1.0;
 
 /// The fastest velocity the solvers hold, mm/s.
 pub(crate) const VEL_LIMIT_MM_S: f64 = 16384.0;
@@ -77,12 +78,11 @@ impl Damping {
     }
 
     /// From `C` in N·s/m, for stored velocities in Q(20 + `g`) N
-    /// ([`Damping::velocity_frac`]).
+    /// ([`Damping::velocity_frac`]; 0 when `C ≥` [`NARROW_MIN_DAMPING`]).
     pub fn with_frac(n_s_per_m: f64, g: u32) -> Self {
         let unit = n_s_per_m >= NARROW_MIN_DAMPING;
-        let (mul, sh) = if unit {
-            (0, g)
-        } else if n_s_per_m <= 0.0 {
+        // The unit path needs neither; no damping is a zero product.
+        let (mul, sh) = if unit || n_s_per_m <= 0.0 {
             (0, 0)
         } else {
             // C/C_v < 1 as a 16-bit operand: Q(16 + x) with x ≥ −1; then Q(20 + g + x).
@@ -104,11 +104,15 @@ impl Damping {
     }
 
     /// The extra fraction bits `g` of [`Narrow`]'s stored velocities, Q(20 + g) N, for a
-    /// substep `h` over the node mass `m` (`h_over_m`, s/kg; 0 if unknown): the most (up
-    /// to 12) that keep the difference of two at the velocity limit within 2³⁰, and,
-    /// where one bit can, any force's velocity step `f C_v h/m` within 2³⁰ (then the
-    /// integrator needs no hold on the force).
+    /// substep `h` over the node mass `m` (`h_over_m`, s/kg; 0 if unknown): none when
+    /// `C ≥` [`NARROW_MIN_DAMPING`] (the damping is then the plain difference); below,
+    /// the most (up to 12) that keep the difference of two at the velocity limit within
+    /// 2³⁰, and, where one bit can, any force's velocity step `f C_v h/m` within 2³⁰
+    /// (then the integrator needs no hold on the force).
     pub fn velocity_frac(n_s_per_m: f64, h_over_m: f64) -> u32 {
+        if n_s_per_m >= NARROW_MIN_DAMPING {
+            return 0;
+        }
         let cv = Self::velocity_scale(n_s_per_m);
         let v_max = VEL_LIMIT_MM_S * cv * (1u64 << FORCE_FRAC) as f64;
         // The velocity step per Q20 force, dimensionless (with a margin for its
@@ -294,7 +298,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
         let push = q::mul_s::<14>(neg_fr, w[k] >> 9);
         let dv = vb[k].wrapping_sub(va[k]);
         let damp = if UNIT {
-            dv >> sh
+            dv
         } else {
             q::mul_s::<16>(dv, mul) >> sh
         };

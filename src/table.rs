@@ -145,7 +145,11 @@ impl NarrowLine {
         } else {
             // |product| ≤ min(2³⁰, 2³¹ − 1 − |f0|).
             let room = i32::MAX as i64 - f0.unsigned_abs() as i64;
-            let cap = if room < (1i64 << 30) { room } else { 1i64 << 30 };
+            let cap = if room < (1i64 << 30) {
+                room
+            } else {
+                1i64 << 30
+            };
             let h = (cap << sh) / k16.unsigned_abs() as i64;
             if h > i32::MAX as i64 {
                 i32::MAX
