@@ -175,12 +175,12 @@ enum Drive {
 struct NarrowStep {
     /// `h c_node / m` (≤ ½), Q(16 + `damp_sh`).
     damp: i32,
-    damp_sh: u32,
+    damp_sh: u8,
     /// `C_v h / m` (dimensionless) as a 16-bit operand: `f · step` (f Q20 N) is a stored
     /// velocity after the shifts.
     step: i32,
-    step_sh1: u32,
-    step_sh2: u32,
+    step_sh1: u8,
+    step_sh2: u8,
     /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
     f_hold: i32,
     /// The fast path (`f_hold` is `i32::MAX`: `C_v h/m` in stored units ≤ ½, `h/(2 C_v)`
@@ -188,19 +188,19 @@ struct NarrowStep {
     /// `⌊f · fast / 2¹⁶⌋ >> fast_sh` and the position change as
     /// `⌊(V + V') · fast_hh / 2¹⁴⌋ >> fast_hh_sh`.
     fast: i32,
-    fast_sh: u32,
+    fast_sh: u8,
     fast_hh: i32,
-    fast_hh_sh: u32,
+    fast_hh_sh: u8,
     /// `h / (2 C_v)`, mm/N, as a 16-bit operand: `V · hh` is Q24 mm after the shifts.
     hh: i32,
-    hh_sh1: u32,
-    hh_sh2: u32,
+    hh_sh1: u8,
+    hh_sh2: u8,
     /// `C_v` as a 16-bit operand: mm/s (Q16) to a stored velocity (`cv_sh` ≥ 8).
     cv: i32,
-    cv_sh: u32,
+    cv_sh: u8,
     /// `1 / C_v` as a 16-bit operand: a stored velocity to mm/s (Q16).
     inv_cv: i32,
-    inv_cv_sh: u32,
+    inv_cv_sh: u8,
     /// The velocity limit (16384 mm/s) as a stored velocity.
     v_limit: i32,
 }
@@ -252,29 +252,29 @@ impl NarrowStep {
         let (inv_cv, z) = q::norm16(1.0 / cv, 0, 30);
         Self {
             damp,
-            damp_sh,
+            damp_sh: damp_sh as u8,
             step,
-            step_sh1,
-            step_sh2,
+            step_sh1: step_sh1 as u8,
+            step_sh2: step_sh2 as u8,
             f_hold,
             fast,
-            fast_sh,
+            fast_sh: fast_sh as u8,
             fast_hh,
-            fast_hh_sh,
+            fast_hh_sh: fast_hh_sh as u8,
             hh,
-            hh_sh1,
-            hh_sh2,
+            hh_sh1: hh_sh1 as u8,
+            hh_sh2: hh_sh2 as u8,
             cv: cvq,
-            cv_sh,
+            cv_sh: cv_sh as u8,
             inv_cv,
-            inv_cv_sh: vq + z - VEL_FRAC,
+            inv_cv_sh: (vq + z - VEL_FRAC) as u8,
             v_limit,
         }
     }
 
     /// A velocity (Q16 mm/s, within ±2³⁰) as the node stores it.
     fn store(&self, v: i32) -> i32 {
-        let (sh1, sh2) = split_shift(self.cv_sh);
+        let (sh1, sh2) = split_shift(self.cv_sh as u32);
         (q::mul_s_by(v, self.cv, sh1) >> sh2)
             .max(-self.v_limit)
             .min(self.v_limit)
@@ -282,7 +282,7 @@ impl NarrowStep {
 
     /// A stored velocity in mm/s (Q16).
     fn velocity(&self, stored: i32) -> i32 {
-        let (sh1, sh2) = split_shift(self.inv_cv_sh);
+        let (sh1, sh2) = split_shift(self.inv_cv_sh as u32);
         q::mul_s_by(stored, self.inv_cv, sh1) >> sh2
     }
 }
@@ -770,7 +770,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             let drag = q::mul_s::<16>(v, c.damp) >> c.damp_sh;
             let step = if HOLD {
                 let f = f.max(-c.f_hold).min(c.f_hold);
-                q::mul_s_by(f, c.step, c.step_sh1) >> c.step_sh2
+                q::mul_s_by(f, c.step, c.step_sh1 as u32) >> c.step_sh2
             } else {
                 q::mul_s::<16>(f, c.fast) >> c.fast_sh
             };
@@ -784,7 +784,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             // result stay within 2³⁰).
             let vv = v.wrapping_add(v_new);
             let du = if HOLD {
-                q::mul_s_by(vv, c.hh, c.hh_sh1) >> c.hh_sh2
+                q::mul_s_by(vv, c.hh, c.hh_sh1 as u32) >> c.hh_sh2
             } else {
                 q::mul_s::<14>(vv, c.fast_hh) >> c.fast_hh_sh
             };
@@ -848,7 +848,7 @@ mod tests {
                         for f in [lowest, limit, limit / 3] {
                             let exact = (f as i64 * s.step as i64) >> s.step_sh1;
                             assert!(exact.abs() <= 1 << 30, "C={c} m={m} {hz} Hz n={n}");
-                            assert_eq!(q::mul_s_by(f, s.step, s.step_sh1) as i64, exact);
+                            assert_eq!(q::mul_s_by(f, s.step, s.step_sh1 as u32) as i64, exact);
                             if limit == i32::MAX {
                                 // The fast path: the same step to 2⁻¹⁴, within 2³⁰.
                                 let fast = (f as i64 * s.fast as i64) >> (16 + s.fast_sh);

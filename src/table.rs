@@ -121,8 +121,8 @@ struct Narrow {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct NarrowLine {
     k: i32,
-    sh1: u32,
-    sh2: u32,
+    sh1: u8,
+    sh2: u8,
     hold: i32,
 }
 
@@ -159,8 +159,8 @@ impl NarrowLine {
         };
         Self {
             k: k16,
-            sh1,
-            sh2,
+            sh1: sh1 as u8,
+            sh2: sh2 as u8,
             hold,
         }
     }
@@ -170,14 +170,14 @@ impl NarrowLine {
     #[inline(always)]
     fn below(&self, f0: i32, e: i32, e0: i32) -> i32 {
         let de = e.wrapping_sub(e0).max(-self.hold);
-        f0.wrapping_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
+        f0.wrapping_add(mul_s_by(de, self.k, self.sh1 as u32) >> self.sh2)
     }
 
     /// `f0 + k (e − e0)` in Q20 N, `e − e0 ≥ 0` held at `hold` above (the line above).
     #[inline(always)]
     fn above(&self, f0: i32, e: i32, e0: i32) -> i32 {
         let de = e.wrapping_sub(e0).min(self.hold);
-        f0.wrapping_add(mul_s_by(de, self.k, self.sh1) >> self.sh2)
+        f0.wrapping_add(mul_s_by(de, self.k, self.sh1 as u32) >> self.sh2)
     }
 }
 
