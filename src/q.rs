@@ -205,6 +205,7 @@ pub fn mul_s_by_split(a: i32, b: i32, sh: u32) -> i32 {
 /// `(n, sh)` with `n = round(x · 2^(base + sh))` ≤ 2¹⁵ for the largest `sh` ≤ `max_sh`:
 /// a positive coefficient as the 16-bit operand of [`mul_s`], to 2⁻¹⁵ relative
 /// (start-up only; `x · 2^base` must be ≤ 2¹⁵ − ½).
+#[inline(never)]
 pub fn norm16(x: f64, base: u32, max_sh: u32) -> (i32, u32) {
     let at = |sh: u32| libm::round(x * libm::ldexp(1.0, (base + sh) as i32));
     let mut sh = 0;

@@ -211,6 +211,29 @@ fn split_shift(sh: u32) -> (u32, u32) {
 }
 
 impl NarrowStep {
+    /// In a solver that does not use them.
+    const UNUSED: Self = Self {
+        damp: 0,
+        damp_sh: 0,
+        step: 0,
+        step_sh1: 0,
+        step_sh2: 0,
+        f_hold: 0,
+        fast: 0,
+        fast_sh: 0,
+        fast_hh: 0,
+        fast_hh_sh: 0,
+        hh: 0,
+        hh_sh1: 0,
+        hh_sh2: 0,
+        cv: 0,
+        cv_sh: 0,
+        inv_cv: 0,
+        inv_cv_sh: 0,
+        v_limit: 0,
+    };
+
+    #[inline(never)]
     fn new(h: f64, config: &SolverConfig) -> Self {
         let cv = Damping::velocity_scale(config.spring_damping);
         // Stored velocities: Q(20 + g) N.
@@ -427,11 +450,21 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             h_over_m: q::from_f64(1000.0 * h / config.node_mass, HM_FRAC),
             keep: q::from_f64(1.0 - h * config.node_damping / config.node_mass, KEEP_FRAC),
             half_h: q::from_f64(0.5 * h, HALF_H_FRAC),
-            narrow: NarrowStep::new(h, config),
-            spring_damping: Damping::with_frac(
-                config.spring_damping,
-                Damping::velocity_frac(config.spring_damping, h / config.node_mass),
-            ),
+            // Only the narrow arithmetic's (software f64 at start-up: kept out of the
+            // other builds' flash).
+            narrow: if A::NARROW {
+                NarrowStep::new(h, config)
+            } else {
+                NarrowStep::UNUSED
+            },
+            spring_damping: if A::NARROW {
+                Damping::with_frac(
+                    config.spring_damping,
+                    Damping::velocity_frac(config.spring_damping, h / config.node_mass),
+                )
+            } else {
+                Damping::wide_only(config.spring_damping)
+            },
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ {
                 stiffness: q::from_f64(cp.stiffness, 16),

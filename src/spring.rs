@@ -77,6 +77,16 @@ impl Damping {
         Self::with_frac(n_s_per_m, Self::velocity_frac(n_s_per_m, 0.0))
     }
 
+    /// From `C` in N·s/m for [`Wide`] only (the narrow fields unset).
+    pub fn wide_only(n_s_per_m: f64) -> Self {
+        Self {
+            wide: q::from_f64(n_s_per_m / 1000.0, DAMP_FRAC),
+            unit: false,
+            mul: 0,
+            sh: 0,
+        }
+    }
+
     /// From `C` in N·s/m, for stored velocities in Q(20 + `g`) N
     /// ([`Damping::velocity_frac`]; 0 when `C ≥` [`NARROW_MIN_DAMPING`]).
     pub fn with_frac(n_s_per_m: f64, g: u32) -> Self {
