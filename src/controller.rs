@@ -84,7 +84,7 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A:
 
     /// One tick. `swap`, if given, is applied first, between this tick and the last.
     /// Returns the force rendered.
-    pub fn tick(&mut self, swap: Option<ParamSet<S>>) -> [Force; 3] {
+    pub fn tick(&mut self, swap: Option<ParamSet<S, A>>) -> [Force; 3] {
         if let Some(set) = swap {
             self.solver.apply(set);
             self.telemetry.swaps = self.telemetry.swaps.saturating_add(1);

@@ -138,11 +138,13 @@ impl DemoSpec {
     /// The swapped parameter set for this spec's patch (software floating point: for the
     /// main loop, not the tick).
     #[inline(never)]
-    pub fn swapped_set<const N: usize, const E: usize>(&self) -> Result<ParamSet<64>, DemoError> {
+    pub fn swapped_set<const N: usize, const E: usize, A: Arith>(
+        &self,
+    ) -> Result<ParamSet<64, A>, DemoError> {
         let topo =
             Topology::<N, E>::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
         let table = ForceTable64::new(&swapped_params()).map_err(DemoError::Table)?;
-        Solver::<N, E, 64>::prepare_for(&topo, table, &self.config()).map_err(DemoError::Solver)
+        Solver::<N, E, 64, A>::prepare_for(&topo, table, &self.config()).map_err(DemoError::Solver)
     }
 }
 
@@ -204,7 +206,7 @@ pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
 fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
     static TABLE2: ForceTable64 = include!("../tables/table2.rs");
     let mut ctl: Controller<DemoDevice, 10, 61, 64, A> = spec.controller(TABLE2)?;
-    let mut swap = Some(spec.swapped_set::<10, 61>()?);
+    let mut swap = Some(spec.swapped_set::<10, 61, A>()?);
     for tick in 0..spec.ticks() {
         let s = if tick >= spec.swap_tick() {
             swap.take()

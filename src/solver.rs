@@ -330,15 +330,17 @@ struct Coeffs {
 
 /// A force table with the substeps and coefficients it needs on a given topology and
 /// configuration: built by [`Solver::prepare`] (start-up or main loop, `f64`), switched in
-/// by [`Solver::apply`] between two ticks (a few moves).
+/// by [`Solver::apply`] between two ticks (a few moves). `A`: the spring arithmetic of
+/// the solver it is for (its coefficients differ).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ParamSet<const S: usize> {
+pub struct ParamSet<const S: usize, A = DefaultArith> {
     table: ForceTable<S>,
     substeps: u32,
     c: Coeffs,
+    arith: PhantomData<A>,
 }
 
-impl<const S: usize> ParamSet<S> {
+impl<const S: usize, A> ParamSet<S, A> {
     /// The table.
     pub fn table(&self) -> &ForceTable<S> {
         &self.table
@@ -423,12 +425,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         &self,
         table: ForceTable<S>,
         config: &SolverConfig,
-    ) -> Result<ParamSet<S>, SolverError> {
+    ) -> Result<ParamSet<S, A>, SolverError> {
         Self::prepare_for(&self.topo, table, config)
     }
 
     /// Switches to a prepared parameter set; the state (positions, velocities) is kept.
-    pub fn apply(&mut self, set: ParamSet<S>) {
+    pub fn apply(&mut self, set: ParamSet<S, A>) {
         self.table = set.table;
         self.substeps = set.substeps;
         self.c = set.c;
@@ -441,7 +443,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         topo: &Topology<NODES, EDGES>,
         table: ForceTable<S>,
         config: &SolverConfig,
-    ) -> Result<ParamSet<S>, SolverError> {
+    ) -> Result<ParamSet<S, A>, SolverError> {
         let substeps = Self::substeps_for(topo, &table, config)?;
         let h = 1.0 / (config.tick_hz * substeps as f64);
         let cp = &config.coupling;
@@ -472,7 +474,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 max_force: q::from_f64(cp.max_force, FORCE_FRAC),
             },
         };
-        Ok(ParamSet { table, substeps, c })
+        Ok(ParamSet {
+            table,
+            substeps,
+            c,
+            arith: PhantomData,
+        })
     }
 
     /// Checks `config` and returns the substeps per tick the stability bound asks for

@@ -356,16 +356,19 @@ proptest! {
     }
 }
 
+/// Table 2 with both shear moduli scaled by `k` (stiffer or softer tissue).
+fn table2_scaled(k: f64) -> Params {
+    let mut p = Params::TABLE2;
+    p.cone.shear_modulus *= k;
+    p.linear.shear_modulus *= k;
+    p
+}
+
 /// The solver's `force_within` is `force` clamped, over the whole strain range, on the
 /// Table 2 spring and on springs with large forces (whose lines saturate).
 #[test]
 fn force_within_is_force_clamped() {
-    let mut springs = vec![Params::TABLE2];
-    let mut big = Params::TABLE2;
-    big.cone.shear_modulus *= 30.0;
-    big.linear.shear_modulus *= 30.0;
-    springs.push(big);
-    for p in springs {
+    for p in [Params::TABLE2, table2_scaled(30.0)] {
         let t = ForceTable::<64>::new(&p).unwrap();
         let mut bits = i32::MIN;
         loop {
@@ -387,17 +390,8 @@ fn force_within_is_force_clamped() {
 /// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring.
 #[test]
 fn force_narrow_is_force_within_to_a_slope_lsb() {
-    let mut springs = vec![Params::TABLE2];
-    let mut stiff = Params::TABLE2;
-    stiff.cone.shear_modulus *= 30.0;
-    stiff.linear.shear_modulus *= 30.0;
-    springs.push(stiff);
-    let mut soft = Params::TABLE2;
-    soft.cone.shear_modulus /= 50.0;
-    soft.linear.shear_modulus /= 50.0;
-    springs.push(soft);
     let mut worst = 0.0f64;
-    for p in springs {
+    for p in [Params::TABLE2, table2_scaled(30.0), table2_scaled(0.02)] {
         let t = ForceTable::<64>::new(&p).unwrap();
         let (lo, hi) = t.tabulated_range();
         let (f_lo, f_hi) = (t.raw().force_lo as f64, t.raw().force_hi as f64);

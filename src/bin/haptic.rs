@@ -219,7 +219,7 @@ mod firmware {
     /// `SPEC.swap_tick()`. Returns its substeps. Out of line, like `init`.
     #[inline(never)]
     fn post_swap() -> u32 {
-        match SPEC.swapped_set::<NODES, EDGES>() {
+        match SPEC.swapped_set::<NODES, EDGES, mccs::spring::DefaultArith>() {
             Ok(set) => {
                 let substeps = set.substeps();
                 let _ = SWAP.post(set);
