@@ -16,7 +16,8 @@
 //!
 //! # Units and formats
 //! Displacements from rest in mm, Q24, kept within ±64 mm; velocities in mm/s, Q16, kept
-//! within ±16384 mm/s; forces in N, Q20 (±2048 N; one spring's force, law and damping,
+//! within ±16384 mm/s (the [`crate::spring::Narrow`] arithmetic stores them as `C v`, N,
+//! see [`crate::spring::Damping`]); forces in N, Q20 (±2048 N; one spring's force, law and damping,
 //! within ±64 N). Positions are in the patch frame (origin at the contact node's rest
 //! position, `z` up). The spring's own formats are in [`crate::spring`].
 //!

@@ -325,7 +325,7 @@ pub fn narrow<const S: usize, const UNIT: bool>(
 ///
 /// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
 /// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
-/// [`MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 30
+/// [`crate::solver::MAX_SPRINGS_PER_NODE`] springs per node (the topology checks), spring damping ≤ 30
 /// N·s/m (the configuration checks). Limits that follow, documented behaviour:
 /// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±2 per axis: a spring
 ///   stretched further pulls as if stretched to 2 `l0` along that axis;
