@@ -58,7 +58,11 @@ const STIFF_FRAC: u32 = 16;
 pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
 
 /// The raw contents of a [`ForceTable`], as emitted by `mccs table` for `include!`.
+/// In declaration order (`repr(C)`): the header before the segments, so that the
+/// Cortex-M0 reaches every header field with an immediate offset (Thumb-1 loads reach
+/// 124 bytes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct RawTable<const S: usize> {
     /// Lower end of the tabulated strain range (Q24).
     pub strain_lo: i32,
@@ -98,9 +102,11 @@ pub struct RawTable<const S: usize> {
 
 /// A tabulated inverse law with `S` segments (`S + 1` knots); see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct ForceTable<const S: usize> {
-    raw: RawTable<S>,
+    // First, with the raw header next, for the same reason as [`RawTable`]'s order.
     narrow: Narrow,
+    raw: RawTable<S>,
 }
 
 /// What [`ForceTable::force_narrow`] needs beyond the raw table, derived from it.
@@ -500,7 +506,7 @@ impl<const S: usize> ForceTable<S> {
             lo: NarrowLine::new(raw.stiffness_lo, raw.force_lo),
             hi: NarrowLine::new(raw.stiffness_hi, raw.force_hi),
         };
-        Self { raw, narrow }
+        Self { narrow, raw }
     }
 
     /// The raw contents.
