@@ -17,26 +17,37 @@ pub fn force(table: &ForceTable64, strain: Strain) -> Force {
     table.force(strain)
 }
 
+/// The two ends of a spring, as [`spring`] reads them: displacements (Q24 mm) and
+/// velocities (as the solver stores them; Q16 mm/s for `Wide`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SpringEnds {
+    /// Displacement of end `a`.
+    pub ua: [i32; 3],
+    /// Displacement of end `b`.
+    pub ub: [i32; 3],
+    /// Velocity of end `a`.
+    pub va: [i32; 3],
+    /// Velocity of end `b`.
+    pub vb: [i32; 3],
+}
+
 /// One spring update (law + damping + Newton step) in this core's arithmetic
-/// ([`crate::spring::DefaultArith`]), never inlined; the end states are read through
-/// references, as the solver reads them from its nodes. Raw formats as in
+/// ([`crate::spring::DefaultArith`]), never inlined; the end states are read through one
+/// reference, as the solver reads them from its nodes. Raw formats as in
 /// [`crate::spring`].
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 pub fn spring(
     table: &ForceTable64,
     edge: &Edge,
-    ua: &[i32; 3],
-    ub: &[i32; 3],
-    va: &[i32; 3],
-    vb: &[i32; 3],
+    ends: &SpringEnds,
     warm: &mut i32,
     damping: &Damping,
 ) -> [i32; 3] {
+    let e = ends;
     if damping.unit {
-        DefaultArith::force::<64, true>(table, edge, *ua, *ub, va, vb, warm, damping)
+        DefaultArith::force::<64, true>(table, edge, e.ua, e.ub, &e.va, &e.vb, warm, damping)
     } else {
-        DefaultArith::force::<64, false>(table, edge, *ua, *ub, va, vb, warm, damping)
+        DefaultArith::force::<64, false>(table, edge, e.ua, e.ub, &e.va, &e.vb, warm, damping)
     }
 }
 

@@ -112,10 +112,7 @@ mod firmware {
             black_box(no_spring(
                 black_box(&table),
                 &c.edge,
-                &c.ua,
-                &c.ub,
-                &c.va,
-                &c.vb,
+                &c.ends,
                 &mut r,
                 &c.damping,
             ));
@@ -125,10 +122,7 @@ mod firmware {
             black_box(e::spring(
                 black_box(&table),
                 &c.edge,
-                &c.ua,
-                &c.ub,
-                &c.va,
-                &c.vb,
+                &c.ends,
                 &mut r,
                 &c.damping,
             ));
@@ -201,10 +195,7 @@ mod firmware {
     /// The spring case's inputs (raw formats of `mccs::spring`).
     struct SpringCase {
         edge: Edge,
-        ua: [i32; 3],
-        ub: [i32; 3],
-        va: [i32; 3],
-        vb: [i32; 3],
+        ends: e::SpringEnds,
         damping: Damping,
     }
 
@@ -218,10 +209,12 @@ mod firmware {
                 dir: [0, 0, -(1 << 29)],
                 inv_len: 1 << 29,
             },
-            ua: [0; 3],
-            ub: [1 << 20, -(1 << 20), 2 << 24],
-            va: [10, -20, 30],
-            vb: [0; 3],
+            ends: e::SpringEnds {
+                ua: [0; 3],
+                ub: [1 << 20, -(1 << 20), 2 << 24],
+                va: [10, -20, 30],
+                vb: [0; 3],
+            },
             damping: Damping::new(1.0),
         }
     }
@@ -233,27 +226,17 @@ mod firmware {
     fn no_spring(
         table: &ForceTable64,
         edge: &Edge,
-        ua: &[i32; 3],
-        ub: &[i32; 3],
-        va: &[i32; 3],
-        vb: &[i32; 3],
+        ends: &e::SpringEnds,
         warm: &mut i32,
         damping: &Damping,
     ) -> [i32; 3] {
-        // SAFETY: the templates are comments: nothing is read or written.
+        // SAFETY: the template is a comment: nothing is read or written.
         unsafe {
             core::arch::asm!(
-                "/* {0} {1} {2} {3} */",
+                "/* {0} {1} {2} {3} {4} */",
                 in(reg) table,
                 in(reg) edge,
-                in(reg) ua,
-                in(reg) ub,
-                options(nostack, preserves_flags)
-            );
-            core::arch::asm!(
-                "/* {0} {1} {2} {3} */",
-                in(reg) va,
-                in(reg) vb,
+                in(reg) ends,
                 in(reg) warm,
                 in(reg) damping,
                 options(nostack, preserves_flags)
