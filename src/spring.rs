@@ -282,10 +282,11 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     // r and 2 + ρ = 1 + r in Q12, s and a = 1 + s in Q11 (each rounded once).
     let r12 = q::narrow::<12>(r0.wrapping_add(ONE));
     let s11 = q::narrow::<9>(s);
-    let t = q::mul_s::<16>(r0, r12 + (1 << 12));
-    let a = s11 + (1 << 11);
+    // t = ρ r + ρ/16 (the 1 of 2 + ρ as a shift), a t = t + s t.
+    let t = q::mul_s::<16>(r0, r12).wrapping_add(r0 >> 4);
     let e = s
-        .wrapping_add(q::mul_s::<11>(t, a))
+        .wrapping_add(t)
+        .wrapping_add(q::mul_s::<11>(t, s11))
         .min((1 << FORCE_FRAC) - 1);
     // ρ' = ρ − r e / 2: Q20 · Q12 / 2⁹ = Q24 (|r e/2| < 4), held below 6 (r < 7).
     let rn = q::opaque(
