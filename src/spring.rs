@@ -297,7 +297,8 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     // ε = −(s + ρ' + s ρ') in Q20 (ρ' Q24 · s Q11 / 2¹⁵), then Q24 (|ε| < 7).
     let srho = q::mul_s::<15>(rn, s11);
     let lm1 = s.wrapping_add(rn >> 4).wrapping_add(srho);
-    let strain = Strain::from_bits(lm1.wrapping_neg().wrapping_mul(16));
+    // (The shift behind a barrier: LLVM would make it a product by −16.)
+    let strain = Strain::from_bits(q::opaque(lm1 << 4).wrapping_neg());
     let f = table.force_narrow(strain);
     // −f r' (Q20 · Q12 / 2¹² = Q20, |f r'| < 448 N).
     let neg_fr = q::mul_s::<12>(f, q::narrow::<12>(rn.wrapping_add(ONE))).wrapping_neg();
