@@ -37,7 +37,7 @@
 //! loop; the only branch is which of the three pieces the strain falls in. Every product
 //! has exact floor semantics, and the Cortex-M0 builds them from 16-bit pieces with the
 //! same bits ([`crate::q`]). Measured (QEMU, averaged over strains on both lines and the
-//! cubic part, the call included): 36 instructions on a Cortex-M4F, 40 on an M3, 96 on an
+//! cubic part, the call included): 33 instructions on a Cortex-M4F, 37 on an M3, 90 on an
 //! M0.
 //!
 //! # Accuracy (measured by `host-tests/tests/table_accuracy.rs`, see README)
