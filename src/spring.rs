@@ -230,7 +230,7 @@ const R_MAX_NARROW: i32 = 7 << LEN_FRAC;
 /// [`wide`] with one 16-bit operand per product (the Cortex-M0's arithmetic). `rho` is
 /// the spring's warm-started `l0/l − 1` (Q24) and `damping` its [`Damping`]; the node
 /// velocities `va`, `vb` are stored as `C_v v` (N, Q(20 + g); see [`Damping`]), so that
-/// the damping force is their difference shifted, with no product unless `C` is below
+/// the damping force is their difference, with no product unless `C` is below
 /// [`NARROW_MIN_DAMPING`] (`UNIT`: the caller has checked that `damping.unit` holds, and
 /// the loop is compiled without the product). The other arguments, the ranges
 /// and the limits are those of [`wide`], except that `l0/l` stays below 7 (a spring
@@ -240,9 +240,9 @@ const R_MAX_NARROW: i32 = 7 << LEN_FRAC;
 /// is `w = d + q` and `s = |w|² − 1 = q · (d + w)`: small when the spring is, with the
 /// 16-bit factor `d + w` of order 1. Newton for `r = l0/l = 1/√(1 + s)` runs on `ρ = r − 1`:
 /// `e = a r² − 1 = s + a ρ (2 + ρ)`, `ρ' = ρ − r e / 2`, and the strain is
-/// `ε = 1 − a r' = −(s + ρ' + s ρ')`. Each product's 16-bit operand (`d + w`, `2 + ρ`,
-/// `a`, `r`, `s`, `w`, `C`) is rounded to at most 2⁻¹² relative, so each term is within
-/// ~1e-4 of itself.
+/// `ε = 1 − a r' = −(s + ρ' + s ρ')`. Each product's 16-bit operand (`1/l0`, `d + w`,
+/// `r`, `s`, `w`, `C/C_v`) is an order-one quantity rounded or truncated to at most 2⁻¹¹,
+/// so each term is within ~1e-4 of itself (the whole spring against the f64 twin: README).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn narrow<const S: usize, const UNIT: bool>(
@@ -256,12 +256,13 @@ pub fn narrow<const S: usize, const UNIT: bool>(
     rho: &mut i32,
     damping: &Damping,
 ) -> V3 {
-    // Q23 geometry: d (Q29 → Q23) and 1/l0 rounded to Q15 (≤ 2¹⁵ for l0 ≥ 1 mm).
+    // Q23 geometry: d (Q29 → Q23) and 1/l0 truncated to Q15 (< 2¹⁵ for l0 ≥ 1 mm).
     const _: () = assert!(INV_LEN_FRAC == 31 && LEN_FRAC == 24);
     let inv = inv_len >> 16;
     let d: V3 = dir.map(|x| x >> 6);
     // w = d + (u_b − u_a)/l0, Q24 · Q15 / 2¹⁶ = Q23, held within ±2 per axis; then q = w − d
-    // (so that q and w agree where w is held) and the Q13 factor d + w (|d + w| < 3).
+    // (so that q and w agree where w is held) and the Q13 factor d + w, truncated
+    // (|d + w| < 3).
     let w: V3 = core::array::from_fn(|k| {
         let qk = q::mul_s::<16>(ub[k].wrapping_sub(ua[k]), inv);
         d[k].wrapping_add(qk).clamp(-(2 << 23), (2 << 23) - 1)
