@@ -170,10 +170,8 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
 /// keep the result (and, for `SH` < 16, `⌊a/2¹⁶⌋ · b · 2^(16 − SH)`) within `i32`.
 #[inline(always)]
 pub fn mul_s<const SH: u32>(a: i32, b: i32) -> i32 {
-    long_or_split!(
-        mul_s_split::<SH>(a, b),
-        ((a as i64 * b as i64) >> SH) as i32
-    )
+    const { assert!(SH <= 16) };
+    mul_s_by(a, b, SH)
 }
 
 /// [`mul_s`] from two 32-bit products, exact: with `a = a₁2¹⁶ + a₀` (`a₀ ∈ [0, 2¹⁶)`),
@@ -181,12 +179,12 @@ pub fn mul_s<const SH: u32>(a: i32, b: i32) -> i32 {
 #[inline(always)]
 pub fn mul_s_split<const SH: u32>(a: i32, b: i32) -> i32 {
     const { assert!(SH <= 16) };
-    let (a1, a0) = (a >> 16, opaque(a & 0xFFFF));
-    (a1.wrapping_mul(b) << (16 - SH)).wrapping_add(a0.wrapping_mul(b) >> SH)
+    mul_s_by_split(a, b, SH)
 }
 
 /// [`mul_s`] with the shift known only at run time (`sh` ≤ 16): two variable shifts
-/// on the M0 instead of immediates. The same conditions on the ranges.
+/// on the M0 instead of immediates (with a constant `sh`, as from [`mul_s`], the same
+/// code as immediates). The same conditions on the ranges.
 #[inline(always)]
 pub fn mul_s_by(a: i32, b: i32, sh: u32) -> i32 {
     long_or_split!(

@@ -172,7 +172,7 @@ enum Drive {
 /// [`crate::spring::Narrow`] (each to 2⁻¹⁵ relative). Its nodes store the velocity as
 /// `V = C_v v` in N, Q(20 + g) (`C_v` and `g` from [`Damping`]), so that a spring's
 /// damping force is a difference of stored values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct NarrowStep {
     /// `h c_node / m` (≤ ½), Q(16 + `damp_sh`).
     damp: i32,
@@ -184,10 +184,11 @@ struct NarrowStep {
     step_sh2: u8,
     /// Largest force (Q20 N) whose velocity step fits: `|f step| / 2^step_sh1 ≤ 2³⁰`.
     f_hold: i32,
-    /// The fast path (`f_hold` is `i32::MAX`: `C_v h/m` in stored units ≤ ½, `h/(2 C_v)`
-    /// in stored units to mm < 2, and stored velocities within ±2²⁸): the step as
+    /// Whether the fast path applies (no hold: `f_hold` is `i32::MAX`; `h/(2 C_v)` in
+    /// stored units to mm < 2; stored velocities within ±2²⁸): the step as
     /// `⌊f · fast / 2¹⁶⌋ >> fast_sh` and the position change as
     /// `⌊(V + V') · fast_hh / 2¹⁴⌋ >> fast_hh_sh`.
+    fast_path: bool,
     fast: i32,
     fast_sh: u8,
     fast_hh: i32,
@@ -212,28 +213,6 @@ fn split_shift(sh: u32) -> (u32, u32) {
 }
 
 impl NarrowStep {
-    /// In a solver that does not use them.
-    const UNUSED: Self = Self {
-        damp: 0,
-        damp_sh: 0,
-        step: 0,
-        step_sh1: 0,
-        step_sh2: 0,
-        f_hold: 0,
-        fast: 0,
-        fast_sh: 0,
-        fast_hh: 0,
-        fast_hh_sh: 0,
-        hh: 0,
-        hh_sh1: 0,
-        hh_sh2: 0,
-        cv: 0,
-        cv_sh: 0,
-        inv_cv: 0,
-        inv_cv_sh: 0,
-        v_limit: 0,
-    };
-
     #[inline(never)]
     fn new(h: f64, config: &SolverConfig) -> Self {
         let cv = Damping::velocity_scale(config.spring_damping);
@@ -255,17 +234,12 @@ impl NarrowStep {
             cv * 1000.0 * h / config.node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
         let factor_hh =
             0.5 * h / cv * libm::ldexp(1.0, crate::topology::LEN_FRAC as i32 - vq as i32);
-        let ((fast, fast_sh), (fast_hh, fast_hh_sh), f_hold) =
-            if f_hold == i32::MAX && factor_hh < 2.0 - 1.0 / 16384.0 && v_limit <= 1 << 28 {
-                (
-                    q::norm16(factor, 16, 40),
-                    q::norm16(factor_hh, 14, 40),
-                    f_hold,
-                )
-            } else {
-                // The general path: a hold below i32::MAX selects it.
-                ((0, 0), (0, 0), f_hold.min(i32::MAX - 1))
-            };
+        let fast_path = f_hold == i32::MAX && factor_hh < 2.0 - 1.0 / 16384.0 && v_limit <= 1 << 28;
+        let ((fast, fast_sh), (fast_hh, fast_hh_sh)) = if fast_path {
+            (q::norm16(factor, 16, 40), q::norm16(factor_hh, 14, 40))
+        } else {
+            ((0, 0), (0, 0))
+        };
         // h/(2 C_v) ≤ 2⁻⁹ s / 10⁻⁴ N·s/mm < 20 mm/N, as Q(y): V · hh / 2^(vq + y − 24).
         let (hh, y) = q::norm16(0.5 * h / cv, 0, 60);
         let (hh_sh1, hh_sh2) = split_shift((vq + y).saturating_sub(crate::topology::LEN_FRAC));
@@ -281,6 +255,7 @@ impl NarrowStep {
             step_sh1: step_sh1 as u8,
             step_sh2: step_sh2 as u8,
             f_hold,
+            fast_path,
             fast,
             fast_sh: fast_sh as u8,
             fast_hh,
@@ -458,7 +433,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             narrow: if A::NARROW {
                 NarrowStep::new(h, config)
             } else {
-                NarrowStep::UNUSED
+                NarrowStep::default()
             },
             spring_damping: if A::NARROW {
                 Damping::with_frac(
@@ -700,7 +675,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             let c = &coeffs.narrow;
             if !A::NARROW {
                 free.iter_mut().for_each(|n| Self::integrate(&coeffs, n));
-            } else if c.f_hold == i32::MAX {
+            } else if c.fast_path {
                 free.iter_mut()
                     .for_each(|n| Self::integrate_narrow::<false>(c, n));
             } else {
@@ -799,9 +774,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. With `HOLD` (the
     /// general path) the force is held at `f_hold` so that the velocity step fits (16384
     /// mm/s in one substep: never reached by a stable patch), and the shifts are run-time;
-    /// without (`f_hold` is `i32::MAX`: every force fits, the stored velocities' fraction
-    /// bits being chosen for it where they can be, see [`Damping::velocity_frac`]), two
-    /// fixed-shift products with one run-time shift each.
+    /// without (`fast_path`: every force fits, the stored velocities' fraction bits being
+    /// chosen for it where they can be, see [`Damping::velocity_frac`]), two fixed-shift
+    /// products with one run-time shift each.
     #[inline(always)]
     fn integrate_narrow<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
         for j in 0..3 {
@@ -890,7 +865,7 @@ mod tests {
                             let exact = (f as i64 * s.step as i64) >> s.step_sh1;
                             assert!(exact.abs() <= 1 << 30, "C={c} m={m} {hz} Hz n={n}");
                             assert_eq!(q::mul_s_by(f, s.step, s.step_sh1 as u32) as i64, exact);
-                            if limit == i32::MAX {
+                            if s.fast_path {
                                 // The fast path: the same step to 2⁻¹⁴, within 2³⁰.
                                 let fast = (f as i64 * s.fast as i64) >> (16 + s.fast_sh);
                                 let general = exact >> s.step_sh2;
@@ -899,7 +874,8 @@ mod tests {
                                 assert_eq!(q::mul_s::<16>(f, s.fast) as i64 >> s.fast_sh, fast);
                             }
                         }
-                        if limit == i32::MAX {
+                        if s.fast_path {
+                            assert_eq!(s.f_hold, i32::MAX);
                             // |V + V'| ≤ 2 v_limit ≤ 2²⁹: the fast position step, within
                             // 2³⁰ and equal to the general one to 2⁻¹³.
                             assert!(s.v_limit <= 1 << 28);
@@ -920,5 +896,6 @@ mod tests {
         assert!(no_hold > 0);
         let d = SolverConfig::default();
         assert_eq!(NarrowStep::new(1.0 / 6000.0, &d).f_hold, i32::MAX);
+        assert!(NarrowStep::new(1.0 / 6000.0, &d).fast_path);
     }
 }
