@@ -13,10 +13,10 @@ out=target/qemu/bench.txt
 status=0
 for spec in "m4f thumbv7em-none-eabihf" "m3 thumbv7m-none-eabi" "m0 thumbv6m-none-eabi"; do
   set -- $spec
-  cargo build --quiet --release --target "$2" --bin bench
+  cargo build --quiet --release -p mccs-firmware --target "$2" --bin bench
   log="target/qemu/bench-$1.log"
   set +e
-  timeout 300 cargo run --quiet --release --target "$2" --bin bench 2> >(grep -v "Timer with period zero" >&2) \
+  timeout 300 cargo run --quiet --release -p mccs-firmware --target "$2" --bin bench 2> >(grep -v "Timer with period zero" >&2) \
     | defmt-print -e "target/$2/release/bench" > "$log"
   rc=${PIPESTATUS[0]}
   set -e

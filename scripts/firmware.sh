@@ -12,9 +12,9 @@ case "$core" in
   m0) target=thumbv6m-none-eabi ;;
   *) echo "firmware.sh: core must be m4f, m3 or m0, not '$core'" >&2; exit 2 ;;
 esac
-cargo build --quiet --release --target "$target" --bin haptic "$@"
+cargo build --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@"
 elf="target/$target/release/haptic"
 # The runner from .cargo/config.toml (QEMU with -icount), output decoded by defmt-print.
 # timeout: a hung firmware must fail, not stall the caller.
-timeout 300 cargo run --quiet --release --target "$target" --bin haptic "$@" 2> >(grep -v "Timer with period zero" >&2) \
+timeout 300 cargo run --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@" 2> >(grep -v "Timer with period zero" >&2) \
   | defmt-print -e "$elf"

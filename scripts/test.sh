@@ -12,13 +12,14 @@ cargo fmt --all -- --check
 step "clippy (host, all targets, -D warnings)"
 cargo clippy --workspace --all-targets -- -D warnings
 
-step "clippy (thumb, with and without defmt, -D warnings)"
+step "clippy (thumb: the core alone, with and without defmt, and the firmware; -D warnings)"
 for t in thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf; do
   cargo clippy -p mccs --target "$t" -- -D warnings
   cargo clippy -p mccs --target "$t" --features defmt -- -D warnings
+  cargo clippy -p mccs-firmware --target "$t" -- -D warnings
 done
 
-step "thumb builds of the core (release)"
+step "thumb builds of the core alone (release, no firmware module)"
 for t in thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf; do
   cargo build -p mccs --release --target "$t"
   cargo build -p mccs --release --target "$t" --features defmt
@@ -53,7 +54,7 @@ step "instruction counts in QEMU: budgets (bench/budgets.txt) and bench/baseline
 bash scripts/bench.sh
 
 step "bench in QEMU: a breached budget exits with failure"
-if timeout 300 cargo run --quiet --release --target thumbv7em-none-eabihf --bin bench --features budget-test \
+if timeout 300 cargo run --quiet --release -p mccs-firmware --target thumbv7em-none-eabihf --bin bench --features budget-test \
     2>/dev/null | defmt-print -e target/thumbv7em-none-eabihf/release/bench > target/qemu/budget-test.log; then
   echo "test.sh: the bench firmware passed an impossible budget" >&2
   exit 1
@@ -63,7 +64,7 @@ grep "result=OVER" target/qemu/budget-test.log
 step "memory of the demo firmware (defmt, release): flash ≤ 64 KiB"
 size_tool="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin/llvm-size"
 for t in thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi; do
-  cargo build --quiet --release --target "$t" --bin haptic
+  cargo build --quiet --release -p mccs-firmware --target "$t" --bin haptic
   "$size_tool" -A "target/$t/release/haptic" | python3 -c '
 import sys
 target = sys.argv[1]

@@ -6,6 +6,9 @@
 //! the probe (no slip). The force is clamped per axis to the device maximum, on the
 //! device and on the node alike, so the coupling stays passive.
 
+use crate::q::{mul_wide, sat};
+use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
+
 /// Coupling parameters (runtime values; see [`crate::SolverConfig`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Coupling {
@@ -40,8 +43,19 @@ pub(crate) struct CouplingQ {
 }
 
 impl CouplingQ {
+    /// Fraction bits of `stiffness`.
+    const STIFF_FRAC: u32 = 16;
     /// Fraction bits of `damping`.
-    pub const DAMP_FRAC: u32 = 24;
+    const DAMP_FRAC: u32 = 24;
+
+    /// From the coupling's parameters (start-up).
+    pub fn new(c: &Coupling) -> Self {
+        Self {
+            stiffness: from_f64(c.stiffness, Self::STIFF_FRAC),
+            damping: from_f64(c.damping / 1000.0, Self::DAMP_FRAC),
+            max_force: from_f64(c.max_force, FORCE_FRAC),
+        }
+    }
 
     /// Force on the contact node (Q20 N) from the probe at `probe` (Q24 mm) moving at
     /// `probe_vel` (Q16 mm/s), the node at `node` moving at `node_vel`. Zero when the
@@ -54,7 +68,9 @@ impl CouplingQ {
         node: [i32; 3],
         node_vel: [i32; 3],
     ) -> [i32; 3] {
-        use crate::q::sat;
+        // Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are both Q40: Q20 N after the shift.
+        const SH: u32 = LEN_FRAC + CouplingQ::STIFF_FRAC - FORCE_FRAC;
+        const _: () = assert!(VEL_FRAC + CouplingQ::DAMP_FRAC - FORCE_FRAC == SH);
         if probe[2] >= node[2] {
             return [0; 3];
         }
@@ -67,8 +83,8 @@ impl CouplingQ {
             let dv = probe_vel[i].saturating_sub(node_vel[i]);
             // Q24 mm · Q16 N/mm → Q20 N; Q16 mm/s · Q24 N·s/mm → Q20 N (long products: the
             // M0 builds them from 16-bit pieces).
-            let spring = crate::q::mul_wide(dx, self.stiffness) >> 20;
-            let damper = crate::q::mul_wide(dv, self.damping) >> 20;
+            let spring = mul_wide(dx, self.stiffness) >> SH;
+            let damper = mul_wide(dv, self.damping) >> SH;
             let f = sat(spring + damper);
             // max/min, not clamp: clamp keeps a panic path for min > max.
             out[i] = f.max(-self.max_force).min(self.max_force);

@@ -1,12 +1,10 @@
 //! The MCCS law in `f64`, used only when a [`ForceTable`](crate::ForceTable) is built.
 //!
-//! Never called per tick. It follows MODEL.md: `Δ(F) = Δ_cone(F) + max(0, F − P)/k_p`,
-//! where the cone is linear (`F/k`) up to `F_T`, follows eq. 11 up to `F_C`, and is solid
-//! (`H`) beyond, and the series spring, preloaded with `P`, moves only once the load
-//! exceeds `P`. With the default `P = F_T` this is exactly MODEL.md's three pieces; for
-//! another preload it is the continuous, increasing law that MODEL.md's pieces would be
-//! if they kept the preload's meaning (MODEL.md writes `(F − P)/k_p` from `F_T` on, which
-//! jumps at `F_T` or runs backwards when `P ≠ F_T`).
+//! Never called per tick. It follows `docs/model.md`:
+//! `Δ(F) = Δ_cone(F) + max(0, F − P)/k_p`, where the cone is linear (`F/k`) up to `F_T`,
+//! follows eq. 11 up to `F_C`, and is solid (`H`) beyond, and the series spring, preloaded
+//! with `P`, moves only once the load exceeds `P` (see the departures from the paper
+//! there: the printed eq. 14 would jump at `F_T`).
 //!
 //! `Δ` is the compressive strain of an edge; `F` its force in N.
 //!
@@ -41,7 +39,7 @@ pub struct Law {
 }
 
 impl Law {
-    /// Validates `params` and derives the constants of MODEL.md.
+    /// Validates `params` and derives the constants of `docs/model.md`.
     pub fn new(params: &Params) -> Result<Self, ParamError> {
         params.validate()?;
         let c = &params.cone;

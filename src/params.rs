@@ -1,8 +1,13 @@
-//! Spring parameters in the units and schema of MODEL.md, and their validation.
+//! Spring parameters in the units and schema of `docs/model.md`, and their validation.
 //!
 //! Lengths in mm, shear moduli in MPa, forces in N. Every value must be finite and > 0,
 //! and the cone's large diameter must exceed its small one. Validation names the
 //! offending key with [`ParamKey`], exactly as the TOML files spell it.
+//!
+//! [`ParamKey`] is the schema's one source: its section and name in the file, its
+//! symbol and unit, whether it is required, and how to read and write it in a
+//! [`Params`]. The parameter-file reader and writer, the CLI and the docs' schema table
+//! all go through it.
 
 use core::fmt;
 
@@ -80,6 +85,93 @@ impl ParamKey {
         Self::LinearPreload,
     ];
 
+    /// The TOML section: `cone` or `linear`.
+    pub const fn section(self) -> &'static str {
+        match self {
+            Self::ConeWireDiameter
+            | Self::ConeSmallDiameter
+            | Self::ConeLargeDiameter
+            | Self::ConeActiveCoils
+            | Self::ConeCompressibleHeight
+            | Self::ConeShearModulus => "cone",
+            _ => "linear",
+        }
+    }
+
+    /// The key within its section, e.g. `wire_diameter`.
+    pub const fn name(self) -> &'static str {
+        let path = self.as_str().as_bytes();
+        let skip = self.section().len() + 1;
+        let (_, name) = path.split_at(skip);
+        match core::str::from_utf8(name) {
+            Ok(n) => n,
+            Err(_) => "",
+        }
+    }
+
+    /// The paper's symbol and the unit: e.g. `("d", "mm")`.
+    pub const fn symbol_and_unit(self) -> (&'static str, &'static str) {
+        match self {
+            Self::ConeWireDiameter => ("d", "mm"),
+            Self::ConeSmallDiameter => ("D1", "mm"),
+            Self::ConeLargeDiameter => ("D2", "mm"),
+            Self::ConeActiveCoils => ("n", "1"),
+            Self::ConeCompressibleHeight => ("H", "mm"),
+            Self::ConeShearModulus => ("G", "MPa"),
+            Self::LinearWireDiameter => ("d_p", "mm"),
+            Self::LinearMeanDiameter => ("D_p", "mm"),
+            Self::LinearActiveCoils => ("n_p", "1"),
+            Self::LinearShearModulus => ("G_p", "MPa"),
+            Self::LinearPreload => ("P", "N"),
+        }
+    }
+
+    /// Whether a parameter file must give the key (only the preload is optional: it
+    /// defaults to the cone's transition force `F_T`).
+    pub const fn required(self) -> bool {
+        !matches!(self, Self::LinearPreload)
+    }
+
+    /// The key's value in `p` (`None`: the optional preload, absent).
+    pub const fn get(self, p: &Params) -> Option<f64> {
+        let (c, l) = (&p.cone, &p.linear);
+        Some(match self {
+            Self::ConeWireDiameter => c.wire_diameter,
+            Self::ConeSmallDiameter => c.small_diameter,
+            Self::ConeLargeDiameter => c.large_diameter,
+            Self::ConeActiveCoils => c.active_coils,
+            Self::ConeCompressibleHeight => c.compressible_height,
+            Self::ConeShearModulus => c.shear_modulus,
+            Self::LinearWireDiameter => l.wire_diameter,
+            Self::LinearMeanDiameter => l.mean_diameter,
+            Self::LinearActiveCoils => l.active_coils,
+            Self::LinearShearModulus => l.shear_modulus,
+            Self::LinearPreload => return l.preload,
+        })
+    }
+
+    /// Sets the key's value in `p`.
+    pub fn set(self, p: &mut Params, value: f64) {
+        let (c, l) = (&mut p.cone, &mut p.linear);
+        let slot = match self {
+            Self::ConeWireDiameter => &mut c.wire_diameter,
+            Self::ConeSmallDiameter => &mut c.small_diameter,
+            Self::ConeLargeDiameter => &mut c.large_diameter,
+            Self::ConeActiveCoils => &mut c.active_coils,
+            Self::ConeCompressibleHeight => &mut c.compressible_height,
+            Self::ConeShearModulus => &mut c.shear_modulus,
+            Self::LinearWireDiameter => &mut l.wire_diameter,
+            Self::LinearMeanDiameter => &mut l.mean_diameter,
+            Self::LinearActiveCoils => &mut l.active_coils,
+            Self::LinearShearModulus => &mut l.shear_modulus,
+            Self::LinearPreload => {
+                l.preload = Some(value);
+                return;
+            }
+        };
+        *slot = value;
+    }
+
     /// The dotted TOML path, e.g. `cone.wire_diameter`.
     pub const fn as_str(self) -> &'static str {
         match self {
@@ -119,6 +211,19 @@ pub enum ParamError {
 }
 
 impl ParamError {
+    /// What is wrong with the key's value (see `Display`, which puts the key first): one
+    /// source for `Display` and the `defmt` impl.
+    pub const fn reason(&self) -> &'static str {
+        match self {
+            Self::NotFinite(_) => "must be a finite number",
+            Self::NotPositive(_) => "must be > 0",
+            Self::LargeNotAboveSmall => "must be larger than cone.small_diameter",
+            Self::PreloadNotBelowSolid => {
+                "must be below the cone's solid force F_C = G d^4 H / (8 n D1^3)"
+            }
+        }
+    }
+
     /// The key the error is about.
     pub const fn key(&self) -> ParamKey {
         match self {
@@ -131,50 +236,23 @@ impl ParamError {
 
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::NotFinite(k) => write!(f, "{k}: must be a finite number"),
-            Self::NotPositive(k) => write!(f, "{k}: must be > 0"),
-            Self::LargeNotAboveSmall => {
-                f.write_str("cone.large_diameter: must be larger than cone.small_diameter")
-            }
-            Self::PreloadNotBelowSolid => f.write_str(
-                "linear.preload: must be below the cone's solid force F_C = G d^4 H / (8 n D1^3)",
-            ),
-        }
+        write!(f, "{}: {}", self.key(), self.reason())
     }
 }
 
 impl core::error::Error for ParamError {}
 
 impl Params {
-    /// The values in schema order (the preload, when absent, as `None`).
-    fn values(&self) -> [Option<f64>; 11] {
-        let (c, l) = (&self.cone, &self.linear);
-        [
-            Some(c.wire_diameter),
-            Some(c.small_diameter),
-            Some(c.large_diameter),
-            Some(c.active_coils),
-            Some(c.compressible_height),
-            Some(c.shear_modulus),
-            Some(l.wire_diameter),
-            Some(l.mean_diameter),
-            Some(l.active_coils),
-            Some(l.shear_modulus),
-            l.preload,
-        ]
-    }
-
-    /// Checks MODEL.md's rules: every value finite and > 0, `D2 > D1`, and a preload (when
+    /// Checks the rules of `docs/model.md`: every value finite and > 0, `D2 > D1`, and a preload (when
     /// given) below the cone's solid force `F_C`.
     pub fn validate(&self) -> Result<(), ParamError> {
-        for (key, value) in ParamKey::ALL.iter().zip(self.values()) {
-            if let Some(v) = value {
+        for key in ParamKey::ALL {
+            if let Some(v) = key.get(self) {
                 if !v.is_finite() {
-                    return Err(ParamError::NotFinite(*key));
+                    return Err(ParamError::NotFinite(key));
                 }
                 if v <= 0.0 {
-                    return Err(ParamError::NotPositive(*key));
+                    return Err(ParamError::NotPositive(key));
                 }
             }
         }

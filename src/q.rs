@@ -10,16 +10,19 @@
 /// A 3-vector of raw fixed-point values (x, y, z).
 pub type V3 = [i32; 3];
 
-/// The long-multiply form of a product, or its 16-bit-piece form on the Cortex-M0.
+/// Whether this target has a 32 × 32 → 64 multiply (`smull`): every Arm target but
+/// ARMv6-M (see the module docs), and every host.
+pub const HAS_LONG_MULTIPLY: bool =
+    cfg!(not(all(target_arch = "arm", not(target_has_atomic = "32"))));
+
+/// The long-multiply form of a product, or its 16-bit-piece form without a long multiply
+/// ([`HAS_LONG_MULTIPLY`]; a constant, so only one form is compiled into the caller).
 macro_rules! long_or_split {
     ($split:expr, $long:expr) => {{
-        #[cfg(core = "m0")]
-        {
-            $split
-        }
-        #[cfg(not(core = "m0"))]
-        {
+        if HAS_LONG_MULTIPLY {
             $long
+        } else {
+            $split
         }
     }};
 }
@@ -50,21 +53,6 @@ pub fn add(a: V3, b: V3) -> V3 {
         a[1].saturating_add(b[1]),
         a[2].saturating_add(b[2]),
     ]
-}
-
-/// Rounds an `f64` to the nearest raw value with `frac` fraction bits, saturating
-/// (start-up only).
-pub fn from_f64(x: f64, frac: u32) -> i32 {
-    let v = libm::round(x * (1u64 << frac) as f64);
-    if v.is_nan() {
-        0
-    } else if v >= i32::MAX as f64 {
-        i32::MAX
-    } else if v <= i32::MIN as f64 {
-        i32::MIN
-    } else {
-        v as i32
-    }
 }
 
 /// `⌊a · b / 2³²⌋`: the high word of the signed 64-bit product.
@@ -224,8 +212,12 @@ pub fn narrow<const SH: u32>(x: i32) -> i32 {
 /// it is, so it cannot rewrite the arithmetic around it (fold a split product back into
 /// a library call, or widen a value it cannot prove fits 32 bits).
 #[inline(always)]
+#[allow(unsafe_code)]
 pub fn opaque(mut x: i32) -> i32 {
-    // SAFETY: the template is a comment: it reads and writes only `x`'s register.
+    // SAFETY: the template is an assembler comment, so no instruction is emitted: the
+    // block reads and writes only the register holding `x` (declared `inout`), touches
+    // no memory (`nomem`) and no stack (`nostack`), and its output is its input
+    // (`pure`). Nothing the compiler relies on can change.
     #[cfg(target_arch = "arm")]
     unsafe {
         core::arch::asm!("/* {0} */", inout(reg) x, options(pure, nomem, nostack))

@@ -7,20 +7,16 @@
 //! Nodes `1 …` are free. Positions are in mm in the patch frame: origin at the contact
 //! node's rest position, `z` up, surface at `z = 0`.
 
-use crate::q::{self, V3};
+use crate::q::V3;
+use crate::units::{from_f64, to_f64, DIR_FRAC, INV_LEN_FRAC, LEN_FRAC};
 use heapless::Vec;
 
 /// Index of the ground node (all fixed nodes).
 pub const GROUND: u16 = 0;
 
-/// Fraction bits of lengths (mm) and dimensionless ratios in the patch: Q24.
-pub const LEN_FRAC: u32 = 24;
-
-/// Fraction bits of an edge's unit rest vector: Q29.
-pub const DIR_FRAC: u32 = 29;
-
-/// Fraction bits of an edge's `1 / l0` (1/mm): Q31.
-pub const INV_LEN_FRAC: u32 = 31;
+/// Most springs at one node: their summed forces (each within
+/// [`crate::arith::SPRING_FORCE_LIMIT`]) cannot overflow the Q20 accumulator.
+pub const MAX_SPRINGS_PER_NODE: usize = 20;
 
 /// One spring of the patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,13 +55,20 @@ pub enum TopologyError {
     TooShort,
     /// An edge referring to a node that does not exist, or joining two fixed points.
     BadEnd,
-    /// More than `solver::MAX_SPRINGS_PER_NODE` springs at one free node.
+    /// More than [`MAX_SPRINGS_PER_NODE`] springs at one free node.
     TooManySprings,
 }
 
 impl core::fmt::Display for TopologyError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(match self {
+        f.write_str(self.message())
+    }
+}
+
+impl TopologyError {
+    /// The message: one source for `Display` and the `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
             Self::NodeCapacity => "topology: more free nodes than the node capacity",
             Self::EdgeCapacity => "topology: more springs than the edge capacity",
             Self::BadGrid => "topology: grid must be 3..=200 with a finite spacing > 0",
@@ -73,7 +76,7 @@ impl core::fmt::Display for TopologyError {
             Self::TooShort => "topology: a spring is shorter than 1 mm",
             Self::BadEnd => "topology: a spring refers to a missing node or joins two fixed points",
             Self::TooManySprings => "topology: more than 20 springs at one node",
-        })
+        }
     }
 }
 
@@ -117,7 +120,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         }
         let index = self.rest.len();
         self.rest
-            .push(rest.map(|x| q::from_f64(x, LEN_FRAC)))
+            .push(rest.map(|x| from_f64(x, LEN_FRAC)))
             .map_err(|_| TopologyError::NodeCapacity)?;
         Ok(index as u16)
     }
@@ -158,17 +161,17 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
                 .iter()
                 .filter(|e| i != GROUND && (e.a == i || e.b == i))
                 .count();
-            if degree >= crate::solver::MAX_SPRINGS_PER_NODE {
+            if degree >= MAX_SPRINGS_PER_NODE {
                 return Err(TopologyError::TooManySprings);
             }
         }
-        let dir = d.map(|x| q::from_f64(x / len, DIR_FRAC));
+        let dir = d.map(|x| from_f64(x / len, DIR_FRAC));
         self.edges
             .push(Edge {
                 a: ia,
                 b: ib,
                 dir,
-                inv_len: q::from_f64(1.0 / len, INV_LEN_FRAC),
+                inv_len: from_f64(1.0 / len, INV_LEN_FRAC),
             })
             .map_err(|_| TopologyError::EdgeCapacity)
     }
@@ -182,7 +185,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         Ok(())
     }
 
-    /// MODEL.md's standard patch: `n × n` surface nodes on a square grid of spacing
+    /// The standard patch (`docs/model.md`): `n × n` surface nodes on a square grid of spacing
     /// `spacing` mm at `z = 0`, the outer ring fixed, a fixed base layer at `z = −spacing`
     /// under every surface node; structural, shear and vertical springs, leaving out
     /// those with both ends fixed (n = 5: 61 springs, n = 8: 214). The contact node is
@@ -268,5 +271,5 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
 }
 
 fn from_q24(x: i32) -> f64 {
-    x as f64 / (1u64 << LEN_FRAC) as f64
+    to_f64(x, LEN_FRAC)
 }

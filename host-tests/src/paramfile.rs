@@ -1,7 +1,8 @@
-//! Reading spring parameters from MODEL.md's TOML schema, with one-line errors that name
-//! the file and the key.
+//! Reading and writing spring parameters in the TOML schema of `docs/model.md`, with
+//! one-line errors that name the file and the key. The schema is the core's
+//! [`ParamKey`]: its sections, keys, which are required, and how each is stored.
 
-use mccs::{Cone, Linear, ParamError, ParamKey, Params};
+use mccs::{ParamError, ParamKey, Params};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -101,74 +102,47 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
             message: e.message().lines().next().unwrap_or("").to_owned(),
         })?;
     for (name, value) in &table {
-        let known: &[&str] = match name.as_str() {
-            "cone" => &[
-                "wire_diameter",
-                "small_diameter",
-                "large_diameter",
-                "active_coils",
-                "compressible_height",
-                "shear_modulus",
-            ],
-            "linear" => &[
-                "wire_diameter",
-                "mean_diameter",
-                "active_coils",
-                "shear_modulus",
-                "preload",
-            ],
-            _ => &[],
-        };
         let unknown = |key: String| ParamFileError::Unknown {
             path: path.to_owned(),
             key,
         };
+        let known = |k: &str| {
+            ParamKey::ALL
+                .iter()
+                .any(|p| p.section() == name.as_str() && p.name() == k)
+        };
         match value.as_table() {
-            Some(t) if !known.is_empty() => {
-                if let Some(k) = t.keys().find(|k| !known.contains(&k.as_str())) {
+            Some(t) if ParamKey::ALL.iter().any(|p| p.section() == name.as_str()) => {
+                if let Some(k) = t.keys().find(|k| !known(k)) {
                     return Err(unknown(format!("{name}.{k}")));
                 }
             }
             _ => return Err(unknown(name.clone())),
         }
     }
-    let get = |key: ParamKey| -> Result<Option<f64>, ParamFileError> {
-        let (section, name) = key.as_str().split_once('.').unwrap_or(("", key.as_str()));
-        let value = table.get(section).and_then(|s| s.get(name));
+    // Every key starts at its Table 2 value and is overwritten; a required key missing
+    // from the file is an error, the optional preload is absent unless given.
+    let mut params = Params::TABLE2;
+    for key in ParamKey::ALL {
+        let value = table.get(key.section()).and_then(|s| s.get(key.name()));
         match value {
-            None => Ok(None),
-            Some(toml::Value::Float(x)) => Ok(Some(*x)),
-            Some(toml::Value::Integer(i)) => Ok(Some(*i as f64)),
-            Some(_) => Err(ParamFileError::NotNumber {
-                path: path.to_owned(),
-                key,
-            }),
+            Some(toml::Value::Float(x)) => key.set(&mut params, *x),
+            Some(toml::Value::Integer(i)) => key.set(&mut params, *i as f64),
+            Some(_) => {
+                return Err(ParamFileError::NotNumber {
+                    path: path.to_owned(),
+                    key,
+                })
+            }
+            None if key.required() => {
+                return Err(ParamFileError::Missing {
+                    path: path.to_owned(),
+                    key,
+                })
+            }
+            None => {}
         }
-    };
-    let req = |key: ParamKey| -> Result<f64, ParamFileError> {
-        get(key)?.ok_or(ParamFileError::Missing {
-            path: path.to_owned(),
-            key,
-        })
-    };
-    use ParamKey as K;
-    let params = Params {
-        cone: Cone {
-            wire_diameter: req(K::ConeWireDiameter)?,
-            small_diameter: req(K::ConeSmallDiameter)?,
-            large_diameter: req(K::ConeLargeDiameter)?,
-            active_coils: req(K::ConeActiveCoils)?,
-            compressible_height: req(K::ConeCompressibleHeight)?,
-            shear_modulus: req(K::ConeShearModulus)?,
-        },
-        linear: Linear {
-            wire_diameter: req(K::LinearWireDiameter)?,
-            mean_diameter: req(K::LinearMeanDiameter)?,
-            active_coils: req(K::LinearActiveCoils)?,
-            shear_modulus: req(K::LinearShearModulus)?,
-            preload: get(K::LinearPreload)?,
-        },
-    };
+    }
     params.validate().map_err(|error| ParamFileError::Invalid {
         path: path.to_owned(),
         error,
@@ -176,28 +150,20 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
     Ok(params)
 }
 
-/// Writes `params` in MODEL.md's schema (full precision, round-trips through [`parse`]).
+/// Writes `params` in the schema (full precision, round-trips through [`parse`]).
 pub fn to_toml(params: &Params) -> String {
-    let c = &params.cone;
-    let l = &params.linear;
-    let mut s = format!(
-        "[cone]\nwire_diameter = {:?}\nsmall_diameter = {:?}\nlarge_diameter = {:?}\n\
-         active_coils = {:?}\ncompressible_height = {:?}\nshear_modulus = {:?}\n\n\
-         [linear]\nwire_diameter = {:?}\nmean_diameter = {:?}\nactive_coils = {:?}\n\
-         shear_modulus = {:?}\n",
-        c.wire_diameter,
-        c.small_diameter,
-        c.large_diameter,
-        c.active_coils,
-        c.compressible_height,
-        c.shear_modulus,
-        l.wire_diameter,
-        l.mean_diameter,
-        l.active_coils,
-        l.shear_modulus
-    );
-    if let Some(p) = l.preload {
-        s.push_str(&format!("preload = {p:?}\n"));
+    let mut s = String::new();
+    let mut section = "";
+    for key in ParamKey::ALL {
+        let Some(v) = key.get(params) else { continue };
+        if key.section() != section {
+            if !section.is_empty() {
+                s.push('\n');
+            }
+            section = key.section();
+            s.push_str(&format!("[{section}]\n"));
+        }
+        s.push_str(&format!("{} = {v:?}\n", key.name()));
     }
     s
 }

@@ -1,4 +1,4 @@
-//! The f64 twin of the core's patch solver: MODEL.md's standard patch, the reference law,
+//! The f64 twin of the core's patch solver: the standard patch of `docs/model.md`, the reference law,
 //! the paper's improved Euler (eqs. 21–22), and the same virtual coupling, written without
 //! the core's code so that tests can hold one against the other.
 //!
@@ -43,7 +43,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// MODEL.md's standard patch: `n × n` surface nodes (index `i·n + j`), then the base
+    /// the standard patch of `docs/model.md`: `n × n` surface nodes (index `i·n + j`), then the base
     /// layer (index `n² + i·n + j`); springs with both ends fixed are left out.
     pub fn standard(n: usize, spacing: f64) -> Mesh {
         let c = (n / 2) as f64;

@@ -1,4 +1,4 @@
-//! The MCCS law of MODEL.md in `f64`: the reference every other part is held to.
+//! The MCCS law of `docs/model.md` in `f64`: the reference every other part is held to.
 //!
 //! `Δ` (strain) as a function of the force `F` (N), its inverse `F(Δ)` and the tangent
 //! stiffness `dF/dΔ`. The nonlinear phase is written in `y = F^(1/3)`:

@@ -4,13 +4,13 @@
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinTx};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
 use embedded_hal_mock::eh1::spi::{Mock as SpiMock, Transaction as SpiTx};
-use mccs::as5047p::{self, decode, read_command, As5047p, EncoderConfig, Frame, ANGLECOM, ERRFL};
-use mccs::motor::{MotorConfig, PwmMotor};
-use mccs::one_dof::OneDofDevice;
-use mccs::{
-    Controller, Fault, Force, ForceTable64, HapticDevice, Length, Params, Solver, SolverConfig,
-    Topology,
+use mccs::{Force, ForceTable64, Length, Params, Solver, SolverConfig, Topology};
+use mccs_firmware::drivers::as5047p::{
+    self, decode, read_command, As5047p, EncoderConfig, Frame, ANGLECOM, ERRFL,
 };
+use mccs_firmware::drivers::pwm_motor::{MotorConfig, PwmMotor};
+use mccs_firmware::one_dof::OneDofDevice;
+use mccs_firmware::{Controller, Fault, HapticDevice};
 
 /// A response frame with even parity: data, or the error flag.
 fn frame(data: u16, error_flag: bool) -> u16 {

@@ -1,8 +1,8 @@
 //! The benchmark's floating-point comparator computes the same patch as the fixed-point
 //! solver (else its instruction counts would compare different work).
 
-use mccs::float_patch::FloatPatch;
 use mccs::{ForceTable64, Length, Params, Solver, SolverConfig, Topology};
+use mccs_firmware::float_patch::FloatPatch;
 
 #[test]
 fn float_comparators_track_the_fixed_point_solver() {

@@ -1,8 +1,10 @@
 //! The fixed-point patch solver against its f64 twin, and the twin against a static
 //! equilibrium solve: steady state, dynamics, energy, robustness.
 
-use mccs::spring::{Arith, Narrow, Wide};
-use mccs::{demo_path, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
+use mccs::{
+    Arith, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, SolverError, Topology, Wide,
+};
+use mccs_firmware::demo_path;
 use mccs_host::patch::{substeps, Mesh, Twin, TwinConfig, V};
 use mccs_host::reference::Reference;
 use nalgebra::{DMatrix, DVector};
@@ -151,7 +153,7 @@ fn springs_to_fixed_points_have_the_ground_as_b() {
         .unwrap();
     let e = t.edges()[0];
     assert_eq!((e.a, e.b), (n, mccs::topology::GROUND));
-    assert_eq!(e.dir, [0, 0, -(1 << mccs::topology::DIR_FRAC)]);
+    assert_eq!(e.dir, [0, 0, -(1 << mccs::units::DIR_FRAC)]);
 }
 
 /// The three indentations of the issue, each arithmetic: the twin against the static

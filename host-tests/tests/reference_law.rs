@@ -61,7 +61,7 @@ fn table2_derived_constants() {
     assert!(rel(r.f_t, 0.541172) < 1e-5, "F_T = {}", r.f_t);
     assert!(rel(r.f_c, 10.2622) < 1e-5, "F_C = {}", r.f_c);
     assert!(rel(s.k_p, 16.4206) < 1e-5, "k_p = {}", s.k_p);
-    // MODEL.md prints Δ(F_T) = 0.235268; its own formulas (F_T / k, and
+    // The starting spec printed Δ(F_T) = 0.235268; its own formulas (F_T / k, and
     // H (D1+D2)(D1²+D2²)/(4 D2³)) both give 0.2352539 (6e-5 apart: a typo there).
     assert!(rel(r.delta(r.f_t), 0.2352539) < 1e-6);
     assert!(rel(r.delta(r.f_t), r.f_t / r.k) < 1e-15);

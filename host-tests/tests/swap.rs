@@ -2,8 +2,9 @@
 //! under real concurrency (two threads, critical-section's std implementation), every tick
 //! runs wholly on the old set or wholly on a new one, never a mix.
 
-use mccs::demo::{self, SmallDemoController};
-use mccs::{ForceTable64, Mailbox, ParamSet, Params, Shared, Telemetry};
+use mccs::{ForceTable64, ParamSet, Params};
+use mccs_firmware::demo::{self, SmallDemoController};
+use mccs_firmware::{Mailbox, Shared, Telemetry};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 static SWAP: Mailbox<ParamSet<64>> = Mailbox::new();
@@ -16,9 +17,7 @@ fn a_tick_runs_on_one_whole_parameter_set() {
     let ctl: SmallDemoController = spec
         .controller(ForceTable64::new(&Params::TABLE2).unwrap())
         .unwrap();
-    let a = spec
-        .swapped_set::<5, 30, mccs::spring::DefaultArith>()
-        .unwrap();
+    let a = spec.swapped_set::<5, 30, mccs::DefaultArith>().unwrap();
     let b = ctl
         .solver()
         .prepare(*ctl.solver().table(), &spec.config())
@@ -54,7 +53,7 @@ fn a_tick_runs_on_one_whole_parameter_set() {
                 if let Some(s) = set {
                     solver.apply(s);
                 }
-                let p = mccs::HapticDevice::read_position(&mut device).unwrap();
+                let p = mccs_firmware::HapticDevice::read_position(&mut device).unwrap();
                 solver.step(p)
             })
             .collect();

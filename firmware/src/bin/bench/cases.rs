@@ -1,0 +1,193 @@
+//! The measured cases: one table evaluation, one spring, one substep of the standard
+//! patch (fixed point and floating point), and one tick of this core's demo.
+
+use super::fw_common::exit;
+use super::harness::Harness;
+use core::hint::black_box;
+use mccs::arith::ArithTable;
+use mccs::state::SpringEnds;
+use mccs::{
+    Arith, DefaultArith, Edge, ForceTable64, Length, Solver, SolverConfig, Strain, Topology,
+};
+use mccs_firmware::demo;
+use mccs_firmware::entry as e;
+use mccs_firmware::float_patch::{FloatPatch, Real};
+use mccs_firmware::target::CORE;
+
+/// `force_and_stiffness` over strains sweeping [−0.25, 0.75): both straight lines and
+/// the cubic part. The harness (the next strain, the black boxes) is measured alone and
+/// taken off. Out of line, like every case: its stack frame is gone before the next.
+#[inline(never)]
+pub fn force_and_stiffness(h: &Harness, table: &ForceTable64) -> u32 {
+    let mut k = 0i32;
+    let harness = h.measure(256, || {
+        k = k.wrapping_add(65_713);
+        let eps = Strain::from_bits((k & 0x00FF_FFFF) - 0x0040_0000);
+        black_box((black_box(table), eps));
+    });
+    let mut k = 0i32;
+    let fs = h.measure(256, || {
+        k = k.wrapping_add(65_713);
+        let eps = Strain::from_bits((k & 0x00FF_FFFF) - 0x0040_0000);
+        black_box(e::force_and_stiffness(black_box(table), eps));
+    });
+    fs - harness
+}
+
+/// The spring case's inputs (raw formats of `mccs::arith`).
+struct SpringCase {
+    edge: Edge,
+    ends: SpringEnds,
+    coeffs: <DefaultArith as Arith>::Coeffs,
+}
+
+/// A 4 mm spring along −z compressed by 2 mm (strain 0.5: the table's cubic part, the
+/// longest path), its ends moving, 1 N·s/m of damping (the default configuration).
+fn spring_case() -> SpringCase {
+    let cfg = SolverConfig::default();
+    SpringCase {
+        edge: Edge {
+            a: 1,
+            b: 2,
+            dir: [0, 0, -(1 << 29)],
+            inv_len: 1 << 29,
+        },
+        ends: SpringEnds {
+            ua: [0; 3],
+            ub: [1 << 20, -(1 << 20), 2 << 24],
+            va: [10, -20, 30],
+            vb: [0; 3],
+        },
+        coeffs: DefaultArith::coeffs(&mccs::arith::StepSpec {
+            h: 1.0 / 6000.0,
+            node_mass: cfg.node_mass,
+            node_damping: cfg.node_damping,
+            spring_damping: cfg.spring_damping,
+        }),
+    }
+}
+
+/// [`e::spring`]'s signature, and nothing but taking its arguments into registers
+/// (empty `asm!`) and returning zeros: the spring case's harness.
+#[inline(never)]
+fn no_spring(
+    table: &ArithTable<64, DefaultArith>,
+    coeffs: &<DefaultArith as Arith>::Coeffs,
+    edge: &Edge,
+    ends: &SpringEnds,
+    warm: &mut i32,
+) -> [i32; 3] {
+    // SAFETY: the template is a comment: nothing is read or written.
+    unsafe {
+        core::arch::asm!(
+            "/* {0} {1} {2} {3} {4} */",
+            in(reg) table,
+            in(reg) coeffs,
+            in(reg) edge,
+            in(reg) ends,
+            in(reg) warm,
+            options(nostack, preserves_flags)
+        );
+    }
+    [0; 3]
+}
+
+/// One spring (`spring_case`) through `e::spring`, less the same call to `no_spring`
+/// (the call, the arguments and the harness's black boxes).
+#[inline(never)]
+pub fn spring(h: &Harness, table: &ForceTable64) -> u32 {
+    let table = black_box(ArithTable::<64, DefaultArith>::new(*table));
+    let mut r = DefaultArith::REST;
+    let case = spring_case();
+    let harness = h.measure(256, || {
+        let c = black_box(&case);
+        black_box(no_spring(
+            black_box(&table),
+            &c.coeffs,
+            &c.edge,
+            &c.ends,
+            &mut r,
+        ));
+    });
+    let spring = h.measure(256, || {
+        let c = black_box(&case);
+        black_box(e::spring(
+            black_box(&table),
+            &c.coeffs,
+            &c.edge,
+            &c.ends,
+            &mut r,
+        ));
+    });
+    spring - harness
+}
+
+/// One substep of the standard N × N patch (2.5 mm, default configuration), after
+/// 200 ticks pressed in, averaged over 16.
+#[inline(never)]
+pub fn substep<const N: usize, const E: usize>(
+    h: &Harness,
+    n: usize,
+    table: &ForceTable64,
+    probe: [Length; 3],
+) -> u32 {
+    let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
+        exit(false)
+    };
+    let Ok(mut s) = Solver::new(topo, *table, &SolverConfig::default()) else {
+        exit(false)
+    };
+    for _ in 0..200 {
+        e::tick(&mut s, probe);
+    }
+    h.measure(16, || e::substep(&mut s, black_box(probe)))
+}
+
+/// One floating-point substep of the standard N × N patch, after 200 substeps pressed
+/// in, averaged over 4.
+#[inline(never)]
+pub fn float<T: Real, const N: usize, const E: usize>(
+    h: &Harness,
+    n: usize,
+    table: &ForceTable64,
+) -> u32 {
+    let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
+        exit(false)
+    };
+    let cfg = SolverConfig::default();
+    let Ok(substeps) = Solver::<N, E, 64>::substeps_for(&topo, table, &cfg) else {
+        exit(false)
+    };
+    let mut p = FloatPatch::<T, N, E, 64>::new(&topo, table, &cfg, substeps);
+    let probe = [T::ZERO, T::ZERO, T::of(-0.5)];
+    for _ in 0..200 {
+        float_substep(&mut p, probe);
+    }
+    h.measure(4, || float_substep(&mut p, black_box(probe)))
+}
+
+#[inline(never)]
+fn float_substep<T: Real, const N: usize, const E: usize>(
+    p: &mut FloatPatch<T, N, E, 64>,
+    probe: [T; 3],
+) {
+    p.substep(probe)
+}
+
+/// One tick of this core's demo configuration, pressed in, averaged over 4.
+#[inline(never)]
+pub fn tick(h: &Harness, table: &ForceTable64, probe: [Length; 3]) -> u32 {
+    let spec = demo::spec_for(CORE);
+    let Ok(topo) = Topology::<10, 61>::standard_patch(spec.grid, 2.5) else {
+        exit(false)
+    };
+    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
+        exit(false)
+    };
+    for _ in 0..200 {
+        e::tick(&mut s, probe);
+    }
+    h.measure(4, || {
+        black_box(e::tick(&mut s, black_box(probe)));
+    })
+}

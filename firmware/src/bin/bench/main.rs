@@ -1,0 +1,120 @@
+//! Instruction counts of the per-tick arithmetic, measured in QEMU under `-icount`:
+//! SysTick runs free (no interrupt) at the machine's clock, and is calibrated against a
+//! loop of known instruction count ([`harness`]); each case ([`cases`]) is averaged over
+//! repeated calls of an `#[inline(never)]` entry point (`mccs_firmware::entry`) with
+//! `black_box`ed inputs, less the cost of an empty call. Prints
+//! `BENCH core=<m4f|m3|m0> case=<name> instructions=<n>`, then checks this core's budgets
+//! ([`report`], `bench/budgets.txt`) and exits with failure on a breach.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("bench is firmware: run it in QEMU (scripts/bench.sh; see docs/performance.md)");
+    std::process::exit(2);
+}
+
+#[cfg(target_os = "none")]
+#[path = "../fw_common.rs"]
+mod fw_common;
+
+#[cfg(target_os = "none")]
+mod cases;
+#[cfg(target_os = "none")]
+mod harness;
+#[cfg(target_os = "none")]
+mod report;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use super::fw_common::exit;
+    use super::harness::Harness;
+    use super::report::{check_budgets, fits, Figures};
+    use super::{cases, harness};
+    use core::hint::black_box;
+    use cortex_m_rt::entry;
+    use mccs::{ForceTable64, Length, Solver};
+    use mccs_firmware::target::{Core, CORE};
+
+    static TABLE2: ForceTable64 = include!("../../../../tables/table2.rs");
+
+    #[entry]
+    fn main() -> ! {
+        let Some(cp) = cortex_m::Peripherals::take() else {
+            exit(false)
+        };
+        let h = harness::start(cp.SYST);
+        let mut figs = Figures::new();
+        defmt::info!("calibration: {=u32} counts per 1024 instructions", h.cpk);
+        let empty = h.measure(64, || {
+            black_box(0u32);
+        });
+        let table = black_box(TABLE2);
+        // These two take off their own harness (the empty call included).
+        figs.report(
+            "force_and_stiffness",
+            cases::force_and_stiffness(&h, &table),
+        );
+        figs.report("spring", cases::spring(&h, &table));
+        let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
+        let sub = |h: &Harness, n| match n {
+            3 => cases::substep::<2, 9>(h, 3, &table, probe),
+            4 => cases::substep::<5, 30>(h, 4, &table, probe),
+            5 => cases::substep::<10, 61>(h, 5, &table, probe),
+            6 => cases::substep::<17, 102>(h, 6, &table, probe),
+            7 => cases::substep::<26, 153>(h, 7, &table, probe),
+            _ => cases::substep::<37, 214>(h, 8, &table, probe),
+        };
+        figs.report("substep_n3", sub(&h, 3) - empty);
+        figs.report("substep_n4", sub(&h, 4) - empty);
+        figs.report("substep_n5", sub(&h, 5) - empty);
+        // Not on the M0: its 16 KiB hold neither these patches nor their figures.
+        if CORE != Core::M0 {
+            figs.report("substep_n6", sub(&h, 6) - empty);
+            figs.report("substep_n7", sub(&h, 7) - empty);
+            figs.report("substep_n8", sub(&h, 8) - empty);
+        }
+        // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
+        // in f64 (software everywhere).
+        figs.report(
+            "substep_n5_f32",
+            cases::float::<f32, 10, 61>(&h, 5, &table) - empty,
+        );
+        figs.report(
+            "substep_n5_f64",
+            cases::float::<f64, 10, 61>(&h, 5, &table) - empty,
+        );
+        if CORE != Core::M0 {
+            figs.report(
+                "substep_n8_f32",
+                cases::float::<f32, 37, 214>(&h, 8, &table) - empty,
+            );
+            figs.report(
+                "substep_n8_f64",
+                cases::float::<f64, 37, 214>(&h, 8, &table) - empty,
+            );
+        }
+        // One whole tick of this core's demo configuration, in contact.
+        figs.report("tick", cases::tick(&h, &table, probe) - empty);
+        let mem = [
+            ("solver_n4", core::mem::size_of::<Solver<5, 30, 64>>()),
+            ("solver_n5", core::mem::size_of::<Solver<10, 61, 64>>()),
+            ("solver_n8", core::mem::size_of::<Solver<37, 214, 64>>()),
+            ("table", core::mem::size_of::<ForceTable64>()),
+        ];
+        defmt::println!(
+            "MEM core={=str} solver_n4={=usize} solver_n5={=usize} solver_n8={=usize} table={=usize}",
+            CORE.name(),
+            mem[0].1,
+            mem[1].1,
+            mem[2].1,
+            mem[3].1
+        );
+        for (case, bytes) in mem {
+            figs.record(case, bytes as u32);
+        }
+        fits(&figs, &table);
+        let ok = check_budgets(&figs);
+        exit(ok)
+    }
+}

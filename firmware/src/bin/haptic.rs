@@ -1,0 +1,224 @@
+//! The haptic firmware: the MCCS patch solver in a 1 kHz SysTick interrupt, driving a
+//! simulated device that replays the demo probe path (see `mccs_firmware::demo`), logging with
+//! defmt. Runs in QEMU on `netduinoplus2` (Cortex-M4F, the default), `lm3s6965evb`
+//! (Cortex-M3) and `microbit` (Cortex-M0); see the README.
+//!
+//! - The tick interrupt owns the controller (solver + device). The main loop reads the
+//!   telemetry and hands over a new parameter set through a `Mailbox` (double buffer):
+//!   the tick switches between two ticks, never inside one.
+//! - A tick during which the next tick fell due (SysTick pending again when it ends) is
+//!   counted as an overrun. In QEMU under `-icount shift=N` time is instructions, so that
+//!   is a tick over its instruction budget (`DemoSpec::budget`).
+//! - A device error puts the controller in its safe state (zero force, latched).
+//! - A panic or a hard fault exits QEMU with failure through semihosting.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!(
+        "haptic is firmware: build it for a Cortex-M target, e.g. \
+         `cargo run -p mccs-firmware --release --target thumbv7em-none-eabihf --bin haptic` (see docs/firmware.md)"
+    );
+    std::process::exit(2);
+}
+
+#[cfg(target_os = "none")]
+mod fw_common;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use super::fw_common;
+    use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
+    use cortex_m_rt::{entry, exception};
+    use fw_common::exit;
+    use mccs::{DefaultArith, ForceTable64, ParamSet};
+    use mccs_firmware::demo::{self, DemoSpec};
+    use mccs_firmware::target::{Core, CORE};
+    use mccs_firmware::{Mailbox, Shared, Telemetry};
+
+    /// SysTick clock (the core clock as each QEMU machine models it).
+    const SYSTICK_HZ: u32 = match CORE {
+        Core::M4F => 168_000_000,
+        Core::M3 => 12_500_000,
+        Core::M0 => 16_000_000,
+    };
+    /// What this core runs (see `mccs_firmware::demo`).
+    const SPEC: DemoSpec = demo::spec_for(CORE);
+    /// The controller's capacities: the core's patch (N = 5 on the M4F, else N = 4, which
+    /// must fit the M0's 16 KiB of RAM).
+    const NODES: usize = if matches!(CORE, Core::M4F) { 10 } else { 5 };
+    const EDGES: usize = if matches!(CORE, Core::M4F) { 61 } else { 30 };
+    /// The controller type.
+    type Ctl = demo::DemoControllerOf<NODES, EDGES>;
+
+    /// Log every this many ticks (every 0.1 s).
+    const TRACE_EVERY: u32 = SPEC.tick_hz / 10;
+
+    /// The Table 2 force table, emitted by `mccs table` (no start-up build needed).
+    static TABLE2: ForceTable64 = include!("../../../tables/table2.rs");
+
+    /// What the tick's first run built.
+    #[derive(Clone, Copy)]
+    struct Info {
+        springs: usize,
+        substeps: u32,
+    }
+    static INFO: Shared<Info> = Shared::new(Info {
+        springs: 0,
+        substeps: 0,
+    });
+    static SWAP: Mailbox<ParamSet<64>> = Mailbox::new();
+    static TELEMETRY: Shared<Telemetry> = Shared::new(Telemetry::new());
+    /// The longest tick so far, SysTick counts.
+    static WORST_TICK: Shared<u32> = Shared::new(0);
+    /// SysTick counts per tick.
+    const PERIOD: u32 = SYSTICK_HZ / SPEC.tick_hz;
+
+    #[entry]
+    fn main() -> ! {
+        let Some(mut cp) = cortex_m::Peripherals::take() else {
+            fail("peripherals taken twice")
+        };
+        // The tick owns the controller: its first run builds it (the counter is still
+        // stopped, so nothing is timed yet), on the interrupt's stack.
+        SCB::set_pendst();
+        cortex_m::asm::isb();
+        let info = INFO.get();
+        if info.substeps == 0 {
+            fail("demo controller");
+        }
+        let swap_substeps = post_swap();
+        defmt::info!(
+            "mccs haptic demo: core={=str} tick={=u32} Hz, N={=usize} patch, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
+            SPEC.core,
+            SPEC.tick_hz,
+            SPEC.grid,
+            info.springs,
+            info.substeps,
+            swap_substeps,
+            SPEC.budget()
+        );
+
+        let syst = &mut cp.SYST;
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(PERIOD - 1);
+        syst.clear_current();
+        syst.enable_counter();
+        syst.enable_interrupt();
+
+        let mut next_trace = 0;
+        loop {
+            cortex_m::asm::wfi();
+            let t = TELEMETRY.get();
+            if t.ticks >= next_trace && t.ticks > 0 {
+                next_trace = t.ticks + TRACE_EVERY;
+                defmt::info!(
+                    "tick={=u32} force_n=({=f32}, {=f32}, {=f32})",
+                    t.ticks,
+                    t.force[0].to_num::<f32>(),
+                    t.force[1].to_num::<f32>(),
+                    t.force[2].to_num::<f32>()
+                );
+            }
+            if let Some(fault) = t.fault {
+                defmt::error!("safe state: {}", defmt::Debug2Format(&fault));
+            }
+            if t.ticks >= SPEC.ticks() {
+                syst.disable_interrupt();
+                // Counts → instructions under -icount: SYSTICK_HZ · 2^shift / 1e9 per one.
+                let per_instruction = SYSTICK_HZ as f32 * (1u32 << SPEC.icount_shift) as f32 / 1e9;
+                defmt::info!(
+                    "longest tick: {=u32} SysTick counts = {=f32} instructions under -icount shift={=u32} (budget {=u32})",
+                    WORST_TICK.get(),
+                    WORST_TICK.get() as f32 / per_instruction,
+                    SPEC.icount_shift,
+                    SPEC.budget()
+                );
+                defmt::println!(
+                    "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32}",
+                    t.ticks,
+                    t.overruns,
+                    t.max_force.to_num::<f32>(),
+                    t.steady_force.to_num::<f32>()
+                );
+                exit(t.fault.is_none());
+            }
+        }
+    }
+
+    #[exception]
+    fn SysTick() {
+        static mut CTL: Option<Ctl> = None;
+        let Some(ctl) = CTL.as_mut() else {
+            init(CTL);
+            return;
+        };
+        let ticks = ctl.telemetry().ticks;
+        if ticks >= SPEC.ticks() {
+            return;
+        }
+        #[cfg(feature = "panic-test")]
+        if ticks == 10 {
+            panic!("injected by the panic-test feature");
+        }
+        let start = SYST::get_current();
+        let pending_at_start = SCB::is_pendst_pending();
+        let swap = if ticks >= SPEC.swap_tick() {
+            SWAP.take()
+        } else {
+            None
+        };
+        ctl.tick(swap);
+        // The tick's own length in SysTick counts. The counter runs down from PERIOD − 1
+        // and reloads; it wrapped during the tick if it now reads higher, or if the next
+        // tick became pending meanwhile. (A tick that started late — the main loop held
+        // interrupts off — is not charged for that.) Longer than a period: an overrun. In
+        // QEMU under -icount, counts are instructions (SPEC.budget() per period).
+        let end = SYST::get_current();
+        let wrapped = end > start || (SCB::is_pendst_pending() && !pending_at_start);
+        let elapsed = start
+            .wrapping_sub(end)
+            .wrapping_add(if wrapped { PERIOD } else { 0 });
+        if elapsed > PERIOD {
+            ctl.note_overrun();
+        }
+        WORST_TICK.set(WORST_TICK.get().max(elapsed));
+        TELEMETRY.set(ctl.telemetry());
+    }
+
+    /// Builds the controller into the tick's slot. Out of line: its construction's stack
+    /// space is free again before the ticks start (the M0 has 16 KiB of RAM).
+    #[inline(never)]
+    fn init(slot: &mut Option<Ctl>) {
+        if SPEC.controller_into(TABLE2, slot).is_err() {
+            *slot = None;
+        }
+        if let Some(ctl) = slot {
+            INFO.set(Info {
+                springs: ctl.solver().topology().edges().len(),
+                substeps: ctl.solver().substeps(),
+            });
+        }
+    }
+
+    /// Builds the second parameter set in the main loop's context (software floating
+    /// point) and posts it for the tick, which switches to it between two ticks at
+    /// `SPEC.swap_tick()`. Returns its substeps. Out of line, like `init`.
+    #[inline(never)]
+    fn post_swap() -> u32 {
+        match SPEC.swapped_set::<NODES, EDGES, DefaultArith>() {
+            Ok(set) => {
+                let substeps = set.substeps();
+                let _ = SWAP.post(set);
+                substeps
+            }
+            Err(_) => fail("swapped parameter set"),
+        }
+    }
+
+    fn fail(what: &str) -> ! {
+        defmt::error!("start-up failed: {=str}", what);
+        exit(false)
+    }
+}

@@ -1,0 +1,169 @@
+//! `Controller`: one haptic tick end to end — device in, solver, device out — with the
+//! safe state and the run statistics the firmware reports.
+//!
+//! Safe state: any internal error (the device failing to read or to write) latches a
+//! [`Fault`]; from then on every tick writes zero force and nothing else, until reset by
+//! building a new controller.
+
+use crate::device::HapticDevice;
+use mccs::{Arith, DefaultArith, Force, ParamSet, Solver};
+
+/// Why the controller is in its safe state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// The device could not read the probe.
+    Read,
+    /// The device could not render the force.
+    Write,
+}
+
+impl Fault {
+    /// The message: one source for `Display` and the `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Read => "device read failed",
+            Self::Write => "device write failed",
+        }
+    }
+}
+
+impl core::fmt::Display for Fault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+/// What the tick publishes for the main loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Telemetry {
+    /// Ticks run.
+    pub ticks: u32,
+    /// The force rendered in the last tick, N.
+    pub force: [Force; 3],
+    /// The largest force on any axis so far, N (absolute value).
+    pub max_force: Force,
+    /// The force along `z` at the steady tick (see [`Controller::new`]), N.
+    pub steady_force: Force,
+    /// Ticks that overran their budget (counted by the firmware).
+    pub overruns: u32,
+    /// The safe state, if entered.
+    pub fault: Option<Fault>,
+    /// Parameter sets applied so far.
+    pub swaps: u32,
+}
+
+impl Telemetry {
+    /// Before the first tick.
+    pub const fn new() -> Self {
+        Self {
+            ticks: 0,
+            force: [Force::ZERO; 3],
+            max_force: Force::ZERO,
+            steady_force: Force::ZERO,
+            overruns: 0,
+            fault: None,
+            swaps: 0,
+        }
+    }
+}
+
+impl Default for Telemetry {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A solver driving a device.
+#[derive(Debug)]
+pub struct Controller<
+    D,
+    const NODES: usize,
+    const EDGES: usize,
+    const S: usize,
+    A: Arith = DefaultArith,
+> {
+    solver: Solver<NODES, EDGES, S, A>,
+    device: D,
+    steady_tick: u32,
+    telemetry: Telemetry,
+}
+
+impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
+    Controller<D, NODES, EDGES, S, A>
+{
+    /// A controller; the force along `z` at tick `steady_tick` (0-based) is recorded as
+    /// the steady force.
+    pub fn new(solver: Solver<NODES, EDGES, S, A>, device: D, steady_tick: u32) -> Self {
+        Self {
+            solver,
+            device,
+            steady_tick,
+            telemetry: Telemetry::new(),
+        }
+    }
+
+    /// One tick. `swap`, if given, is applied first, between this tick and the last.
+    /// Returns the force rendered.
+    pub fn tick(&mut self, swap: Option<ParamSet<S, A>>) -> [Force; 3] {
+        if let Some(set) = swap {
+            self.solver.apply(set);
+            self.telemetry.swaps = self.telemetry.swaps.saturating_add(1);
+        }
+        let force = match self.telemetry.fault {
+            Some(_) => [Force::ZERO; 3],
+            None => match self.device.read_position() {
+                Ok(probe) => self.solver.step(probe),
+                Err(_) => self.enter_safe_state(Fault::Read),
+            },
+        };
+        if self.device.write_force(force).is_err() && self.telemetry.fault.is_none() {
+            self.enter_safe_state(Fault::Write);
+            let _ = self.device.write_force([Force::ZERO; 3]);
+        }
+        let force = if self.telemetry.fault.is_some() {
+            [Force::ZERO; 3]
+        } else {
+            force
+        };
+        let t = &mut self.telemetry;
+        if t.ticks == self.steady_tick {
+            t.steady_force = force[2];
+        }
+        for f in force {
+            t.max_force = t.max_force.max(f.saturating_abs());
+        }
+        t.force = force;
+        t.ticks = t.ticks.saturating_add(1);
+        force
+    }
+
+    fn enter_safe_state(&mut self, fault: Fault) -> [Force; 3] {
+        self.telemetry.fault = Some(fault);
+        [Force::ZERO; 3]
+    }
+
+    /// Counts a tick that overran its budget.
+    pub fn note_overrun(&mut self) {
+        self.telemetry.overruns = self.telemetry.overruns.saturating_add(1);
+    }
+
+    /// The statistics so far.
+    pub fn telemetry(&self) -> Telemetry {
+        self.telemetry
+    }
+
+    /// The solver.
+    pub fn solver(&self) -> &Solver<NODES, EDGES, S, A> {
+        &self.solver
+    }
+
+    /// The device.
+    pub fn device(&self) -> &D {
+        &self.device
+    }
+
+    /// The solver and the device back.
+    pub fn into_parts(self) -> (Solver<NODES, EDGES, S, A>, D) {
+        (self.solver, self.device)
+    }
+}

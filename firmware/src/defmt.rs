@@ -1,0 +1,28 @@
+//! Every `defmt::Format` impl of the device layer, in one place (feature `defmt`).
+
+use crate::demo::DemoError;
+use crate::{Fault, PathError};
+use defmt::{write, Format, Formatter};
+
+impl Format for Fault {
+    fn format(&self, f: Formatter) {
+        write!(f, "{=str}", self.message())
+    }
+}
+
+impl Format for PathError {
+    fn format(&self, f: Formatter) {
+        write!(f, "{=str}", self.message())
+    }
+}
+
+impl Format for DemoError {
+    fn format(&self, f: Formatter) {
+        match self {
+            Self::Topology(e) => write!(f, "{}", e),
+            Self::Solver(e) => write!(f, "{}", e),
+            Self::Table(e) => write!(f, "{}", e),
+            Self::Path(e) => write!(f, "{}", e),
+        }
+    }
+}

@@ -1,0 +1,249 @@
+//! The demo run, shared by the firmware (`src/bin/haptic.rs`) and the host (`mccs demo`)
+//! so that both run exactly the same thing: the Table 2 spring on a standard 2.5 mm patch,
+//! the probe replaying [`demo_path`] (2 s: approach, press to 1.2 mm, hold, 2 mm stroke,
+//! release), and 1.25 s in a switch to a stiffer tissue ([`swapped_params`]: the cone's
+//! shear modulus × 1.25), built by the main loop and handed over through a
+//! [`Mailbox`](crate::mailbox::Mailbox). Each core runs the [`DemoSpec`] that fits its
+//! instruction budget.
+
+use crate::controller::Controller;
+use crate::device::SimulatedDevice;
+use crate::probe_path::{demo_path, PathError};
+use crate::target::Core;
+use mccs::{
+    Arith, ForceTable64, Narrow, ParamSet, Params, Solver, SolverConfig, SolverError, TableError,
+    Topology, TopologyError, Wide,
+};
+
+/// A demo configuration: what each core runs within its instruction budget.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DemoSpec {
+    /// `m4f`, `m3` or `m0`.
+    pub core: &'static str,
+    /// Tick rate, Hz.
+    pub tick_hz: u32,
+    /// Patch: N × N surface nodes at 2.5 mm.
+    pub grid: usize,
+    /// Haptic node mass, kg.
+    pub node_mass: f64,
+    /// Spring damping, N·s/m.
+    pub spring_damping: f64,
+    /// QEMU `-icount` shift: one instruction is 2^shift ns, which makes the emulated
+    /// instruction rate no faster than the real core at one instruction per cycle.
+    pub icount_shift: u32,
+    /// The core clock the budget stands for, Hz.
+    pub clock_hz: u32,
+}
+
+/// Cortex-M4F (STM32F405, 168 MHz): N = 5 at 1 kHz, 6 substeps per tick.
+/// Budget: 125,000 instructions per tick (`-icount shift=3`, 8 ns each).
+pub const M4F: DemoSpec = DemoSpec {
+    core: "m4f",
+    tick_hz: 1000,
+    grid: 5,
+    node_mass: 0.005,
+    spring_damping: 1.0,
+    icount_shift: 3,
+    clock_hz: 168_000_000,
+};
+
+/// Cortex-M3 (LM3S6965, 50 MHz): N = 4 at 1 kHz, 2 substeps per tick (heavier haptic
+/// masses and more damping). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
+pub const M3: DemoSpec = DemoSpec {
+    core: "m3",
+    tick_hz: 1000,
+    grid: 4,
+    node_mass: 0.03,
+    spring_damping: 3.0,
+    icount_shift: 5,
+    clock_hz: 50_000_000,
+};
+
+/// Cortex-M0 (48 MHz class): N = 4 at 1 kHz, 2 substeps per tick, the M3's
+/// configuration, in the narrow spring arithmetic ([`mccs::Narrow`]: the M0 has
+/// no 32 × 32 → 64 multiply). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
+pub const M0: DemoSpec = DemoSpec {
+    core: "m0",
+    tick_hz: 1000,
+    grid: 4,
+    node_mass: 0.03,
+    spring_damping: 3.0,
+    icount_shift: 5,
+    clock_hz: 48_000_000,
+};
+
+/// The spec for a core name.
+pub fn spec(core: &str) -> Option<DemoSpec> {
+    [M4F, M3, M0].into_iter().find(|s| s.core == core)
+}
+
+/// The spec for a core.
+pub const fn spec_for(core: Core) -> DemoSpec {
+    match core {
+        Core::M4F => M4F,
+        Core::M3 => M3,
+        Core::M0 => M0,
+    }
+}
+
+impl DemoSpec {
+    /// Ticks in the run (2 s).
+    pub const fn ticks(&self) -> u32 {
+        2 * self.tick_hz
+    }
+
+    /// The tick whose `z` force is the steady force: the end of the hold (t = 1.0 s).
+    pub const fn steady_tick(&self) -> u32 {
+        self.tick_hz - 1
+    }
+
+    /// The first tick on the swapped parameters (mid-stroke, t = 1.25 s).
+    pub const fn swap_tick(&self) -> u32 {
+        self.tick_hz * 5 / 4
+    }
+
+    /// Instructions one tick may take: `2^-shift` instructions per ns over the tick.
+    pub const fn budget(&self) -> u32 {
+        ((1_000_000_000u64 / self.tick_hz as u64) >> self.icount_shift) as u32
+    }
+
+    /// The solver configuration.
+    pub fn config(&self) -> SolverConfig {
+        SolverConfig {
+            tick_hz: self.tick_hz as f64,
+            node_mass: self.node_mass,
+            spring_damping: self.spring_damping,
+            ..SolverConfig::default()
+        }
+    }
+
+    /// The demo controller, starting from `table` (Table 2's). Out of line, like the
+    /// other start-up builders, so that small-RAM cores do not pay for their stack
+    /// frames at once.
+    pub fn controller<const N: usize, const E: usize, A: Arith>(
+        &self,
+        table: ForceTable64,
+    ) -> Result<Controller<DemoDevice, N, E, 64, A>, DemoError> {
+        let mut slot = None;
+        self.controller_into(table, &mut slot)?;
+        slot.ok_or(DemoError::Path(PathError::Count))
+    }
+
+    /// [`Self::controller`], built straight into `slot` (fewer copies on the stack).
+    #[inline(never)]
+    pub fn controller_into<const N: usize, const E: usize, A: Arith>(
+        &self,
+        table: ForceTable64,
+        slot: &mut Option<Controller<DemoDevice, N, E, 64, A>>,
+    ) -> Result<(), DemoError> {
+        let topo = Topology::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
+        let device = SimulatedDevice::new(demo_path(self.tick_hz).map_err(DemoError::Path)?);
+        let solver = Solver::with_arith(topo, table, &self.config(), A::default())
+            .map_err(DemoError::Solver)?;
+        *slot = Some(Controller::new(solver, device, self.steady_tick()));
+        Ok(())
+    }
+
+    /// The swapped parameter set for this spec's patch (software floating point: for the
+    /// main loop, not the tick).
+    #[inline(never)]
+    pub fn swapped_set<const N: usize, const E: usize, A: Arith>(
+        &self,
+    ) -> Result<ParamSet<64, A>, DemoError> {
+        let topo =
+            Topology::<N, E>::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
+        let table = ForceTable64::new(&swapped_params()).map_err(DemoError::Table)?;
+        Solver::<N, E, 64, A>::prepare_for(&topo, table, &self.config()).map_err(DemoError::Solver)
+    }
+}
+
+/// Grid spacing of the demo patch, mm.
+pub const SPACING: f64 = 2.5;
+
+/// The demo's device.
+pub type DemoDevice = SimulatedDevice<7>;
+/// A demo controller in this core's arithmetic with capacity for `NODES` node slots
+/// (the ground included) and `EDGES` springs.
+pub type DemoControllerOf<const NODES: usize, const EDGES: usize> =
+    Controller<DemoDevice, NODES, EDGES, 64>;
+/// A demo controller with capacity for N = 5 (9 free nodes + ground, 61 springs).
+pub type DemoController = DemoControllerOf<10, 61>;
+/// A demo controller with capacity for N = 4 (4 free nodes + ground, 30 springs): the
+/// M3 and M0 demos, which must fit 16 KiB of RAM on the M0.
+pub type SmallDemoController = DemoControllerOf<5, 30>;
+
+/// The tissue switched to mid-run: Table 2 with the cone's shear modulus × 1.25.
+pub fn swapped_params() -> Params {
+    let mut p = Params::TABLE2;
+    p.cone.shear_modulus *= 1.25;
+    p
+}
+
+/// Why the demo could not start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DemoError {
+    /// The patch.
+    Topology(TopologyError),
+    /// The solver or a parameter set.
+    Solver(SolverError),
+    /// The swapped table.
+    Table(TableError),
+    /// The probe path.
+    Path(PathError),
+}
+
+impl core::fmt::Display for DemoError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Topology(e) => e.fmt(f),
+            Self::Solver(e) => e.fmt(f),
+            Self::Table(e) => e.fmt(f),
+            Self::Path(e) => e.fmt(f),
+        }
+    }
+}
+
+/// What a demo run ends with (the firmware's SUMMARY line).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Summary {
+    /// Ticks run.
+    pub ticks: u32,
+    /// Ticks over budget.
+    pub overruns: u32,
+    /// Largest force on any axis, N.
+    pub max_force: f32,
+    /// Force along z at the steady tick, N.
+    pub steady_force: f32,
+}
+
+/// Runs the whole demo on the host (no overruns: nothing is timed), with the swap handed
+/// over at [`DemoSpec::swap_tick`] exactly as the firmware does, in the arithmetic of the
+/// spec's core ([`mccs::Narrow`] for the M0).
+pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
+    if spec.core == "m0" {
+        run_on_host_in::<Narrow>(spec)
+    } else {
+        run_on_host_in::<Wide>(spec)
+    }
+}
+
+fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
+    static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
+    let mut ctl: Controller<DemoDevice, 10, 61, 64, A> = spec.controller(TABLE2)?;
+    let mut swap = Some(spec.swapped_set::<10, 61, A>()?);
+    for tick in 0..spec.ticks() {
+        let s = if tick >= spec.swap_tick() {
+            swap.take()
+        } else {
+            None
+        };
+        ctl.tick(s);
+    }
+    let t = ctl.telemetry();
+    Ok(Summary {
+        ticks: t.ticks,
+        overruns: t.overruns,
+        max_force: t.max_force.to_num(),
+        steady_force: t.steady_force.to_num(),
+    })
+}

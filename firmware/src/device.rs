@@ -1,0 +1,60 @@
+//! `HapticDevice`: what the tick needs of the hardware — read the probe, write the force —
+//! and `SimulatedDevice`, which replays a [`ProbePath`] for QEMU and the host tests.
+
+use crate::probe_path::ProbePath;
+use mccs::{Force, Length};
+
+/// A haptic device: probe position in, force out (patch frame, mm and N).
+pub trait HapticDevice {
+    /// A device failure (the controller then goes to its safe state).
+    type Error;
+    /// The probe position now.
+    fn read_position(&mut self) -> Result<[Length; 3], Self::Error>;
+    /// Renders `force` on the probe until the next call.
+    fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error>;
+}
+
+/// A device that replays a probe path, one waypoint tick per read, and keeps the last
+/// force written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SimulatedDevice<const K: usize> {
+    path: ProbePath<K>,
+    tick: u32,
+    last_force: [Force; 3],
+}
+
+impl<const K: usize> SimulatedDevice<K> {
+    /// Replays `path` from its first waypoint.
+    pub fn new(path: ProbePath<K>) -> Self {
+        Self {
+            path,
+            tick: 0,
+            last_force: [Force::ZERO; 3],
+        }
+    }
+
+    /// The last force written.
+    pub fn last_force(&self) -> [Force; 3] {
+        self.last_force
+    }
+
+    /// Ticks read so far.
+    pub fn ticks(&self) -> u32 {
+        self.tick
+    }
+}
+
+impl<const K: usize> HapticDevice for SimulatedDevice<K> {
+    type Error = core::convert::Infallible;
+
+    fn read_position(&mut self) -> Result<[Length; 3], Self::Error> {
+        let p = self.path.at(self.tick);
+        self.tick = self.tick.saturating_add(1);
+        Ok(p)
+    }
+
+    fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error> {
+        self.last_force = force;
+        Ok(())
+    }
+}

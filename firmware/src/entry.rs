@@ -1,0 +1,48 @@
+//! Out-of-line entry points into the per-tick arithmetic, so that a benchmark can count
+//! the instructions of exactly one call (QEMU `-icount`, or DWT on hardware). They add
+//! nothing but the call itself.
+
+use mccs::arith::ArithTable;
+use mccs::state::SpringEnds;
+use mccs::{Arith, DefaultArith, Edge, Force, ForceTable64, Length, Solver, Stiffness, Strain};
+
+/// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
+#[inline(never)]
+pub fn force_and_stiffness(table: &ForceTable64, strain: Strain) -> (Force, Stiffness) {
+    table.force_and_stiffness(strain)
+}
+
+/// One [`ForceTable64::force`] evaluation, never inlined.
+#[inline(never)]
+pub fn force(table: &ForceTable64, strain: Strain) -> Force {
+    table.force(strain)
+}
+
+/// One spring update (law + damping + Newton step) in this core's arithmetic
+/// ([`DefaultArith`]), never inlined; the end states are read through one reference, as
+/// the solver reads them from its nodes. Raw formats as in [`mccs::arith`].
+#[inline(never)]
+pub fn spring(
+    table: &ArithTable<64, DefaultArith>,
+    coeffs: &<DefaultArith as Arith>::Coeffs,
+    edge: &Edge,
+    ends: &SpringEnds,
+    warm: &mut i32,
+) -> [i32; 3] {
+    DefaultArith::spring(table, coeffs, edge, ends, warm)
+}
+
+/// One substep of a solver with the probe held at `probe`, never inlined.
+#[inline(never)]
+pub fn substep<const N: usize, const E: usize>(solver: &mut Solver<N, E, 64>, probe: [Length; 3]) {
+    solver.substep_probe(probe)
+}
+
+/// One tick of a solver, never inlined.
+#[inline(never)]
+pub fn tick<const N: usize, const E: usize>(
+    solver: &mut Solver<N, E, 64>,
+    probe: [Length; 3],
+) -> [Force; 3] {
+    solver.step(probe)
+}

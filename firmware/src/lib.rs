@@ -1,0 +1,39 @@
+//! # mccs-firmware — the device layer and the firmware around the `mccs` core
+//!
+//! What a controller needs beyond the model and the solver (`mccs`), kept apart from
+//! them so that the core builds for every target without any of it:
+//!
+//! - [`device`]: [`HapticDevice`](device::HapticDevice), what the tick needs of the
+//!   hardware, and the [`SimulatedDevice`](device::SimulatedDevice) replaying a
+//!   [`ProbePath`](probe_path::ProbePath);
+//! - [`drivers`]: the AS5047P SPI encoder and the PWM motor (embedded-hal 1.0), and
+//!   [`one_dof`], a 1-DOF device made of the two;
+//! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
+//!   buffer between the main loop and the tick interrupt;
+//! - [`demo`]: the demo run shared by the QEMU firmware and the host (`mccs demo`);
+//! - [`entry`], [`float_patch`]: what the instruction-count bench calls.
+//!
+//! The bins (`src/bin/`) are thin and build only for `target_os = "none"`: `haptic`, the
+//! demo firmware, and `bench`, the instruction counts. `docs/architecture.md` draws the
+//! layers; `docs/firmware.md` is the firmware engineer's guide.
+#![cfg_attr(not(test), no_std)]
+#![deny(missing_docs)]
+
+pub mod controller;
+pub mod demo;
+pub mod device;
+pub mod drivers;
+pub mod entry;
+pub mod float_patch;
+pub mod mailbox;
+pub mod one_dof;
+pub mod probe_path;
+pub mod target;
+
+#[cfg(feature = "defmt")]
+mod defmt;
+
+pub use controller::{Controller, Fault, Telemetry};
+pub use device::{HapticDevice, SimulatedDevice};
+pub use mailbox::{Mailbox, Shared};
+pub use probe_path::{demo_path, PathError, ProbePath, Waypoint};

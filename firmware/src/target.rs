@@ -1,0 +1,36 @@
+//! Which Cortex-M core this build is for, told by standard target cfgs (no build-script
+//! cfg): a hard-float ABI (`thumbv7em-none-eabihf`) is the Cortex-M4F; a target without
+//! a 32 × 32 → 64 multiply ([`mccs::q::HAS_LONG_MULTIPLY`]: `thumbv6m-none-eabi`) the
+//! Cortex-M0; any other (`thumbv7m-none-eabi`) the Cortex-M3. On a host the answer is
+//! [`Core::M3`] and means nothing.
+
+/// A core the demo and the bench know.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Core {
+    /// Cortex-M4F (`thumbv7em-none-eabihf`), the default controller.
+    M4F,
+    /// Cortex-M3 (`thumbv7m-none-eabi`).
+    M3,
+    /// Cortex-M0 (`thumbv6m-none-eabi`).
+    M0,
+}
+
+impl Core {
+    /// `m4f`, `m3` or `m0`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::M4F => "m4f",
+            Self::M3 => "m3",
+            Self::M0 => "m0",
+        }
+    }
+}
+
+/// The core of this build.
+pub const CORE: Core = if cfg!(target_abi = "eabihf") {
+    Core::M4F
+} else if !mccs::q::HAS_LONG_MULTIPLY {
+    Core::M0
+} else {
+    Core::M3
+};

@@ -1,0 +1,104 @@
+//! `mccs curve`: the law `F(ε)` and `dF/dε` on a strain grid, from the reference or from
+//! the fixed-point table.
+
+use super::table::{table, with_table};
+
+use super::{arg_error, file_error, fmt_strain, io_error, Backend, CliError};
+use crate::paramfile;
+use crate::reference::Reference;
+use mccs::{ForceTable, Strain};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Largest number of rows `curve` prints.
+pub const MAX_ROWS: usize = 10_000_000;
+
+#[derive(clap::Args, Debug)]
+pub(super) struct Args {
+    /// Parameter file (the TOML schema of docs/model.md).
+    #[arg(long)]
+    params: PathBuf,
+    /// First strain (may be negative: tension).
+    #[arg(long, allow_negative_numbers = true)]
+    from: f64,
+    /// Last strain (inclusive when reached).
+    #[arg(long, allow_negative_numbers = true)]
+    to: f64,
+    /// Strain step, > 0.
+    #[arg(long, allow_negative_numbers = true)]
+    step: f64,
+    /// Evaluation backend.
+    #[arg(long, value_enum, default_value_t = Backend::Reference)]
+    backend: Backend,
+    /// Knots of the fixed-point table (17, 33, 65 or 129; `--backend fixed` only).
+    #[arg(long, default_value_t = 65)]
+    knots: usize,
+}
+
+pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
+    let p = paramfile::read(&a.params)?;
+    let strains = strain_grid(a.from, a.to, a.step)?;
+    let rows = match a.backend {
+        Backend::Reference => {
+            let r = Reference::new(&p).map_err(|e| file_error(&a.params, e))?;
+            strains
+                .iter()
+                .map(|&e| (e, r.force(e), r.stiffness(e)))
+                .collect::<Vec<_>>()
+        }
+        Backend::Fixed => {
+            with_table!(a.knots, &p, &a.params, mccs::table::DEFAULT_DOMAIN, |t| {
+                fixed_curve(&t, &strains)
+            })
+        }
+    };
+    write_curve(out, &rows)
+}
+
+/// The strains `from + i·step ≤ to`, validated.
+pub fn strain_grid(from: f64, to: f64, step: f64) -> Result<Vec<f64>, CliError> {
+    for (name, v) in [("--from", from), ("--to", to), ("--step", step)] {
+        if !v.is_finite() {
+            return Err(arg_error(name, "must be a finite number"));
+        }
+    }
+    if step <= 0.0 {
+        return Err(arg_error("--step", "must be > 0"));
+    }
+    if to < from {
+        return Err(arg_error("--to", "must be >= --from"));
+    }
+    let count = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    if count > MAX_ROWS as f64 {
+        return Err(arg_error("--step", "too small: more than 10,000,000 rows"));
+    }
+    // Rounded to 12 decimals, so that the printed strain is the one evaluated.
+    Ok((0..count as usize)
+        .map(|i| {
+            let e = from + i as f64 * step;
+            fmt_strain(e).parse().unwrap_or(e)
+        })
+        .collect())
+}
+
+fn fixed_curve<const S: usize>(t: &ForceTable<S>, strains: &[f64]) -> Vec<(f64, f64, f64)> {
+    strains
+        .iter()
+        .map(|&e| {
+            let (f, k) = t.force_and_stiffness(Strain::saturating_from_num(e));
+            (e, f.to_num::<f64>(), k.to_num::<f64>())
+        })
+        .collect()
+}
+
+fn write_curve(out: &mut dyn Write, rows: &[(f64, f64, f64)]) -> Result<(), CliError> {
+    let mut w = csv::Writer::from_writer(out);
+    let err = |e: csv::Error| CliError(format!("stdout: {e}"));
+    w.write_record(["strain", "force_n", "stiffness_n"])
+        .map_err(err)?;
+    for (e, f, k) in rows {
+        w.write_record([fmt_strain(*e), f.to_string(), k.to_string()])
+            .map_err(err)?;
+    }
+    w.flush().map_err(io_error)
+}

@@ -1,0 +1,119 @@
+//! The `mccs` command-line tool: one module per subcommand, each owning its arguments
+//! (`clap::Args`) and its run. Every failure is a [`CliError`]: one line, exit status 2.
+
+use crate::paramfile;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::io::Write;
+use std::path::Path;
+
+mod curve;
+mod demo;
+mod fit;
+mod patch;
+mod table;
+
+pub use demo::{parse_summary, FirmwareSummary};
+pub use patch::{reference_max_stiffness, PatchRun};
+pub use table::render_table;
+
+/// One-line error for the user; the process exits with status 2.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CliError(pub String);
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl From<paramfile::ParamFileError> for CliError {
+    fn from(e: paramfile::ParamFileError) -> Self {
+        CliError(e.to_string())
+    }
+}
+
+/// `ARG: what`.
+pub(crate) fn arg_error(arg: &str, what: &str) -> CliError {
+    CliError(format!("{arg}: {what}"))
+}
+
+/// `FILE: what`, for a parameter file whose values break a rule.
+pub(crate) fn file_error(file: &Path, e: impl std::fmt::Display) -> CliError {
+    CliError(format!("{}: {e}", file.display()))
+}
+
+/// A failure writing the output.
+pub(crate) fn io_error(e: std::io::Error) -> CliError {
+    CliError(format!("stdout: {e}"))
+}
+
+/// Multi-component conical spring soft tissue: curves, tables and patch runs.
+#[derive(Parser, Debug)]
+#[command(name = "mccs", version)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// How a force is evaluated.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// The f64 reference law (host only).
+    Reference,
+    /// The no_std core's fixed-point table, as the firmware evaluates it.
+    Fixed,
+}
+
+/// The fixed-point solver's arithmetic (`mccs::arith`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArithArg {
+    /// 32 × 32 → 64 products: the M3/M4F firmware.
+    Wide,
+    /// One 16-bit operand per product: the M0 firmware.
+    Narrow,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print F(ε) and dF/dε as CSV `strain,force_n,stiffness_n` for ε = FROM, FROM+STEP, … ≤ TO.
+    Curve(curve::Args),
+    /// Emit the fixed-point force table as Rust source for `include!`.
+    Table(table::Args),
+    /// Fit models to compression data (CSV `strain,force_n`) and compare them: one line
+    /// `FIT model=<name> mean_abs=<f> max_abs=<f> mse=<f>` per model.
+    Fit(fit::Args),
+    /// Print the shipped synthetic demo data set (`params/demo-data.csv`): the Table 2
+    /// MCCS law at 40 forces to 1 N, strains with 1 % Gaussian noise (seed 2020).
+    DemoData,
+    /// Run the firmware's demo on the host (the same code, fixed point) and print its
+    /// SUMMARY line; with `--check LOG`, compare a firmware log's SUMMARY line with it.
+    Demo(demo::Args),
+    /// Indent the standard patch: ramp the contact node down to DEPTH over the first half
+    /// of the run, hold it there, and print CSV `time_s,reaction_n` per tick.
+    Patch(patch::Args),
+}
+
+/// Runs the parsed command, writing its output to `out`.
+pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
+    match cli.command {
+        Command::Curve(a) => curve::run(a, out),
+        Command::Table(a) => table::run(a, out),
+        Command::Fit(a) => fit::run(a, out),
+        Command::DemoData => out
+            .write_all(crate::fit::to_csv(&crate::fit::demo_data()).as_bytes())
+            .map_err(io_error),
+        Command::Demo(a) => demo::run(a, out),
+        Command::Patch(a) => patch::run(a, out),
+    }
+}
+
+/// A grid strain with the float noise of `from + i·step` removed (12 decimals at most).
+pub(crate) fn fmt_strain(e: f64) -> String {
+    let s = format!("{e:.12}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}

@@ -1,0 +1,209 @@
+//! `docs/architecture.md` against the code: every module of the core and of the firmware
+//! crate has a row, every row names a module that exists, each module imports only what
+//! its row allows, and the modules' imports form no circle.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The rows of the module table under `heading`: module → the sibling modules it may
+/// import (`None`: any, the row says it formats other types).
+fn rows(doc: &str, heading: &str) -> BTreeMap<String, Option<BTreeSet<String>>> {
+    let section = doc
+        .split("\n## ")
+        .find(|s| s.starts_with(heading))
+        .unwrap_or_else(|| panic!("docs/architecture.md: no section {heading}"));
+    let mut out = BTreeMap::new();
+    for line in section.lines().filter(|l| l.starts_with("| `")) {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let (first, last) = (cells[1], cells[cells.len() - 2]);
+        let allowed = if last.contains("the types it formats") {
+            None
+        } else {
+            Some(
+                last.split('`')
+                    .skip(1)
+                    .step_by(2)
+                    .map(|m| m.split("::").next().unwrap_or(m).to_string())
+                    .collect(),
+            )
+        };
+        for name in first.split('`').skip(1).step_by(2) {
+            let module = name
+                .trim_start_matches("bin/")
+                .split(['/', '.'])
+                .next()
+                .unwrap_or(name);
+            out.insert(module.to_string(), allowed.clone());
+        }
+    }
+    out
+}
+
+/// Every `.rs` file under `dir`.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// The top-level modules a file refers to through `crate::…` (in `use` lists too).
+fn imports(text: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    let code: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut rest = code.as_str();
+    while let Some(i) = rest.find("crate::") {
+        rest = &rest[i + 7..];
+        if let Some(list) = rest.strip_prefix('{') {
+            let end = list.find('}').unwrap_or(list.len());
+            for item in list[..end].split(',') {
+                let m: String = item
+                    .trim()
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !m.is_empty() {
+                    out.insert(m);
+                }
+            }
+        } else {
+            let m: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            out.insert(m);
+        }
+    }
+    out
+}
+
+/// Checks one crate's `src` against its section; returns its module graph.
+fn check_crate(src: &Path, heading: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let doc = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let table = rows(&doc, heading);
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for f in files(src) {
+        let rel = f.strip_prefix(src).unwrap();
+        let first = rel
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_string_lossy();
+        if first == "lib.rs" {
+            continue;
+        }
+        let module = first
+            .trim_start_matches("bin")
+            .trim_end_matches(".rs")
+            .to_string();
+        let module = if module.is_empty() {
+            // A bin: its own file or folder name.
+            let name = rel
+                .components()
+                .nth(1)
+                .unwrap()
+                .as_os_str()
+                .to_string_lossy();
+            name.trim_end_matches(".rs").to_string()
+        } else {
+            module
+        };
+        let allowed = table.get(&module).unwrap_or_else(|| {
+            panic!(
+                "{}: no row for module `{module}` in docs/architecture.md ({heading})",
+                f.display()
+            )
+        });
+        let text = std::fs::read_to_string(&f).unwrap();
+        let deps: BTreeSet<String> = imports(&text)
+            .into_iter()
+            .filter(|m| *m != module && table.contains_key(m))
+            .collect();
+        if let Some(allowed) = allowed {
+            for d in &deps {
+                assert!(
+                    allowed.contains(d),
+                    "{}: imports `{d}`, which its row in docs/architecture.md does not allow",
+                    f.display()
+                );
+            }
+        }
+        graph.entry(module).or_default().extend(deps);
+    }
+    for module in table.keys() {
+        assert!(
+            graph.contains_key(module),
+            "docs/architecture.md ({heading}): `{module}` names no module under {}",
+            src.display()
+        );
+    }
+    graph
+}
+
+/// A circle in `graph`, if there is one.
+fn circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        n: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == n) {
+            return Some(path[i..].to_vec());
+        }
+        if done.contains(n) {
+            return None;
+        }
+        path.push(n.to_string());
+        for d in graph.get(n).into_iter().flatten() {
+            if let Some(c) = visit(d, graph, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(n.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    graph
+        .keys()
+        .find_map(|n| visit(n, graph, &mut Vec::new(), &mut done))
+}
+
+#[test]
+fn the_core_matches_its_drawing_and_has_no_circle() {
+    let graph = check_crate(&root().join("src"), "The core");
+    assert_eq!(circle(&graph), None, "import circle in the core");
+}
+
+#[test]
+fn the_firmware_crate_matches_its_drawing_and_has_no_circle() {
+    let graph = check_crate(&root().join("firmware/src"), "The device layer");
+    assert_eq!(circle(&graph), None, "import circle in the firmware crate");
+}
+
+#[test]
+fn the_circle_finder_finds_circles() {
+    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    g.entry("a".into()).or_default().insert("b".into());
+    g.entry("b".into()).or_default().insert("c".into());
+    g.entry("c".into()).or_default();
+    assert_eq!(circle(&g), None);
+    g.entry("c".into()).or_default().insert("a".into());
+    assert!(circle(&g).is_some());
+}

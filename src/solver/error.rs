@@ -1,0 +1,54 @@
+//! [`SolverError`]: why a solver or a parameter set could not be built.
+
+use super::ConfigKey;
+
+/// Why a solver could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverError {
+    /// A configuration value is out of its range (see [`crate::SolverConfig`]).
+    Config(ConfigKey),
+    /// No damping at all: the improved Euler step is unstable at any step size.
+    NoDamping,
+    /// The stability bound needs more substeps per tick than `max_substeps`.
+    TooManySubsteps {
+        /// Substeps the bound asks for (saturated at `u32::MAX`).
+        needed: u32,
+    },
+    /// The topology has no contact node.
+    NoContact,
+}
+
+impl core::fmt::Display for SolverError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Config(k) => write!(f, "{k}: {}", self.message()),
+            Self::TooManySubsteps { needed } => {
+                write!(
+                    f,
+                    "max_substeps: stability needs {needed} substeps per tick ({})",
+                    self.message()
+                )
+            }
+            other => f.write_str(other.message()),
+        }
+    }
+}
+
+impl SolverError {
+    /// The message without its values (see `Display`): one source for `Display` and the
+    /// `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Config(_) => "out of range",
+            Self::NoDamping => {
+                "spring_damping/node_damping: the improved Euler integrator needs damping"
+            }
+            Self::TooManySubsteps { .. } => {
+                "raise max_substeps, the node mass or the damping, or lower the tick rate"
+            }
+            Self::NoContact => "topology: no contact node",
+        }
+    }
+}
+
+impl core::error::Error for SolverError {}

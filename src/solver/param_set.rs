@@ -1,0 +1,97 @@
+//! [`ParamSet`]: a force table with the substeps and coefficients it needs on a given
+//! topology and configuration, prepared away from the tick and switched in between two.
+
+use super::{stability, Solver, SolverConfig, SolverError};
+use crate::arith::{Arith, ArithTable, DefaultArith, StepSpec};
+use crate::coupling::CouplingQ;
+use crate::table::ForceTable;
+use crate::topology::Topology;
+
+/// The fixed-point coefficients derived from a [`SolverConfig`] and the substep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Coeffs<A: Arith> {
+    /// The arithmetic's: spring damping and integrator.
+    pub arith: A::Coeffs,
+    /// Tick rate, Hz (for the probe velocity).
+    pub tick_hz: i32,
+    pub coupling: CouplingQ,
+}
+
+/// A force table with the substeps and coefficients it needs on a given topology and
+/// configuration: built by [`Solver::prepare`] (start-up or main loop, `f64`), switched in
+/// by [`Solver::apply`] between two ticks (a few moves). `A`: the arithmetic of the
+/// solver it is for (its coefficients differ).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParamSet<const S: usize, A: Arith = DefaultArith> {
+    pub(crate) table: ArithTable<S, A>,
+    pub(crate) substeps: u32,
+    pub(crate) c: Coeffs<A>,
+}
+
+impl<const S: usize, A: Arith> ParamSet<S, A> {
+    /// The table.
+    pub fn table(&self) -> &ForceTable<S> {
+        &self.table.table
+    }
+
+    /// Substeps per tick.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
+    /// Prepares a parameter set for this solver's topology: the table, the substeps the
+    /// stability bound asks for with it, and the fixed-point coefficients.
+    pub fn prepare(
+        &self,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<ParamSet<S, A>, SolverError> {
+        Self::prepare_for(&self.topo, table, config)
+    }
+
+    /// Switches to a prepared parameter set; the state (positions, velocities) is kept.
+    pub fn apply(&mut self, set: ParamSet<S, A>) {
+        self.table = set.table;
+        self.substeps = set.substeps;
+        self.c = set.c;
+    }
+
+    /// [`Solver::prepare`] for a topology without a solver (e.g. in another context than
+    /// the one owning the solver).
+    #[inline(never)]
+    pub fn prepare_for(
+        topo: &Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<ParamSet<S, A>, SolverError> {
+        let substeps = stability::substeps_for(topo, &table, config)?;
+        let h = 1.0 / (config.tick_hz * substeps as f64);
+        let c = Coeffs {
+            arith: A::coeffs(&StepSpec {
+                h,
+                node_mass: config.node_mass,
+                node_damping: config.node_damping,
+                spring_damping: config.spring_damping,
+            }),
+            tick_hz: config.tick_hz as i32,
+            coupling: CouplingQ::new(&config.coupling),
+        };
+        Ok(ParamSet {
+            table: ArithTable::new(table),
+            substeps,
+            c,
+        })
+    }
+
+    /// Checks `config` and returns the substeps per tick the stability bound asks for
+    /// (see [`stability`]).
+    pub fn substeps_for(
+        topo: &Topology<NODES, EDGES>,
+        table: &ForceTable<S>,
+        config: &SolverConfig,
+    ) -> Result<u32, SolverError> {
+        stability::substeps_for(topo, table, config)
+    }
+}

@@ -1,0 +1,358 @@
+//! Building a [`ForceTable`] from the `f64` law (start-up or host; never per tick): the
+//! grid ([`Grid::place`]), the knots ([`Grid::knot`]), the segments' cubics
+//! ([`hermite`]), the coefficients' unit ([`coefficient_shift`]), the stiffness scale
+//! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
+
+use super::{ForceTable, RawTable, TableError, DEFAULT_DOMAIN};
+use crate::law::Law;
+use crate::params::Params;
+use crate::units::{checked_from_f64, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
+
+impl<const S: usize> ForceTable<S> {
+    /// Builds the table for `params` over the default domain [−0.5, 0.95].
+    pub fn new(params: &Params) -> Result<Self, TableError> {
+        Self::with_domain(params, DEFAULT_DOMAIN.0, DEFAULT_DOMAIN.1)
+    }
+
+    /// Builds the table for `params` over the strain domain `[from, to]`.
+    ///
+    /// Runs the `f64` law (software floating point on most cores): call it at start-up or
+    /// on the host (`mccs table`), never per tick.
+    pub fn with_domain(params: &Params, from: f64, to: f64) -> Result<Self, TableError> {
+        let law = Law::new(params)?;
+        Self::from_law(&law, from, to)
+    }
+
+    /// Builds the table for an already derived law.
+    #[inline(never)]
+    pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
+        let grid = Grid::place::<S>(law, from, to)?;
+        let shift = coefficient_shift::<S>(law, &grid)?;
+        let segs = segments::<S>(law, &grid, shift)?;
+        let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
+        // The lines are anchored on the end knots floored to Q20: the table's own values
+        // floor the same way, so the curve stays monotone across the anchors.
+        let l = lines::<S>(law, &grid, segs.first >> shift)?;
+        Ok(Self::from_raw(RawTable {
+            strain_lo: grid.strain_lo,
+            strain_hi: grid.strain_hi,
+            index_pre: 1 << grid.index_shift,
+            index_scale: grid.index_scale,
+            anchor_lo: l.anchor_lo,
+            force_lo: l.force_lo,
+            stiffness_lo: l.stiffness_lo,
+            force_hi: segs.last >> shift,
+            stiffness_hi: l.stiffness_hi,
+            shift,
+            stiff_scale,
+            stiff_post,
+            segments: segs.coefficients,
+        }))
+    }
+}
+
+/// Where the knots are: `lo + i · step`, `i = 0 … S`, with the grid's index in the
+/// evaluation's fixed-point terms.
+struct Grid {
+    /// Whether the table starts at the kink `Δ(min(F_T, P))` (the exact line below) and
+    /// ends at the solid point `Δ(F_C)` (the exact line above).
+    at_kink: bool,
+    at_solid: bool,
+    /// The knot on the preload's slope kink `Δ(P)`, if inside the table.
+    kink_knot: Option<usize>,
+    /// Whether the first knot moved below the table's start to put a knot on `Δ(P)`.
+    grid_moved: bool,
+    /// The first knot, rounded to the strain format (as an `f64` and in Q24).
+    lo: f64,
+    strain_lo: i32,
+    /// One past the last strain inside the table (Q24).
+    strain_hi: i32,
+    /// The segment width the evaluation's index implies.
+    step: f64,
+    index_shift: u32,
+    index_scale: u32,
+}
+
+impl Grid {
+    /// Places `S` segments over the law's curved part inside `[from, to]`.
+    fn place<const S: usize>(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
+        if S == 0 {
+            return Err(TableError::NoSegments);
+        }
+        if !(from.is_finite() && to.is_finite() && from < to && from > -127.0 && to < 127.0) {
+            return Err(TableError::BadDomain);
+        }
+        let (e_t, e_c) = (law.strain_t(), law.strain_c());
+        // Whether the table starts at the kink and ends at the solid point (exact lines
+        // beyond), decided before the ends are rounded to the strain format.
+        let (at_kink, at_solid) = (from <= e_t, to >= e_c);
+        let lo = if at_kink { e_t } else { from };
+        let hi = if at_solid { e_c } else { to };
+        if hi <= lo {
+            return Err(TableError::NoNonlinearPhase);
+        }
+        // A preload above F_T puts the law's one slope kink, Δ(P), inside the table. The
+        // grid is then placed so that a knot falls on it, and the two segments meeting
+        // there get the two one-sided slopes: the first knot moves down (into the exact
+        // linear phase, or below the domain) by less than a segment, and the step grows
+        // only if the table would otherwise end short of `hi`.
+        let e_p = law.delta(law.preload);
+        let mut kink_knot = None;
+        let mut lo_grid = lo;
+        let mut width = hi - lo;
+        if law.preload > law.f_t && e_p > lo && e_p < hi {
+            let mut step = width / S as f64;
+            let j = libm::ceil((e_p - lo) / step);
+            if j < S as f64 {
+                step = libm::fmax(step, (hi - e_p) / (S as f64 - j));
+                lo_grid = e_p - j * step;
+                width = S as f64 * step;
+                kink_knot = Some(j as usize);
+            }
+        }
+        let strain_lo = checked_from_f64(lo_grid, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        let grid_moved = lo_grid < lo;
+        let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
+        // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
+        // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
+        // scale keeps about 21 significant bits.
+        let span = libm::ceil(width * (1u64 << STRAIN_FRAC) as f64) + 2.0;
+        if span.is_nan() || span >= (1u64 << 32) as f64 {
+            return Err(TableError::BadDomain);
+        }
+        let mut index_shift = 0u32;
+        while index_shift < 31 && span * (2u64 << index_shift) as f64 <= (1u64 << 32) as f64 {
+            index_shift += 1;
+        }
+        let scale = libm::floor(S as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
+        if !(scale >= 1.0 && scale < (1u64 << 32) as f64) {
+            return Err(TableError::TooNarrow);
+        }
+        // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index
+        // ([`crate::arith::narrow::table_force`]: two 32-bit multiplies) is the same number.
+        let index_scale = narrow_scale(scale as u32);
+        // The evaluation places knot i at lo + i · step: build at exactly those strains.
+        let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
+        // Strains below strain_lo + d (in Q24 LSBs) have coordinates below S·2¹⁵.
+        let num = (S as u128) << 47;
+        let den = (index_scale as u128) << index_shift;
+        let d = num.div_ceil(den);
+        let strain_hi =
+            i32::try_from(strain_lo as i128 + d as i128).map_err(|_| TableError::BadDomain)?;
+        Ok(Self {
+            at_kink,
+            at_solid,
+            kink_knot,
+            grid_moved,
+            lo,
+            strain_lo,
+            strain_hi,
+            step,
+            index_shift,
+            index_scale,
+        })
+    }
+
+    /// Knot `i`: the force, and the slopes dF/dt (per segment) from below and from
+    /// above, all in Q20 N units, unrounded.
+    fn knot(&self, law: &Law, i: usize) -> Result<Knot, TableError> {
+        let unit = (1u64 << FORCE_FRAC) as f64;
+        let e = self.lo + i as f64 * self.step;
+        let f = law.force(e);
+        // At a kink, the one-sided slopes at the kink itself (the knot's strain is
+        // rounded, and may sit a hair to either side). The first knot's segment lies
+        // above the kink it starts at.
+        let f_slope = if self.kink_knot == Some(i) {
+            law.preload
+        } else if i == 0 && self.at_kink && !self.grid_moved {
+            libm::fmax(f, law.first_kink())
+        } else {
+            f
+        };
+        let below = 1.0 / law.compliance(f_slope);
+        let above = 1.0 / law.compliance_above(f_slope);
+        if !(libm::fabs(f * unit) < (1u64 << 30) as f64 && below.is_finite() && above.is_finite()) {
+            return Err(TableError::OutOfRange);
+        }
+        Ok(Knot {
+            value: f * unit,
+            slope_below: below * self.step * unit,
+            slope_above: above * self.step * unit,
+        })
+    }
+}
+
+/// A knot's force and its one-sided slopes per segment (Q20 N units, unrounded).
+#[derive(Clone, Copy)]
+struct Knot {
+    value: f64,
+    slope_below: f64,
+    slope_above: f64,
+}
+
+/// The cubic of one segment from its end values `a0, a1` and end slopes `m0, m1` (same
+/// unit): `[C1, C2, C3]` unrounded, with the Fritsch–Carlson limiter where the law bends
+/// harder than the grid resolves (a soft cone against a stiff series spring, just below
+/// the solid point): the end slopes are scaled into the circle α² + β² ≤ 9 that keeps
+/// the cubic monotone. Smooth laws (Table 2) never reach it.
+fn hermite(a0: f64, a1: f64, m0: f64, m1: f64) -> [f64; 3] {
+    let secant = a1 - a0;
+    let (mut s0, mut s1) = (m0, m1);
+    if secant > 0.0 {
+        let (al, be) = (s0 / secant, s1 / secant);
+        let r2 = al * al + be * be;
+        if r2 > 9.0 {
+            let tau = 3.0 / libm::sqrt(r2);
+            (s0, s1) = (tau * s0, tau * s1);
+        }
+    }
+    let c1 = 2.0 * s0;
+    let c2 = 4.0 * (3.0 * secant - 2.0 * s0 - s1);
+    [c1, c2, 8.0 * secant - 4.0 * c1 - 2.0 * c2]
+}
+
+/// The coefficients' unit, Q(20 + shift) N: the largest shift (≤ 12) that keeps every knot
+/// within 2³⁰ and every segment's |C1| + |C2| + |C3| within 2²⁹, so that no Horner step
+/// of the value or the stiffness can overflow.
+fn coefficient_shift<const S: usize>(law: &Law, grid: &Grid) -> Result<u32, TableError> {
+    let (mut big_value, mut big_poly) = (1e-30f64, 1e-30f64);
+    let mut prev = grid.knot(law, 0)?;
+    big_value = libm::fmax(big_value, libm::fabs(prev.value));
+    for i in 1..=S {
+        let k = grid.knot(law, i)?;
+        let c = hermite(prev.value, k.value, prev.slope_above, k.slope_below);
+        big_value = libm::fmax(big_value, libm::fabs(k.value));
+        big_poly = libm::fmax(
+            big_poly,
+            libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]),
+        );
+        prev = k;
+    }
+    let fits = |shift: u32| {
+        let x = (1u64 << shift) as f64;
+        big_value * x <= (1u64 << 30) as f64 - 64.0
+            && 1.01 * big_poly * x <= (1u64 << 29) as f64 - 64.0
+    };
+    if !fits(0) {
+        return Err(TableError::OutOfRange);
+    }
+    let mut shift = 0u32;
+    while shift < 12 && fits(shift + 1) {
+        shift += 1;
+    }
+    Ok(shift)
+}
+
+/// The segments' coefficients in the unit of `shift`, with the first and last knots and a
+/// bound on `|dF/dτ|` (in the unit).
+struct Segments<const S: usize> {
+    coefficients: [[i32; 4]; S],
+    first: i32,
+    last: i32,
+    slope_bound: f64,
+}
+
+/// The segments: knots rounded to Q(20 + shift); `C1`, `C2` rounded at full resolution,
+/// `C3 = 8 (a1 − a0) − 4 C1 − 2 C2` exact, so that `c0 + c1 + c2 + c3` is the next knot.
+fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segments<S>, TableError> {
+    let scale = (1u64 << shift) as f64;
+    let first = grid.knot(law, 0)?;
+    let mut coefficients = [[0i32; 4]; S];
+    let (mut a0, mut m0) = (libm::round(first.value * scale), first.slope_above);
+    let a_first = a0;
+    let mut slope_bound = 0.0f64;
+    for (i, c) in coefficients.iter_mut().enumerate() {
+        let k = grid.knot(law, i + 1)?;
+        let a1 = libm::round(k.value * scale);
+        let [c1, c2, _] = hermite(a0, a1, m0 * scale, k.slope_below * scale);
+        let (c1, c2) = (libm::round(c1), libm::round(c2));
+        let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+        if libm::fabs(a0) >= (1u64 << 30) as f64
+            || libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3) > (1u64 << 29) as f64
+        {
+            return Err(TableError::OutOfRange);
+        }
+        // |dF/dτ| ≤ |c1| + 2|c2| + 3|c3|, in the unit.
+        slope_bound = libm::fmax(
+            slope_bound,
+            libm::fabs(c1) / 2.0 + libm::fabs(c2) / 2.0 + 3.0 * libm::fabs(c3) / 8.0,
+        );
+        *c = [a0 as i32, c1 as i32, c2 as i32, c3 as i32];
+        (a0, m0) = (a1, k.slope_above);
+    }
+    Ok(Segments {
+        coefficients,
+        first: a_first as i32,
+        last: a0 as i32,
+        slope_bound,
+    })
+}
+
+/// The stiffness scale `(stiff_scale, stiff_post)`: dF/dε (Q16) = (D / 2) · sps ·
+/// 2^(16 − 20 − shift) for D = 2 dF/dτ, sps = 1/step segments per strain:
+/// ⌊D · M / 2³²⌋ with M = sps · 2^(27 − shift) (at least sps · 2¹⁵ significant: `shift`
+/// ≤ 12), a power of two moved into `stiff_post` while M would not fit.
+fn stiffness_scale(grid: &Grid, shift: u32, slope_bound: f64) -> Result<(i32, i32), TableError> {
+    let (unit, scale) = ((1u64 << FORCE_FRAC) as f64, (1u64 << shift) as f64);
+    let sps = 1.0 / grid.step;
+    let k_bound = slope_bound / (scale * unit) * sps * (1u64 << STIFF_FRAC) as f64;
+    if k_bound.is_nan() || k_bound > (1u64 << 30) as f64 {
+        return Err(TableError::OutOfRange);
+    }
+    let mut v = sps * libm::ldexp(1.0, 27 - shift as i32);
+    let mut post = 0u32;
+    while v >= (1u64 << 31) as f64 - 1.0 && post < 30 {
+        v /= 2.0;
+        post += 1;
+    }
+    if v >= (1u64 << 31) as f64 - 1.0 {
+        return Err(TableError::OutOfRange);
+    }
+    Ok((libm::round(v) as i32, 1i32 << post))
+}
+
+/// The straight lines beyond the table.
+struct Lines {
+    anchor_lo: i32,
+    force_lo: i32,
+    stiffness_lo: i32,
+    stiffness_hi: i32,
+}
+
+/// Below the table: at the kink, the exact line `k ε` through zero, with `k` rounded
+/// down so that the line never passes above the first knot (the curve stays monotone;
+/// the step up at the knot is `(k − k_q) ε_lo` ≤ 2^-16 ε_lo N); otherwise the tangent at
+/// the domain edge, through the first knot (`first_q20`). Above the table, the line
+/// through the last knot: `k_p` when the table ends at the solid point, else the tangent
+/// there.
+fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines, TableError> {
+    let (stiffness_lo, anchor_lo, force_lo) = if grid.at_kink {
+        let kq = libm::floor(law.k * (1u64 << STIFF_FRAC) as f64);
+        if kq > i32::MAX as f64 {
+            return Err(TableError::OutOfRange);
+        }
+        (kq as i32, 0, 0)
+    } else {
+        let kq = checked_from_f64(1.0 / law.compliance(law.force(grid.lo)), STIFF_FRAC)
+            .ok_or(TableError::OutOfRange)?;
+        (kq, grid.strain_lo, first_q20)
+    };
+    let e_hi = grid.lo + S as f64 * grid.step;
+    let above = if grid.at_solid {
+        law.k_p
+    } else {
+        1.0 / law.compliance(law.force(e_hi))
+    };
+    Ok(Lines {
+        anchor_lo,
+        force_lo,
+        stiffness_lo,
+        stiffness_hi: checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
+    })
+}
+
+/// `x` with all but its 15 most significant bits cleared.
+const fn narrow_scale(x: u32) -> u32 {
+    let k = (32 - x.leading_zeros()).saturating_sub(15);
+    (x >> k) << k
+}

@@ -1,0 +1,59 @@
+//! [`TableError`]: why a force table could not be built.
+
+use crate::params::ParamError;
+use core::fmt;
+
+/// Why a table could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableError {
+    /// The spring parameters are invalid.
+    Param(ParamError),
+    /// The domain bounds are not finite, not ordered, or outside ±127.
+    BadDomain,
+    /// The domain does not reach into the nonlinear phase `(Δ(F_T), Δ(F_C))`.
+    NoNonlinearPhase,
+    /// The nonlinear phase inside the domain is too narrow for `S` segments at Q16.
+    TooNarrow,
+    /// A force or stiffness in the table exceeds its fixed-point format.
+    OutOfRange,
+    /// Fewer than one segment.
+    NoSegments,
+}
+
+impl TableError {
+    /// The message, without the parameter error's own (see `Display`): one source for
+    /// `Display` and the `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Param(_) => "params: invalid",
+            Self::BadDomain => "domain: bounds must be finite, within ±127, and from < to",
+            Self::NoNonlinearPhase => {
+                "domain: does not reach into the nonlinear phase (Δ(F_T), Δ(F_C)) of this spring"
+            }
+            Self::TooNarrow => {
+                "domain: the nonlinear phase inside it is too narrow for this many knots"
+            }
+            Self::OutOfRange => {
+                "params: forces or stiffnesses in the domain exceed the fixed-point formats (±2048 N, ±32768 N/strain)"
+            }
+            Self::NoSegments => "knots: at least 2 are needed",
+        }
+    }
+}
+
+impl From<ParamError> for TableError {
+    fn from(e: ParamError) -> Self {
+        Self::Param(e)
+    }
+}
+
+impl fmt::Display for TableError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Param(e) => e.fmt(f),
+            other => f.write_str(other.message()),
+        }
+    }
+}
+
+impl core::error::Error for TableError {}

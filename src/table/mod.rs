@@ -1,0 +1,263 @@
+//! `ForceTable`: the inverse MCCS law `F(ε)` tabulated for constant-time fixed-point
+//! evaluation (the paper's MATLAB `finverse` step, made fit for a microcontroller).
+//!
+//! # Layout
+//! Only where the law is curved is it tabulated: from the end of the straight line `k ε`
+//! (`Δ(min(F_T, P))`) to the solid point `Δ(F_C)`, clipped to the strain domain, on a grid
+//! uniform in strain with `S` segments (`S + 1` knots). Below it the law is the exact line
+//! of slope `k`; above `Δ(F_C)` the exact line of slope `k_p`. Where the domain cuts the
+//! curved part short, the line beyond the domain edge is the tangent there (an
+//! under-estimate of the stiffening law above the edge). With a preload above `F_T` the
+//! grid is placed so that a knot sits on the slope kink `Δ(P)`.
+//!
+//! Each segment holds the cubic Hermite polynomial through its two knots with the exact
+//! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
+//! the law bends harder than the grid resolves, so that the curve stays monotone), as
+//! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
+//! per segment, 1072 bytes in all for 65 knots) so that each Horner step is one product
+//! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
+//! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
+//! the kink, the line through zero with `k` rounded down), so the curve is continuous and
+//! monotone.
+//!
+//! # Formats and ranges
+//! - strain: [`Strain`] = `I8F24`, range ±128, resolution 6.0e-8;
+//! - force: [`Force`] = `I12F20` in N, range ±2048 N, resolution 9.5e-7 N;
+//! - stiffness: [`Stiffness`] = `I16F16` in N per unit strain, range ±32768, resolution 1.5e-5;
+//! - position in a segment `τ`: Q15;
+//! - coefficients: Q(20 + `shift`) N, the shift (0 … 12) chosen per table so that the
+//!   knots use most of an `i32` and no Horner step can overflow.
+//!
+//! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`).
+//!
+//! # Cost
+//! The segment and `τ` come from one subtract, one multiply by a power of two and one
+//! unsigned high-word product (no search, no division); the value is three Horner steps
+//! (one `smmla` each on the M3/M4), the stiffness two more and one scaling product. No
+//! loop; the only branch is which of the three pieces the strain falls in. Every product
+//! has exact floor semantics, and the Cortex-M0 builds them from 16-bit pieces with the
+//! same bits ([`crate::q`]). Instruction counts per core: `docs/performance.md`.
+//!
+//! # Accuracy
+//! Measured against the `f64` reference by `host-tests/tests/table_accuracy.rs`:
+//! `docs/accuracy.md`.
+
+use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
+use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
+
+mod build;
+mod error;
+
+pub use error::TableError;
+
+/// The default strain domain `[ε_min, ε_max]`.
+pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
+
+/// The raw contents of a [`ForceTable`], as emitted by `mccs table` for `include!`.
+/// In declaration order (`repr(C)`): the header before the segments, so that the
+/// Cortex-M0 reaches every header field with an immediate offset (Thumb-1 loads reach
+/// 124 bytes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+pub struct RawTable<const S: usize> {
+    /// Lower end of the tabulated strain range (Q24).
+    pub strain_lo: i32,
+    /// Upper end of the tabulated strain range (Q24), exclusive.
+    pub strain_hi: i32,
+    /// The segment coordinate of a strain `e` inside the table, Q15 segments, is
+    /// `⌊(e − strain_lo) · index_pre · index_scale / 2³²⌋` (unsigned; `index_pre` a power
+    /// of two that puts the table's width at the top of a `u32`).
+    pub index_pre: u32,
+    /// See `index_pre`.
+    pub index_scale: u32,
+    /// The line below `strain_lo` passes through (`anchor_lo`, `force_lo`) (Q24, Q20 N):
+    /// through zero when the table starts at the kink, else through the first knot.
+    pub anchor_lo: i32,
+    /// See `anchor_lo`.
+    pub force_lo: i32,
+    /// Slope of the line below `strain_lo` (Q16 N per unit strain).
+    pub stiffness_lo: i32,
+    /// The line above `strain_hi` passes through (`strain_hi`, `force_hi`) (Q20 N).
+    pub force_hi: i32,
+    /// Slope of the line above `strain_hi` (Q16 N per unit strain).
+    pub stiffness_hi: i32,
+    /// The coefficients' unit: Q(20 + `shift`) N, `shift` ∈ 0 … 12.
+    pub shift: u32,
+    /// The stiffness in Q16 is `⌊D · stiff_scale / 2³²⌋ · stiff_post` for `D = 2 dF/dτ` in
+    /// the coefficients' unit (`stiff_post` a power of two).
+    pub stiff_scale: i32,
+    /// See `stiff_scale`.
+    pub stiff_post: i32,
+    /// Per segment `[C0, C1, C2, C3] = [c0, 2 c1, 4 c2, 8 c3]` of the cubic
+    /// `F(τ) = c0 + c1 τ + c2 τ² + c3 τ³`, `τ ∈ [0, 1)`: the degree-`j` coefficient carries
+    /// `2^j` so that each Horner step is one product by `τ/2` ([`crate::q::mul_t`]).
+    /// `c0` is the knot value and `C3 = 8 (c0' − c0) − 4 C1 − 2 C2` makes the cubic end
+    /// on the next knot `c0'` exactly.
+    pub segments: [[i32; 4]; S],
+}
+
+/// A tabulated inverse law with `S` segments (`S + 1` knots); see the module docs. It is
+/// built by [`ForceTable::new`], [`ForceTable::with_domain`] or [`ForceTable::from_law`]
+/// (`build.rs`), or wraps a table emitted by `mccs table` ([`ForceTable::from_raw`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(transparent)]
+pub struct ForceTable<const S: usize> {
+    raw: RawTable<S>,
+}
+
+/// 16 segments, 17 knots, 256 bytes of coefficients.
+pub type ForceTable16 = ForceTable<16>;
+/// 32 segments, 33 knots, 512 bytes of coefficients.
+pub type ForceTable32 = ForceTable<32>;
+/// 64 segments, 65 knots, 1 KiB of coefficients: the project default.
+pub type ForceTable64 = ForceTable<64>;
+/// 128 segments, 129 knots, 2 KiB of coefficients.
+pub type ForceTable128 = ForceTable<128>;
+
+impl<const S: usize> ForceTable<S> {
+    /// Wraps raw contents (for tables emitted by `mccs table` and `include!`d).
+    pub const fn from_raw(raw: RawTable<S>) -> Self {
+        Self { raw }
+    }
+
+    /// The raw contents.
+    pub const fn raw(&self) -> &RawTable<S> {
+        &self.raw
+    }
+
+    /// Size of the table in bytes.
+    pub const SIZE_BYTES: usize = core::mem::size_of::<RawTable<S>>();
+
+    /// The tabulated strain range `[lo, hi]`.
+    pub fn tabulated_range(&self) -> (Strain, Strain) {
+        (
+            Strain::from_bits(self.raw.strain_lo),
+            Strain::from_bits(self.raw.strain_hi),
+        )
+    }
+
+    /// The largest tangent stiffness anywhere on the curve (both lines, and every segment
+    /// at its ends and middle), for stability bounds. A loop over the segments: call it
+    /// at start-up, not per tick.
+    pub fn max_stiffness(&self) -> Stiffness {
+        let r = &self.raw;
+        let mut max = r.stiffness_lo.max(r.stiffness_hi);
+        let span = r.strain_hi.saturating_sub(r.strain_lo) as i64;
+        for i in 0..=(2 * S) as i64 {
+            let e = r.strain_lo as i64 + span * i / (2 * S) as i64;
+            let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
+            max = max.max(k.to_bits());
+        }
+        Stiffness::from_bits(max)
+    }
+
+    /// Force (N) at compressive strain `strain`; constant time, saturating, no panic.
+    #[inline]
+    pub fn force(&self, strain: Strain) -> Force {
+        let r = &self.raw;
+        let e = strain.to_bits();
+        if e <= r.strain_lo {
+            return Force::from_bits(line(r.force_lo, r.stiffness_lo, e, r.anchor_lo));
+        }
+        if e >= r.strain_hi {
+            return Force::from_bits(line(r.force_hi, r.stiffness_hi, e, r.strain_hi));
+        }
+        let (c, t) = self.segment(e);
+        Force::from_bits(cubic_value(r, c, t))
+    }
+
+    /// [`ForceTable::force`] clamped to `[−2^BITS, 2^BITS)` in raw Q20 (`BITS` ≤ 30, i.e.
+    /// within ±1024 N), as the solver needs it: the same values, a few instructions
+    /// less (the clamp makes the saturation of the straight lines exact).
+    #[inline]
+    pub fn force_within<const BITS: u32>(&self, strain: Strain) -> i32 {
+        const { assert!(BITS <= 30) };
+        let r = &self.raw;
+        let e = strain.to_bits();
+        let f = if e <= r.strain_lo {
+            line_held(r.force_lo, r.stiffness_lo, e, r.anchor_lo)
+        } else if e >= r.strain_hi {
+            line_held(r.force_hi, r.stiffness_hi, e, r.strain_hi)
+        } else {
+            let (c, t) = self.segment(e);
+            cubic_value(r, c, t)
+        };
+        f.clamp(-(1 << BITS), (1 << BITS) - 1)
+    }
+
+    /// Force (N) and tangent stiffness `dF/dε` (N per unit strain) at `strain`;
+    /// constant time, saturating, no panic.
+    #[inline]
+    pub fn force_and_stiffness(&self, strain: Strain) -> (Force, Stiffness) {
+        let r = &self.raw;
+        let e = strain.to_bits();
+        if e <= r.strain_lo {
+            let f = line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
+            return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_lo));
+        }
+        if e >= r.strain_hi {
+            let f = line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
+            return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_hi));
+        }
+        let (c, t) = self.segment(e);
+        let f = cubic_value(r, c, t);
+        // D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ², in the same halving Horner form.
+        let c3x3 = c[3].wrapping_mul(3);
+        let c2x2 = c[2].wrapping_mul(2);
+        let d = c[1].wrapping_add(mul_t(c2x2.wrapping_add(mul_t(c3x3, t)), t));
+        let k = mulhi(d, r.stiff_scale).wrapping_mul(r.stiff_post);
+        (Force::from_bits(f), Stiffness::from_bits(k))
+    }
+
+    /// The segment holding `e` (`strain_lo < e < strain_hi`) and the Q15 position in it.
+    #[inline(always)]
+    fn segment(&self, e: i32) -> (&[i32; 4], u32) {
+        let r = &self.raw;
+        let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
+        let pos = mulhi_u(de, r.index_scale);
+        // strain_hi is placed so that pos < S · 2¹⁵ here: the mask (or min) only keeps
+        // the compiler from adding a bounds check.
+        let i = (pos >> 15) as usize;
+        let i = if S.is_power_of_two() {
+            i & (S - 1)
+        } else {
+            i.min(S - 1)
+        };
+        (&r.segments[i], pos & 0x7FFF)
+    }
+}
+
+/// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.
+#[inline(always)]
+pub(crate) fn cubic_value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32) -> i32 {
+    let a = c[2].wrapping_add(mul_t(c[3], t));
+    let a = c[1].wrapping_add(mul_t(a, t));
+    c[0].wrapping_add(mul_t(a, t)).wrapping_shr(r.shift)
+}
+
+/// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;
+/// saturating exactly.
+#[inline(always)]
+fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
+    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let p = mul_wide(k, e.saturating_sub(e0));
+    let hi = (p >> 32) as i32;
+    let df = if (hi >> (SH - 1)) == (hi >> 31) {
+        (hi << (32 - SH)) | ((p as u32) >> SH) as i32
+    } else if hi < 0 {
+        i32::MIN
+    } else {
+        i32::MAX
+    };
+    f0.saturating_add(df)
+}
+
+/// [`line`] for callers that clamp the result to well inside ±2048 N: the product is held
+/// through its high word ([`shr_held`]), so a held value is ±2048 N to within its low 12
+/// bits (4 mN) — beyond any such clamp.
+#[inline(always)]
+fn line_held(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
+    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let df = shr_held::<SH, 31>(mul_wide(k, e.saturating_sub(e0)));
+    f0.saturating_add(df)
+}
