@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Instruction counts per core from QEMU under -icount (src/bin/bench.rs). The firmware
+# Instruction counts per core from QEMU under -icount (firmware/src/bin/bench/). The firmware
 # checks its core's budgets in bench/budgets.txt and exits with failure on a breach of an
 # enforced one; this script then compares every figure with the committed baseline
 # bench/baseline.txt and fails if any grew by more than 5 %.

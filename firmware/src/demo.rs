@@ -1,4 +1,4 @@
-//! The demo run, shared by the firmware (`src/bin/haptic.rs`) and the host (`mccs demo`)
+//! The demo run, shared by the firmware (`firmware/src/bin/haptic.rs`) and the host (`mccs demo`)
 //! so that both run exactly the same thing: the Table 2 spring on a standard 2.5 mm patch,
 //! the probe replaying [`demo_path`] (2 s: approach, press to 1.2 mm, hold, 2 mm stroke,
 //! release), and 1.25 s in a switch to a stiffer tissue ([`swapped_params`]: the cone's

@@ -1,4 +1,4 @@
-//! `mccs`: see `mccs --help` and the README.
+//! `mccs`: see `mccs --help` and docs/cli.md.
 
 use clap::Parser;
 use mccs_host::cli::{run, Cli};

@@ -158,7 +158,7 @@ fn springs_to_fixed_points_have_the_ground_as_b() {
 
 /// The three indentations of the issue, each arithmetic: the twin against the static
 /// solve (1e-6), the fixed point against the twin (0.5 %; the measured figures are in
-/// the README).
+/// docs/accuracy.md).
 #[test]
 fn steady_state_matches_static_equilibrium_and_twin() {
     steady_state::<Wide>("wide");

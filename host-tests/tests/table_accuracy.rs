@@ -1,7 +1,7 @@
 //! The fixed-point `ForceTable` against the f64 reference over the whole strain domain.
 //!
 //! `cargo test -p mccs-host --test table_accuracy -- --nocapture` prints the figures the
-//! README reports (max and RMS error per knot count, linear vs Hermite, bytes).
+//! docs/accuracy.md reports (max and RMS error per knot count, linear vs Hermite, bytes).
 
 mod common;
 
@@ -61,7 +61,7 @@ fn sweep<const S: usize>(r: &Reference, t: &ForceTable<S>) -> Stats {
 }
 
 /// Max and RMS error (relative to `F(ε_max)`) of piecewise-linear interpolation in `f64`
-/// on the same knots, for the README's comparison.
+/// on the same knots, for the comparison in docs/accuracy.md.
 fn linear_interpolation_error(r: &Reference, knots: usize) -> (f64, f64) {
     let scale = r.force(DOMAIN.1);
     let (lo, hi) = (r.strain_t(), DOMAIN.1.min(r.strain_c()));
@@ -205,7 +205,7 @@ fn bad_domains_are_typed_errors() {
 
 /// Near-cylindrical cones (`D2/D1` → 1) squeeze the whole climb from `k` to `k_p` into
 /// a sliver of strain just below the solid point: Hermite's stiffness is then off by more
-/// than 1e-3 near `Δ(F_C)` at 65 knots. Measured here for the README: 0.43 % at
+/// than 1e-3 near `Δ(F_C)` at 65 knots. Measured here for docs/accuracy.md: 0.43 % at
 /// `D2/D1 = 1.05` (the force stays within the 2e-5 bound).
 #[test]
 fn near_cylindrical_cone_stiffness_error() {

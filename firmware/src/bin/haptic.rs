@@ -1,7 +1,7 @@
 //! The haptic firmware: the MCCS patch solver in a 1 kHz SysTick interrupt, driving a
 //! simulated device that replays the demo probe path (see `mccs_firmware::demo`), logging with
 //! defmt. Runs in QEMU on `netduinoplus2` (Cortex-M4F, the default), `lm3s6965evb`
-//! (Cortex-M3) and `microbit` (Cortex-M0); see the README.
+//! (Cortex-M3) and `microbit` (Cortex-M0); see docs/firmware.md.
 //!
 //! - The tick interrupt owns the controller (solver + device). The main loop reads the
 //!   telemetry and hands over a new parameter set through a `Mailbox` (double buffer):
