@@ -47,6 +47,12 @@ impl Format for SolverError {
                 needed,
                 self.message()
             ),
+            Self::SpringTooLong { max_mm } => write!(
+                f,
+                "topology: a spring is longer than {=u32} mm ({=str})",
+                max_mm,
+                self.message()
+            ),
             other => write!(f, "{=str}", other.message()),
         }
     }

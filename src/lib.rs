@@ -39,7 +39,7 @@ mod defmt;
 pub use arith::{Arith, DefaultArith, Narrow, Wide};
 pub use coupling::Coupling;
 pub use law::Law;
-pub use params::{Cone, Linear, ParamError, ParamKey, Params};
+pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
 pub use solver::{ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableError,

@@ -196,6 +196,124 @@ impl fmt::Display for ParamKey {
     }
 }
 
+/// A quantity derived from the parameters that the fixed-point formats must hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Derived {
+    /// `k`, the cone's linear stiffness (N per unit strain).
+    K,
+    /// `k_p`, the series spring's stiffness (N per unit strain).
+    Kp,
+    /// `F_T`, the force at the end of the linear phase (N).
+    Ft,
+    /// `F_C`, the cone's solid force (N).
+    Fc,
+    /// `H`, the compressible height, a strain.
+    H,
+}
+
+impl Derived {
+    /// Every derived quantity, in the order they are checked.
+    pub const ALL: [Derived; 5] = [Self::K, Self::Kp, Self::Ft, Self::Fc, Self::H];
+
+    /// The range the fixed-point formats hold: stiffnesses in Q16 (±32768, with the
+    /// headroom a table needs), forces in Q20 (±2048 N; a table holds ±1024 N), strains in
+    /// Q24 (±128).
+    pub const fn range(self) -> (f64, f64) {
+        match self {
+            Self::K | Self::Kp => (1e-4, 16384.0),
+            Self::Ft => (1e-5, 1024.0),
+            Self::Fc => (1e-5, 1e9),
+            Self::H => (1e-6, 100.0),
+        }
+    }
+
+    /// How each parameter enters the quantity: `(key, exponent)` of its power law (the
+    /// diameters of `k` approximately).
+    const fn dependencies(self) -> &'static [(ParamKey, f64)] {
+        use ParamKey as P;
+        match self {
+            Self::K => &[
+                (P::ConeShearModulus, 1.0),
+                (P::ConeWireDiameter, 4.0),
+                (P::ConeActiveCoils, -1.0),
+                (P::ConeSmallDiameter, -1.5),
+                (P::ConeLargeDiameter, -1.5),
+            ],
+            Self::Kp => &[
+                (P::LinearShearModulus, 1.0),
+                (P::LinearWireDiameter, 4.0),
+                (P::LinearActiveCoils, -1.0),
+                (P::LinearMeanDiameter, -3.0),
+            ],
+            Self::Ft => &[
+                (P::ConeShearModulus, 1.0),
+                (P::ConeWireDiameter, 4.0),
+                (P::ConeCompressibleHeight, 1.0),
+                (P::ConeActiveCoils, -1.0),
+                (P::ConeLargeDiameter, -3.0),
+            ],
+            Self::Fc => &[
+                (P::ConeShearModulus, 1.0),
+                (P::ConeWireDiameter, 4.0),
+                (P::ConeCompressibleHeight, 1.0),
+                (P::ConeActiveCoils, -1.0),
+                (P::ConeSmallDiameter, -3.0),
+            ],
+            Self::H => &[(P::ConeCompressibleHeight, 1.0)],
+        }
+    }
+
+    /// The quantity's value for `p` (whose values are finite and > 0).
+    pub fn of(self, p: &Params) -> f64 {
+        let (c, l) = (&p.cone, &p.linear);
+        let gd4 = c.shear_modulus * pow4(c.wire_diameter);
+        let (d1, d2) = (c.small_diameter, c.large_diameter);
+        match self {
+            Self::K => gd4 / (2.0 * c.active_coils * (d1 * d1 + d2 * d2) * (d1 + d2)),
+            Self::Kp => {
+                l.shear_modulus * pow4(l.wire_diameter)
+                    / (8.0 * l.active_coils * l.mean_diameter * l.mean_diameter * l.mean_diameter)
+            }
+            Self::Ft => gd4 * c.compressible_height / (8.0 * c.active_coils * d2 * d2 * d2),
+            Self::Fc => gd4 * c.compressible_height / (8.0 * c.active_coils * d1 * d1 * d1),
+            Self::H => c.compressible_height,
+        }
+    }
+
+    /// The parameter that pushed the quantity out of its range the most: the largest
+    /// term `exponent · ln(value / Table 2's value)` in the direction of the excess.
+    fn culprit(self, p: &Params, high: bool) -> ParamKey {
+        let mut best = (f64::NEG_INFINITY, self.dependencies()[0].0);
+        for &(key, exp) in self.dependencies() {
+            let (Some(v), Some(t)) = (key.get(p), key.get(&Params::TABLE2)) else {
+                continue;
+            };
+            let push = exp * libm::log(v / t);
+            let push = if high { push } else { -push };
+            if push > best.0 {
+                best = (push, key);
+            }
+        }
+        best.1
+    }
+
+    /// The quantity's name in messages.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::K => "the cone's stiffness k",
+            Self::Kp => "the series spring's stiffness k_p",
+            Self::Ft => "the transition force F_T",
+            Self::Fc => "the solid force F_C",
+            Self::H => "the compressible height H",
+        }
+    }
+}
+
+fn pow4(x: f64) -> f64 {
+    let x2 = x * x;
+    x2 * x2
+}
+
 /// Why a parameter set was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamError {
@@ -208,6 +326,17 @@ pub enum ParamError {
     /// `linear.preload` is not below the cone's solid force `F_C`: the series spring
     /// would never move before the cone is solid, and the law would have a vertical step.
     PreloadNotBelowSolid,
+    /// The values are valid one by one, but make a derived quantity too large (`high`)
+    /// or too small for the fixed-point formats ([`Derived::range`]); `key` is the value
+    /// that pushed it there the most.
+    OutOfFormat {
+        /// The value at fault.
+        key: ParamKey,
+        /// The derived quantity out of range.
+        quantity: Derived,
+        /// Above the range (else below).
+        high: bool,
+    },
 }
 
 impl ParamError {
@@ -221,6 +350,32 @@ impl ParamError {
             Self::PreloadNotBelowSolid => {
                 "must be below the cone's solid force F_C = G d^4 H / (8 n D1^3)"
             }
+            Self::OutOfFormat { quantity, high, .. } => match (quantity, high) {
+                (Derived::K, true) => {
+                    "makes the cone's stiffness k exceed 16384 N per unit strain, more than the fixed point holds"
+                }
+                (Derived::K, false) => {
+                    "makes the cone's stiffness k fall below 1e-4 N per unit strain, less than the fixed point resolves"
+                }
+                (Derived::Kp, true) => {
+                    "makes the series spring's stiffness k_p exceed 16384 N per unit strain, more than the fixed point holds"
+                }
+                (Derived::Kp, false) => {
+                    "makes the series spring's stiffness k_p fall below 1e-4 N per unit strain, less than the fixed point resolves"
+                }
+                (Derived::Ft, true) => {
+                    "makes the transition force F_T exceed 1024 N, more than the fixed point holds"
+                }
+                (Derived::Ft, false) => {
+                    "makes the transition force F_T fall below 1e-5 N, less than the fixed point resolves"
+                }
+                (Derived::Fc, true) => "makes the solid force F_C exceed 1e9 N",
+                (Derived::Fc, false) => {
+                    "makes the solid force F_C fall below 1e-5 N, less than the fixed point resolves"
+                }
+                (Derived::H, true) => "must be at most 100 (a strain)",
+                (Derived::H, false) => "must be at least 1e-6 (a strain)",
+            },
         }
     }
 
@@ -230,6 +385,7 @@ impl ParamError {
             Self::NotFinite(k) | Self::NotPositive(k) => *k,
             Self::LargeNotAboveSmall => ParamKey::ConeLargeDiameter,
             Self::PreloadNotBelowSolid => ParamKey::LinearPreload,
+            Self::OutOfFormat { key, .. } => *key,
         }
     }
 }
@@ -243,8 +399,9 @@ impl fmt::Display for ParamError {
 impl core::error::Error for ParamError {}
 
 impl Params {
-    /// Checks the rules of `docs/model.md`: every value finite and > 0, `D2 > D1`, and a preload (when
-    /// given) below the cone's solid force `F_C`.
+    /// Checks the rules of `docs/model.md`: every value finite and > 0, `D2 > D1`, the
+    /// derived quantities within what the fixed-point formats hold ([`Derived::range`]),
+    /// and a preload (when given) below the cone's solid force `F_C`.
     pub fn validate(&self) -> Result<(), ParamError> {
         for key in ParamKey::ALL {
             if let Some(v) = key.get(self) {
@@ -260,12 +417,21 @@ impl Params {
         if c.large_diameter <= c.small_diameter {
             return Err(ParamError::LargeNotAboveSmall);
         }
+        for quantity in Derived::ALL {
+            let v = quantity.of(self);
+            let (lo, hi) = quantity.range();
+            if !(v >= lo && v <= hi) {
+                // NaN (both parts of a ratio out of range): blame the larger excess.
+                let high = v.is_nan() || v > hi;
+                return Err(ParamError::OutOfFormat {
+                    key: quantity.culprit(self, high),
+                    quantity,
+                    high,
+                });
+            }
+        }
         if let Some(p) = self.linear.preload {
-            let d1 = c.small_diameter;
-            let d4 = c.wire_diameter * c.wire_diameter * c.wire_diameter * c.wire_diameter;
-            let f_c = c.shear_modulus * d4 * c.compressible_height
-                / (8.0 * c.active_coils * d1 * d1 * d1);
-            if p >= f_c {
+            if p >= Derived::Fc.of(self) {
                 return Err(ParamError::PreloadNotBelowSolid);
             }
         }

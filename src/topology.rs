@@ -264,6 +264,27 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         self.rest.get(i as usize).map(|p| p.map(from_q24))
     }
 
+    /// A 32-bit FNV-1a digest of the topology (node slots, contact node, and every edge's
+    /// ends and rest geometry as stored): what a [`crate::ParamSet`] is tied to, so that a
+    /// set prepared for one topology is refused by a solver on another (start-up only:
+    /// a loop over the edges).
+    pub fn fingerprint(&self) -> u32 {
+        let mut h: u32 = 0x811c_9dc5;
+        let mut eat = |x: u32| {
+            for b in x.to_le_bytes() {
+                h = (h ^ b as u32).wrapping_mul(0x0100_0193);
+            }
+        };
+        eat(self.rest.len() as u32);
+        eat(self.contact as u32);
+        for e in self.edges.iter() {
+            eat(e.a as u32 | (e.b as u32) << 16);
+            e.dir.iter().for_each(|&d| eat(d as u32));
+            eat(e.inv_len as u32);
+        }
+        h
+    }
+
     /// Rest length of edge `e` (mm), from its stored `1/l0`.
     pub fn rest_length(e: &Edge) -> f64 {
         (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64

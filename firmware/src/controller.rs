@@ -1,9 +1,11 @@
 //! `Controller`: one haptic tick end to end — device in, solver, device out — with the
 //! safe state and the run statistics the firmware reports.
 //!
-//! Safe state: any internal error (the device failing to read or to write) latches a
-//! [`Fault`]; from then on every tick writes zero force and nothing else, until reset by
-//! building a new controller.
+//! Safe state: any device error (failing to read or to write) latches a [`Fault`] and
+//! puts the device in its safe state at once ([`HapticDevice::safe_state`]: zero duty
+//! first, then the drive cut); from then on every tick re-asserts the safe state and
+//! does nothing else, until reset by building a new controller. A parameter set prepared
+//! for another topology or tick rate is refused and counted; the solver keeps its set.
 
 use crate::device::HapticDevice;
 use mccs::{Arith, DefaultArith, Force, ParamSet, Solver};
@@ -50,6 +52,10 @@ pub struct Telemetry {
     pub fault: Option<Fault>,
     /// Parameter sets applied so far.
     pub swaps: u32,
+    /// Parameter sets refused (prepared for another topology or tick rate).
+    pub rejected_swaps: u32,
+    /// Ticks on which putting the device in its safe state itself reported an error.
+    pub safe_state_errors: u32,
 }
 
 impl Telemetry {
@@ -63,6 +69,8 @@ impl Telemetry {
             overruns: 0,
             fault: None,
             swaps: 0,
+            rejected_swaps: 0,
+            safe_state_errors: 0,
         }
     }
 }
@@ -106,24 +114,27 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A:
     /// Returns the force rendered.
     pub fn tick(&mut self, swap: Option<ParamSet<S, A>>) -> [Force; 3] {
         if let Some(set) = swap {
-            self.solver.apply(set);
-            self.telemetry.swaps = self.telemetry.swaps.saturating_add(1);
-        }
-        let force = match self.telemetry.fault {
-            Some(_) => [Force::ZERO; 3],
-            None => match self.device.read_position() {
-                Ok(probe) => self.solver.step(probe),
-                Err(_) => self.enter_safe_state(Fault::Read),
-            },
-        };
-        if self.device.write_force(force).is_err() && self.telemetry.fault.is_none() {
-            self.enter_safe_state(Fault::Write);
-            let _ = self.device.write_force([Force::ZERO; 3]);
+            let t = &mut self.telemetry;
+            match self.solver.apply(set) {
+                Ok(()) => t.swaps = t.swaps.saturating_add(1),
+                Err(_) => t.rejected_swaps = t.rejected_swaps.saturating_add(1),
+            }
         }
         let force = if self.telemetry.fault.is_some() {
+            self.safe_state();
             [Force::ZERO; 3]
         } else {
-            force
+            match self.device.read_position() {
+                Ok(probe) => {
+                    let force = self.solver.step(probe);
+                    if self.device.write_force(force).is_ok() {
+                        force
+                    } else {
+                        self.enter_safe_state(Fault::Write)
+                    }
+                }
+                Err(_) => self.enter_safe_state(Fault::Read),
+            }
         };
         let t = &mut self.telemetry;
         if t.ticks == self.steady_tick {
@@ -137,9 +148,19 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A:
         force
     }
 
+    /// Latches `fault` and puts the device in its safe state; the force is zero.
     fn enter_safe_state(&mut self, fault: Fault) -> [Force; 3] {
         self.telemetry.fault = Some(fault);
+        self.safe_state();
         [Force::ZERO; 3]
+    }
+
+    /// The device's safe state, its errors counted.
+    fn safe_state(&mut self) {
+        if self.device.safe_state().is_err() {
+            let t = &mut self.telemetry;
+            t.safe_state_errors = t.safe_state_errors.saturating_add(1);
+        }
     }
 
     /// Counts a tick that overran its budget.

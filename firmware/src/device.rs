@@ -12,6 +12,9 @@ pub trait HapticDevice {
     fn read_position(&mut self) -> Result<[Length; 3], Self::Error>;
     /// Renders `force` on the probe until the next call.
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error>;
+    /// The safe state: no force, the drive cut, whatever else fails (every part
+    /// attempted; the first error returned). Called on a fault and on every tick after.
+    fn safe_state(&mut self) -> Result<(), Self::Error>;
 }
 
 /// A device that replays a probe path, one waypoint tick per read, and keeps the last
@@ -55,6 +58,11 @@ impl<const K: usize> HapticDevice for SimulatedDevice<K> {
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error> {
         self.last_force = force;
+        Ok(())
+    }
+
+    fn safe_state(&mut self) -> Result<(), Self::Error> {
+        self.last_force = [Force::ZERO; 3];
         Ok(())
     }
 }

@@ -308,3 +308,40 @@ proptest! {
         }
     }
 }
+
+/// Values that are finite and > 0 one by one, but whose derived quantities leave the
+/// fixed-point formats (the G = 1e308 and G = 1e-300 among them), are refused
+/// with the key that pushed them out the most.
+#[test]
+fn derived_quantities_out_of_the_formats_name_their_key() {
+    use mccs::{Derived, ParamError};
+    let cases: [(ParamKey, f64, Derived, bool); 8] = [
+        (ParamKey::ConeShearModulus, 1e308, Derived::K, true),
+        (ParamKey::ConeShearModulus, 1e-300, Derived::K, false),
+        (ParamKey::ConeWireDiameter, 1e100, Derived::K, true),
+        (ParamKey::ConeSmallDiameter, 1e-200, Derived::Fc, true),
+        (ParamKey::LinearShearModulus, 1e300, Derived::Kp, true),
+        (ParamKey::LinearMeanDiameter, 1e-100, Derived::Kp, true),
+        (ParamKey::ConeCompressibleHeight, 1e-9, Derived::Ft, false),
+        (ParamKey::ConeCompressibleHeight, 1e6, Derived::Ft, true),
+    ];
+    for (key, value, quantity, high) in cases {
+        let mut p = Params::TABLE2;
+        key.set(&mut p, value);
+        let want = ParamError::OutOfFormat {
+            key,
+            quantity,
+            high,
+        };
+        assert_eq!(p.validate(), Err(want), "{key} = {value}");
+        assert_eq!(Reference::new(&p).err(), Some(want));
+        assert_eq!(mccs::Law::new(&p).err(), Some(want));
+        assert!(want.to_string().starts_with(key.as_str()));
+    }
+    // Table 2 itself sits well inside every range.
+    for q in Derived::ALL {
+        let (lo, hi) = q.range();
+        let v = q.of(&Params::TABLE2);
+        assert!(v > 10.0 * lo && v < hi / 10.0, "{q:?} = {v}");
+    }
+}

@@ -51,7 +51,7 @@ fn a_tick_runs_on_one_whole_parameter_set() {
             .map(|set| {
                 let (mut solver, mut device) = (ctl.solver().clone(), *ctl.device());
                 if let Some(s) = set {
-                    solver.apply(s);
+                    solver.apply(s).expect("prepared for this solver");
                 }
                 let p = mccs_firmware::HapticDevice::read_position(&mut device).unwrap();
                 solver.step(p)

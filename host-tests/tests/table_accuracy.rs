@@ -197,10 +197,24 @@ fn bad_domains_are_typed_errors() {
     let mut bad = p;
     bad.cone.shear_modulus = -1.0;
     assert!(matches!(ForceTable::<64>::new(&bad), Err(E::Param(_))));
+    // Stiffer than the stiffness format holds: refused with the parameters.
     let mut huge = p;
     huge.cone.shear_modulus *= 1e4;
     huge.linear.shear_modulus *= 1e4;
-    assert_eq!(ForceTable::<64>::new(&huge), Err(E::OutOfRange));
+    assert_eq!(
+        ForceTable::<64>::new(&huge),
+        Err(E::Param(mccs::ParamError::OutOfFormat {
+            key: mccs::ParamKey::ConeShearModulus,
+            quantity: mccs::Derived::K,
+            high: true
+        }))
+    );
+    // Valid parameters whose forces inside the domain exceed a table's ±1024 N.
+    let mut strong = p;
+    strong.cone.shear_modulus *= 1e3;
+    strong.linear.shear_modulus *= 100.0;
+    assert_eq!(strong.validate(), Ok(()));
+    assert_eq!(ForceTable::<64>::new(&strong), Err(E::OutOfRange));
 }
 
 /// Near-cylindrical cones (`D2/D1` → 1) squeeze the whole climb from `k` to `k_p` into

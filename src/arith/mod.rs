@@ -63,6 +63,9 @@ pub trait Arith: Copy + core::fmt::Debug + Default + PartialEq + Eq + 'static {
     type Coeffs: Copy + core::fmt::Debug + PartialEq + Eq;
     /// A spring's warm-start value at rest.
     const REST: i32;
+    /// The longest rest length, mm, for which the arithmetic holds its documented
+    /// precision (`docs/accuracy.md`); a solver refuses longer springs.
+    const MAX_REST_LENGTH_MM: f64;
 
     /// The table's extra data for this arithmetic.
     fn table_aux<const S: usize>(table: &ForceTable<S>) -> Self::TableAux;

@@ -57,6 +57,7 @@ impl Arith for Wide {
     type TableAux = ();
     type Coeffs = WideCoeffs;
     const REST: i32 = ONE;
+    const MAX_REST_LENGTH_MM: f64 = f64::INFINITY;
 
     fn table_aux<const S: usize>(_: &ForceTable<S>) {}
 
@@ -165,12 +166,17 @@ fn spring<const S: usize>(
     let (dir, inv_len) = (edge.dir, edge.inv_len);
     let Ends { ua, ub, va, vb } = ends;
     // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q29: the high word of Q24 · Q31 is
-    // Q23, times 64; |u_b − u_a| < 2³¹ (the displacement clamp).
+    // q in Q23 (|u_b − u_a| < 2³¹: the displacement clamp), held within ±4 (one `ssat`)
+    // so that q · 64 fits; the sum with dir (|dir| ≤ 1) saturates, and then w is held
+    // within ±2. Where q was held, |q| ≥ 4 > 2 + |dir|, so w is held at the same ±2 it
+    // would have been: the spring still pulls (or pushes) along that axis, never the
+    // other way.
     const Q_FRAC: u32 = LEN_FRAC + INV_LEN_FRAC - 32;
+    const Q_HOLD: i32 = 1 << (31 - (W_FRAC - Q_FRAC));
     let w: V3 = core::array::from_fn(|k| {
-        let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len);
+        let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len).clamp(-Q_HOLD, Q_HOLD - 1);
         dir[k]
-            .wrapping_add(q.wrapping_mul(1 << (W_FRAC - Q_FRAC)))
+            .saturating_add(q << (W_FRAC - Q_FRAC))
             .clamp(-W_LIMIT, W_LIMIT - 1)
     });
     // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high

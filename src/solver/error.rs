@@ -16,6 +16,15 @@ pub enum SolverError {
     },
     /// The topology has no contact node.
     NoContact,
+    /// A [`crate::ParamSet`] prepared for another topology or tick rate was applied; the
+    /// solver keeps its set.
+    ForeignParamSet,
+    /// A spring is longer than the arithmetic's precision allows
+    /// ([`crate::Arith::MAX_REST_LENGTH_MM`]: 16 mm for [`crate::Narrow`]).
+    SpringTooLong {
+        /// The longest rest length allowed, mm.
+        max_mm: u32,
+    },
 }
 
 impl core::fmt::Display for SolverError {
@@ -26,6 +35,13 @@ impl core::fmt::Display for SolverError {
                 write!(
                     f,
                     "max_substeps: stability needs {needed} substeps per tick ({})",
+                    self.message()
+                )
+            }
+            Self::SpringTooLong { max_mm } => {
+                write!(
+                    f,
+                    "topology: a spring is longer than {max_mm} mm ({})",
                     self.message()
                 )
             }
@@ -47,6 +63,12 @@ impl SolverError {
                 "raise max_substeps, the node mass or the damping, or lower the tick rate"
             }
             Self::NoContact => "topology: no contact node",
+            Self::ForeignParamSet => {
+                "parameter set: prepared for another topology or tick rate; the solver keeps its own"
+            }
+            Self::SpringTooLong { .. } => {
+                "this arithmetic's precision; scale the patch down or use the wide arithmetic"
+            }
         }
     }
 }

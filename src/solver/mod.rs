@@ -52,6 +52,8 @@ pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize, A: Ari
     c: Coeffs<A>,
     substeps: u32,
     contact: usize,
+    /// The topology's fingerprint, which a [`ParamSet`] must carry to be applied.
+    fingerprint: u32,
     table: ArithTable<S, A>,
     topo: Topology<NODES, EDGES>,
     /// Per node: displacement, velocity, force accumulator.
@@ -100,6 +102,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             c: set.c,
             substeps: set.substeps,
             contact,
+            fingerprint: set.fingerprint,
             nodes: [Node::ZERO; NODES],
             warm: [A::REST; EDGES],
             probe_prev: [0; 3],

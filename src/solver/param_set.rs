@@ -26,6 +26,8 @@ pub struct ParamSet<const S: usize, A: Arith = DefaultArith> {
     pub(crate) table: ArithTable<S, A>,
     pub(crate) substeps: u32,
     pub(crate) c: Coeffs<A>,
+    /// The topology it was prepared for ([`Topology::fingerprint`]).
+    pub(crate) fingerprint: u32,
 }
 
 impl<const S: usize, A: Arith> ParamSet<S, A> {
@@ -52,10 +54,17 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// Switches to a prepared parameter set; the state (positions, velocities) is kept.
-    pub fn apply(&mut self, set: ParamSet<S, A>) {
+    /// A set prepared for another topology or another tick rate would run this patch at
+    /// a substep its stability bound was not computed for: it is refused
+    /// ([`SolverError::ForeignParamSet`]) and the solver keeps its set.
+    pub fn apply(&mut self, set: ParamSet<S, A>) -> Result<(), SolverError> {
+        if set.fingerprint != self.fingerprint || set.c.tick_hz != self.c.tick_hz {
+            return Err(SolverError::ForeignParamSet);
+        }
         self.table = set.table;
         self.substeps = set.substeps;
         self.c = set.c;
+        Ok(())
     }
 
     /// [`Solver::prepare`] for a topology without a solver (e.g. in another context than
@@ -66,6 +75,15 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         table: ForceTable<S>,
         config: &SolverConfig,
     ) -> Result<ParamSet<S, A>, SolverError> {
+        if topo
+            .edges()
+            .iter()
+            .any(|e| Topology::<NODES, EDGES>::rest_length(e) > A::MAX_REST_LENGTH_MM)
+        {
+            return Err(SolverError::SpringTooLong {
+                max_mm: A::MAX_REST_LENGTH_MM as u32,
+            });
+        }
         let substeps = stability::substeps_for(topo, &table, config)?;
         let h = 1.0 / (config.tick_hz * substeps as f64);
         let c = Coeffs {
@@ -82,6 +100,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             table: ArithTable::new(table),
             substeps,
             c,
+            fingerprint: topo.fingerprint(),
         })
     }
 

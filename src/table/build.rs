@@ -125,7 +125,10 @@ impl Grid {
             index_shift += 1;
         }
         let scale = libm::floor(S as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
-        if !(scale >= 1.0 && scale < (1u64 << 32) as f64) {
+        // At most 31 significant bits (the narrow index keeps 15 of them), and each segment
+        // at least one strain LSB wide (below that the knots are not strains the format
+        // holds).
+        if !(scale >= 1.0 && scale < (1u64 << 31) as f64) || span - 2.0 < S as f64 {
             return Err(TableError::TooNarrow);
         }
         // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index

@@ -18,6 +18,9 @@ pub enum TableError {
     OutOfRange,
     /// Fewer than one segment.
     NoSegments,
+    /// A raw table's header breaks the invariants the builder keeps
+    /// ([`crate::ForceTable::validate`]): it was not emitted by `mccs table`, or was edited.
+    Inconsistent,
 }
 
 impl TableError {
@@ -37,6 +40,9 @@ impl TableError {
                 "params: forces or stiffnesses in the domain exceed the fixed-point formats (±2048 N, ±32768 N/strain)"
             }
             Self::NoSegments => "knots: at least 2 are needed",
+            Self::Inconsistent => {
+                "table: its header is inconsistent (not as `mccs table` emits it)"
+            }
         }
     }
 }

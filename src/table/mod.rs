@@ -120,6 +120,33 @@ impl<const S: usize> ForceTable<S> {
         Self { raw }
     }
 
+    /// Checks the invariants every built table keeps (a raw table from elsewhere may not):
+    /// a tabulated range of at least one strain LSB per segment, a power-of-two index
+    /// prefactor, an index scale of 1 … 31 significant bits, a coefficient shift of at
+    /// most 12, a power-of-two stiffness post-factor, and non-negative slopes on the
+    /// lines. Evaluation never panics either way; on a table that fails this check its
+    /// values mean nothing.
+    pub fn validate(&self) -> Result<(), TableError> {
+        let r = &self.raw;
+        let span = r.strain_hi as i64 - r.strain_lo as i64;
+        let ok = S > 0
+            && span >= S as i64
+            && r.index_pre.is_power_of_two()
+            && r.index_scale > 0
+            && r.index_scale < 1 << 31
+            && r.shift <= 12
+            && r.stiff_post > 0
+            && (r.stiff_post as u32).is_power_of_two()
+            && r.stiff_scale >= 0
+            && r.stiffness_lo >= 0
+            && r.stiffness_hi >= 0;
+        if ok {
+            Ok(())
+        } else {
+            Err(TableError::Inconsistent)
+        }
+    }
+
     /// The raw contents.
     pub const fn raw(&self) -> &RawTable<S> {
         &self.raw

@@ -3,12 +3,33 @@
 //!
 //! Frames are 16 bits, SPI mode 1, MSB first. A command is `PARC | R/W | ADDR[13:0]`
 //! (`PARC` makes the frame's parity even); a response is `PARD | EF | DATA[13:0]` for the
-//! command sent in the *previous* frame. This driver always sends "read ANGLECOM"
-//! (0x3FFF), so each read returns the angle sampled one frame (one tick) earlier. A frame
-//! with bad parity, or with the error flag set, is not used: the last good position is
-//! kept and the error is counted; after an error flag the driver sends "read ERRFL" once
-//! (which clears the flag) and then the angle again: the position resumes three frames
-//! later (the frame carrying ERRFL's contents is not a position).
+//! command sent in the *previous* frame. The driver sends "read ANGLECOM" (0x3FFF), so
+//! each read returns the angle sampled one frame (one tick) earlier.
+//!
+//! # Bad frames
+//! A frame is *bad* — not used, the last good position kept, counted in
+//! [`EncoderErrors`] (`consecutive` too, which the device turns into a fault) — when:
+//! - its parity is odd (corrupted on the wire);
+//! - the sensor's error flag is set (the driver then reads ERRFL once, which clears it;
+//!   the frame carrying ERRFL's contents is not a position either);
+//! - its angle is *implausible*: farther from the last good angle than
+//!   [`EncoderConfig::max_step`] counts per frame since it allows;
+//! - it answers the periodic diagnostic read of DIAAGC
+//!   ([`EncoderConfig::diag_every`]) and that does not show the sensor running: the
+//!   offset loop finished (`LF` = 1) and no CORDIC overflow (`COF` = 0). Until a diagnostic
+//!   passes (at start, and after a failed one) the driver reads DIAAGC every frame and
+//!   takes no angle.
+//!
+//! # Stuck lines
+//! - MISO stuck high reads `0xFFFF`: even parity, error flag set: every frame is bad.
+//! - MISO stuck low reads `0x0000`: even parity, no flag, angle 0 — a valid-looking frame.
+//!   It is caught by the next diagnostic read (DIAAGC reads 0: `LF` = 0), at the latest
+//!   `diag_every` frames later, wherever the probe is; and at once by the plausibility
+//!   check unless the probe was within `max_step` counts of angle 0.
+//! - A stuck clock or chip select leaves MISO at one level: as above.
+//! - One stuck data bit flips the parity whenever the true bit differs from it: about
+//!   half the frames are parity errors, and the jumps of the others fail the
+//!   plausibility check unless they are small.
 //!
 //! Travel: `mm = wrap(angle − zero) · mm_per_count`, with `wrap` into ±8192 counts (half a
 //! turn). For a lever of radius `r` mm turned through a capstan of ratio `i`,
@@ -21,6 +42,12 @@ use mccs::units::{from_f64, Length};
 pub const ANGLECOM: u16 = 0x3FFF;
 /// ERRFL: the error register (reading it clears the error flag).
 pub const ERRFL: u16 = 0x0001;
+/// DIAAGC: diagnostics and automatic gain control.
+pub const DIAAGC: u16 = 0x3FFC;
+/// DIAAGC's `LF` bit: the offset compensation loop has finished (1 in normal operation).
+pub const DIAAGC_LF: u16 = 1 << 8;
+/// DIAAGC's `COF` bit: CORDIC overflow (the angle is invalid).
+pub const DIAAGC_COF: u16 = 1 << 9;
 /// NOP (address 0).
 pub const NOP: u16 = 0x0000;
 
@@ -56,13 +83,34 @@ pub const fn decode(frame: u16) -> Frame {
     }
 }
 
-/// Encoder mounting: the angle at zero travel and the travel per count.
+/// Encoder mounting and checks.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EncoderConfig {
     /// Angle (counts, 0 … 16383) at zero travel.
     pub zero: u16,
     /// Travel per count, mm (sign gives the direction), |x| < 0.01.
     pub mm_per_count: f64,
+    /// The largest plausible change of angle per frame, counts (the fastest the probe
+    /// moves, times the frame period, over the travel per count; 0 … 8191, 8191 disables
+    /// the check). An angle farther from the last good one than this times the frames
+    /// since it is a bad frame.
+    pub max_step: u16,
+    /// Frames between diagnostic reads of DIAAGC (0: never). One frame in this many
+    /// carries no angle (the position holds for that tick).
+    pub diag_every: u16,
+}
+
+impl EncoderConfig {
+    /// `max_step` for a probe speed (mm/s) at a frame rate (Hz): the counts the probe
+    /// can cover in one frame, plus one, at most 8191.
+    pub fn max_step_for(mm_per_count: f64, speed_mm_s: f64, frame_hz: f64) -> u16 {
+        let counts = speed_mm_s / frame_hz / libm::fabs(mm_per_count);
+        if counts.is_finite() {
+            (libm::ceil(counts) + 1.0).clamp(1.0, 8191.0) as u16
+        } else {
+            8191
+        }
+    }
 }
 
 /// Error counters.
@@ -72,6 +120,10 @@ pub struct EncoderErrors {
     pub parity: u32,
     /// Frames with the sensor's error flag.
     pub flagged: u32,
+    /// Angles farther from the last good one than the probe can move.
+    pub implausible: u32,
+    /// Diagnostic reads that did not show the sensor running.
+    pub diagnostic: u32,
     /// Bad frames in a row (reset by a good angle).
     pub consecutive: u32,
 }
@@ -83,62 +135,124 @@ pub struct As5047p<SPI> {
     zero: u16,
     /// mm per count, Q30.
     scale: i32,
+    max_step: u16,
+    diag_every: u16,
+    /// Frames until the next diagnostic read.
+    diag_in: u16,
+    /// Whether a diagnostic has passed since the start or the last failed one.
+    verified: bool,
+    /// The last good angle (counts) and its travel (Q24 mm), and frames since it.
+    last_angle: Option<u16>,
     last_good: i32,
+    since_good: u32,
     /// The command sent in the last frame, answered in the next.
     in_flight: u16,
-    /// The command to send next.
-    next: u16,
+    /// Whether the next frame reads ERRFL (after an error flag).
+    errfl_pending: bool,
     errors: EncoderErrors,
 }
 
 impl<SPI: SpiDevice<u8>> As5047p<SPI> {
-    /// A driver on `spi`; the first read returns the previous command's answer (none yet:
-    /// position 0 until the first good angle).
+    /// A driver on `spi`. Until the first good angle the position is 0; with diagnostics
+    /// on, the first frames read DIAAGC until it passes.
     pub fn new(spi: SPI, config: EncoderConfig) -> Self {
         Self {
             spi,
             zero: config.zero & 0x3FFF,
             scale: from_f64(config.mm_per_count.clamp(-0.01, 0.01), 30),
+            max_step: config.max_step.min(8191),
+            diag_every: config.diag_every,
+            diag_in: config.diag_every,
+            verified: config.diag_every == 0,
+            last_angle: None,
             last_good: 0,
+            since_good: 0,
             // The first frame answers nothing we sent: treat it as a NOP's answer.
             in_flight: NOP,
-            next: ANGLECOM,
+            errfl_pending: false,
             errors: EncoderErrors::default(),
         }
     }
 
+    /// The command for the next frame.
+    fn next_command(&mut self) -> u16 {
+        if core::mem::take(&mut self.errfl_pending) {
+            return ERRFL;
+        }
+        if self.diag_every == 0 {
+            return ANGLECOM;
+        }
+        if !self.verified {
+            return DIAAGC;
+        }
+        self.diag_in = self.diag_in.saturating_sub(1);
+        if self.diag_in == 0 {
+            self.diag_in = self.diag_every;
+            DIAAGC
+        } else {
+            ANGLECOM
+        }
+    }
+
+    fn bad(&mut self) {
+        let e = &mut self.errors;
+        e.consecutive = e.consecutive.saturating_add(1);
+    }
+
     /// One frame: returns the travel (mm) — the new one, or the last good one if the
-    /// frame was bad or carried ERRFL. Errs only when the SPI bus itself fails.
+    /// frame was bad or carried no angle. Errs only when the SPI bus itself fails.
     pub fn read(&mut self) -> Result<Length, SPI::Error> {
         let answered = self.in_flight;
-        let sent = self.next;
+        let sent = self.next_command();
         let mut rx = [0u8; 2];
         self.spi
             .transfer(&mut rx, &read_command(sent).to_be_bytes())?;
         self.in_flight = sent;
-        self.next = ANGLECOM;
+        self.since_good = self.since_good.saturating_add(1);
         match decode(u16::from_be_bytes(rx)) {
-            Frame::Data(angle) if answered == ANGLECOM => {
-                let delta = ((angle.wrapping_sub(self.zero) << 2) as i16) >> 2; // ±8192
-                                                                                // Counts · Q30 mm/count → Q24 mm.
-                self.last_good = mccs::q::sat((delta as i64 * self.scale as i64) >> 6);
-                self.errors.consecutive = 0;
+            Frame::Data(angle) if answered == ANGLECOM && self.verified => self.angle(angle),
+            Frame::Data(d) if answered == DIAAGC => {
+                let running = d & DIAAGC_LF != 0 && d & DIAAGC_COF == 0;
+                if running {
+                    self.verified = true;
+                } else {
+                    self.verified = false;
+                    self.errors.diagnostic = self.errors.diagnostic.saturating_add(1);
+                    self.bad();
+                }
             }
-            Frame::Data(_) => {} // ERRFL's contents: reading it cleared the flag
+            Frame::Data(_) => {} // ERRFL's contents (reading it cleared the flag), or NOP's
             Frame::Parity => {
                 self.errors.parity = self.errors.parity.saturating_add(1);
-                self.errors.consecutive = self.errors.consecutive.saturating_add(1);
+                self.bad();
             }
             Frame::ErrorFlag => {
                 self.errors.flagged = self.errors.flagged.saturating_add(1);
-                self.errors.consecutive = self.errors.consecutive.saturating_add(1);
+                self.bad();
                 // Read ERRFL once to clear the flag (unless this frame just asked).
-                if sent != ERRFL {
-                    self.next = ERRFL;
-                }
+                self.errfl_pending = sent != ERRFL;
             }
         }
         Ok(Length::from_bits(self.last_good))
+    }
+
+    /// A data frame answering ANGLECOM: taken if plausible.
+    fn angle(&mut self, angle: u16) {
+        if let Some(last) = self.last_angle {
+            let jump = (((angle.wrapping_sub(last)) << 2) as i16 >> 2).unsigned_abs() as u32;
+            let allowed = (self.max_step as u32).saturating_mul(self.since_good);
+            if jump > allowed {
+                self.errors.implausible = self.errors.implausible.saturating_add(1);
+                self.bad();
+                return;
+            }
+        }
+        let delta = ((angle.wrapping_sub(self.zero) << 2) as i16) >> 2; // ±8192
+                                                                        // Counts · Q30 mm/count → Q24 mm.
+        self.last_good = mccs::q::sat((delta as i64 * self.scale as i64) >> 6);
+        self.last_angle = Some(angle);
+        self.since_good = 0;
+        self.errors.consecutive = 0;
     }
 
     /// Error counters so far.

@@ -54,6 +54,8 @@ impl Arith for Narrow {
     type TableAux = NarrowTable;
     type Coeffs = NarrowCoeffs;
     const REST: i32 = 0;
+    /// `1/l0` is a 16-bit operand in Q15: 11 significant bits at 16 mm.
+    const MAX_REST_LENGTH_MM: f64 = 16.0;
 
     fn table_aux<const S: usize>(table: &ForceTable<S>) -> NarrowTable {
         NarrowTable::new(table.raw())

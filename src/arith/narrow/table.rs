@@ -22,10 +22,12 @@ pub struct NarrowTable {
 impl NarrowTable {
     /// From the raw table (start-up).
     pub const fn new<const S: usize>(raw: &RawTable<S>) -> Self {
+        // A built table's scale has at most 31 significant bits (k ≤ 16); a raw one from
+        // elsewhere may have 32, and then gets a meaningless index, not a panic.
         let k = (32 - raw.index_scale.leading_zeros()).saturating_sub(15);
         Self {
             scale: raw.index_scale >> k,
-            scale_sh: 16 - k,
+            scale_sh: 16u32.saturating_sub(k),
             lo: NarrowLine::new(raw.stiffness_lo, raw.force_lo),
             hi: NarrowLine::new(raw.stiffness_hi, raw.force_hi),
         }
