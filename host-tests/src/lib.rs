@@ -9,3 +9,5 @@ pub mod fit;
 pub mod paramfile;
 pub mod patch;
 pub mod reference;
+pub mod replay;
+pub mod trajectory;

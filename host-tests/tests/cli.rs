@@ -365,10 +365,41 @@ fn patch_errors_name_the_argument() {
             .collect();
         assert_usage_error(&mccs(&args), &[needle]);
     }
+    // The patch has defaults (N = 5, 2.5 mm, the reference backend); the depth has none.
     assert_usage_error(
         &mccs(&["patch", "--params", "params/table2.toml", "--grid", "5"]),
-        &["--spacing"],
+        &["--indent"],
     );
+    // --arith is for the fixed backend only.
+    assert_usage_error(
+        &mccs(&["patch", "--params", "params/table2.toml", "--indent", "1", "--arith", "narrow"]),
+        &["--arith"],
+    );
+}
+
+/// The defect 9: with the default domain (no --from/--to given), a table error
+/// named `--to`. It names the parameter file now, in every subcommand that has no domain
+/// arguments.
+#[test]
+fn table_errors_without_domain_arguments_name_the_file() {
+    // A stiff series spring with a preload near the cone's solid force: linear up to a
+    // strain beyond 0.95.
+    let f = temp_file(
+        "late-kink.toml",
+        "[cone]\nwire_diameter = 0.1\nsmall_diameter = 0.3\nlarge_diameter = 0.8\nactive_coils = 5.0\ncompressible_height = 3.0\nshear_modulus = 1.8472e5\n[linear]\nwire_diameter = 0.068\nmean_diameter = 0.2\nactive_coils = 10.0\nshear_modulus = 4.9151e5\n",
+    );
+    let path = f.to_str().unwrap();
+    for args in [
+        vec!["patch", "--params", path, "--indent", "1", "--backend", "fixed"],
+        vec!["curve", "--params", path, "--from", "0", "--to", "1", "--step", "0.5", "--backend", "fixed"],
+    ] {
+        let out = mccs(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("late-kink.toml"), "{args:?}: {err}");
+        assert!(!err.contains("--to") && !err.contains("--from"), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1);
+    }
 }
 
 #[test]

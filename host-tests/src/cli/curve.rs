@@ -1,7 +1,7 @@
 //! `mccs curve`: the law `F(ε)` and `dF/dε` on a strain grid, from the reference or from
 //! the fixed-point table.
 
-use super::table::{table, with_table};
+use super::table::{table, with_table, Domain};
 
 use super::{arg_error, file_error, fmt_strain, io_error, Backend, CliError};
 use crate::paramfile;
@@ -47,7 +47,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
         }
         Backend::Fixed => {
-            with_table!(a.knots, &p, &a.params, mccs::table::DEFAULT_DOMAIN, |t| {
+            with_table!(a.knots, &p, &a.params, Domain::Default, |t| {
                 fixed_curve(&t, &strains)
             })
         }

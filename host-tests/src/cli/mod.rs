@@ -10,10 +10,13 @@ mod curve;
 mod demo;
 mod fit;
 mod patch;
+mod patch_args;
+mod replay;
 mod table;
 
 pub use demo::{parse_summary, FirmwareSummary};
 pub use patch::{reference_max_stiffness, PatchRun};
+pub use patch_args::MAX_GRID_REFERENCE;
 pub use table::render_table;
 
 /// One-line error for the user; the process exits with status 2.
@@ -91,6 +94,10 @@ enum Command {
     /// Indent the standard patch: ramp the contact node down to DEPTH over the first half
     /// of the run, hold it there, and print CSV `time_s,reaction_n` per tick.
     Patch(patch::Args),
+    /// Replay a recorded probe trajectory against the standard patch and print CSV
+    /// `time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm` per
+    /// tick.
+    Replay(replay::Args),
 }
 
 /// Runs the parsed command, writing its output to `out`.
@@ -104,6 +111,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             .map_err(io_error),
         Command::Demo(a) => demo::run(a, out),
         Command::Patch(a) => patch::run(a, out),
+        Command::Replay(a) => replay::run(a, out),
     }
 }
 

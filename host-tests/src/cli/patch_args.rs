@@ -1,0 +1,145 @@
+//! The arguments `patch` and `replay` share: the standard patch, the solver and its
+//! configuration, with the same defaults in both.
+
+use super::{arg_error, ArithArg, Backend, CliError};
+use crate::replay::{Engine, MAX_GRID_FIXED};
+use mccs::{Coupling, SolverConfig};
+
+/// The largest grid of the reference backend.
+pub const MAX_GRID_REFERENCE: usize = 40;
+
+/// The standard patch and the solver that runs it.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub(super) struct PatchArgs {
+    /// Surface nodes per side, N (3 … 40; 3 … 12 with `--backend fixed`).
+    #[arg(long, default_value_t = 5)]
+    pub grid: usize,
+    /// Grid spacing, mm (grid × spacing ≤ 100 mm).
+    #[arg(long, default_value_t = 2.5, allow_negative_numbers = true)]
+    pub spacing: f64,
+    /// Solver: the f64 twin or the no_std fixed-point core.
+    #[arg(long, value_enum, default_value_t = Backend::Reference)]
+    pub backend: Backend,
+    /// Arithmetic of the fixed-point core (`--backend fixed` only; default wide).
+    #[arg(long, value_enum)]
+    pub arith: Option<ArithArg>,
+    /// Tick rate, Hz (a whole number, 1 … 100000).
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    pub rate: f64,
+}
+
+impl PatchArgs {
+    /// Checks the arguments; each error names its argument.
+    pub fn check(&self) -> Result<(), CliError> {
+        let max_grid = match self.backend {
+            Backend::Reference => MAX_GRID_REFERENCE,
+            Backend::Fixed => MAX_GRID_FIXED,
+        };
+        if !(3..=max_grid).contains(&self.grid) {
+            return Err(arg_error(
+                "--grid",
+                &format!("must be 3 … {max_grid} for this backend"),
+            ));
+        }
+        if !(self.spacing.is_finite()
+            && self.spacing > 0.0
+            && self.spacing * self.grid as f64 <= 100.0)
+        {
+            return Err(arg_error(
+                "--spacing",
+                "must be > 0 mm, with grid × spacing ≤ 100 mm",
+            ));
+        }
+        let r = self.rate;
+        if !(r.is_finite() && (1.0..=100_000.0).contains(&r) && r.fract() == 0.0) {
+            return Err(arg_error(
+                "--rate",
+                "must be a whole number of Hz, 1 … 100000",
+            ));
+        }
+        if self.arith.is_some() && self.backend != Backend::Fixed {
+            return Err(arg_error("--arith", "only with --backend fixed"));
+        }
+        Ok(())
+    }
+
+    /// The engine these arguments ask for.
+    pub fn engine(&self) -> Engine {
+        match (self.backend, self.arith) {
+            (Backend::Reference, _) => Engine::Reference,
+            (Backend::Fixed, Some(ArithArg::Narrow)) => Engine::Narrow,
+            (Backend::Fixed, _) => Engine::Wide,
+        }
+    }
+}
+
+/// The solver's configuration beyond the patch: the probe coupling, the node mass and
+/// the spring damping (the defaults are `SolverConfig::default()`'s).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub(super) struct TuningArgs {
+    /// Coupling stiffness, N/mm (> 0, ≤ 1000).
+    #[arg(long, default_value_t = Coupling::default().stiffness, allow_negative_numbers = true)]
+    pub coupling_stiffness: f64,
+    /// Coupling damping, N·s/m (0 … 1000).
+    #[arg(long, default_value_t = Coupling::default().damping, allow_negative_numbers = true)]
+    pub coupling_damping: f64,
+    /// Largest force per axis the device renders, N (> 0, < 2000).
+    #[arg(long, default_value_t = Coupling::default().max_force, allow_negative_numbers = true)]
+    pub max_force: f64,
+    /// Haptic mass of each free node, g (> 0).
+    #[arg(long, default_value_t = SolverConfig::default().node_mass * 1000.0, allow_negative_numbers = true)]
+    pub node_mass: f64,
+    /// Relative damping of each spring, N·s/m (0 … 30).
+    #[arg(long, default_value_t = SolverConfig::default().spring_damping, allow_negative_numbers = true)]
+    pub spring_damping: f64,
+}
+
+impl TuningArgs {
+    /// The configuration at `rate`; each value out of range names its argument.
+    pub fn config(&self, rate: f64) -> Result<SolverConfig, CliError> {
+        let cfg = SolverConfig {
+            tick_hz: rate,
+            node_mass: self.node_mass / 1000.0,
+            spring_damping: self.spring_damping,
+            coupling: Coupling {
+                stiffness: self.coupling_stiffness,
+                damping: self.coupling_damping,
+                max_force: self.max_force,
+            },
+            ..SolverConfig::default()
+        };
+        cfg.validate().map_err(|e| config_error(e, &cfg))?;
+        Ok(cfg)
+    }
+}
+
+/// A solver error as the argument at fault, where one is.
+pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError {
+    use mccs::{ConfigKey as K, SolverError as E};
+    let (arg, what) = match e {
+        E::Config(K::TickHz) => ("--rate", "out of range for this configuration"),
+        E::Config(K::NodeMass) => ("--node-mass", "must be > 0 g (and large enough for the rate)"),
+        E::Config(K::SpringDamping) => ("--spring-damping", "must be 0 … 30 N·s/m"),
+        E::Config(K::CouplingStiffness) => ("--coupling-stiffness", "must be > 0 and ≤ 1000 N/mm"),
+        E::Config(K::CouplingDamping) => ("--coupling-damping", "must be 0 … 1000 N·s/m"),
+        E::Config(K::CouplingMaxForce) => ("--max-force", "must be > 0 and < 2000 N"),
+        E::TooManySubsteps { needed } => {
+            return arg_error(
+                "--rate",
+                &format!(
+                    "this spring needs {needed} substeps per tick at {} Hz (at most {}): lower the rate, or raise --node-mass or the damping",
+                    cfg.tick_hz, cfg.max_substeps
+                ),
+            )
+        }
+        E::NoDamping => ("--spring-damping", "the integrator needs damping: must be > 0"),
+        E::SpringTooLong { max_mm } => {
+            return arg_error(
+                "--spacing",
+                &format!("the narrow arithmetic holds springs up to {max_mm} mm: use a smaller spacing or --arith wide"),
+            )
+        }
+        other => return CliError(other.to_string()),
+    };
+    arg_error(arg, what)
+}

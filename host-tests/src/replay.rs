@@ -1,0 +1,158 @@
+//! Replaying a probe trajectory against the standard patch, in the fixed-point core
+//! (`mccs::Solver`, either arithmetic) or the `f64` twin (`patch::Twin`): per tick the
+//! device force, the contact node's displacement, and the largest displacement of any
+//! node.
+
+use crate::patch::{substeps, Mesh, Twin, TwinConfig};
+use crate::reference::Reference;
+use crate::trajectory::Trajectory;
+use mccs::{Arith, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
+
+/// Capacities of the fixed backend's solver: N = 12 has 101 node slots and 558 springs.
+pub const FIXED_NODES: usize = 101;
+/// See [`FIXED_NODES`].
+pub const FIXED_EDGES: usize = 558;
+/// The largest grid of the fixed backend.
+pub const MAX_GRID_FIXED: usize = 12;
+
+/// Which solver replays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Engine {
+    /// The `f64` twin.
+    Reference,
+    /// The fixed-point core in the wide arithmetic.
+    Wide,
+    /// The fixed-point core in the narrow arithmetic (the M0's).
+    Narrow,
+}
+
+/// One tick's output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    /// The probe sample's time, s.
+    pub time: f64,
+    /// The device force, N.
+    pub force: [f64; 3],
+    /// The contact node's displacement from rest, mm.
+    pub contact: [f64; 3],
+    /// The largest |displacement| from rest of any node, mm.
+    pub max_disp: f64,
+}
+
+/// Why a replay could not run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReplayError {
+    /// The solver refused the configuration.
+    Solver(SolverError),
+    /// The table could not be built.
+    Table(mccs::TableError),
+    /// The grid or spacing.
+    Topology(mccs::TopologyError),
+}
+
+impl std::fmt::Display for ReplayError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Solver(e) => e.fmt(f),
+            Self::Table(e) => e.fmt(f),
+            Self::Topology(e) => e.fmt(f),
+        }
+    }
+}
+
+/// A replay: the patch, the solver's configuration and the engine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Replay {
+    /// Surface nodes per side.
+    pub grid: usize,
+    /// Grid spacing, mm.
+    pub spacing: f64,
+    /// The solver's configuration (its `tick_hz` is the sampling rate).
+    pub config: SolverConfig,
+    /// The engine.
+    pub engine: Engine,
+}
+
+impl Replay {
+    /// Runs `traj` through the patch with `params`; `row` gets each tick's output.
+    pub fn run(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        mut row: impl FnMut(Row),
+    ) -> Result<(), ReplayError> {
+        match self.engine {
+            Engine::Reference => self.run_twin(params, traj, &mut row),
+            Engine::Wide => self.run_fixed(params, traj, mccs::Wide, &mut row),
+            Engine::Narrow => self.run_fixed(params, traj, mccs::Narrow, &mut row),
+        }
+    }
+
+    fn run_fixed<A: Arith>(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        arith: A,
+        row: &mut dyn FnMut(Row),
+    ) -> Result<(), ReplayError> {
+        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
+        let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, self.spacing)
+            .map_err(ReplayError::Topology)?;
+        let nodes = topo.node_count() as u16;
+        let contact = topo.contact();
+        let mut s = Solver::with_arith(topo, table, &self.config, arith)
+            .map_err(ReplayError::Solver)?;
+        let mm = |x: [Length; 3]| x.map(|c| c.to_num::<f64>());
+        for (time, p) in traj.ticks(self.config.tick_hz) {
+            let f = s.step(p.map(Length::saturating_from_num));
+            let max_disp = (1..nodes)
+                .filter_map(|i| s.displacement(i))
+                .map(|d| norm(mm(d)))
+                .fold(0.0, f64::max);
+            row(Row {
+                time,
+                force: f.map(|c| c.to_num::<f64>()),
+                contact: s.displacement(contact).map(mm).unwrap_or([0.0; 3]),
+                max_disp,
+            });
+        }
+        Ok(())
+    }
+
+    fn run_twin(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        row: &mut dyn FnMut(Row),
+    ) -> Result<(), ReplayError> {
+        let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
+        let mesh = Mesh::standard(self.grid, self.spacing);
+        let mut tc = TwinConfig::from_solver(&self.config, 0);
+        let k_max = crate::cli::reference_max_stiffness(&law);
+        let n = substeps(&mesh, k_max, &tc).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
+        if n > self.config.max_substeps {
+            return Err(ReplayError::Solver(SolverError::TooManySubsteps { needed: n }));
+        }
+        tc.substeps = n;
+        let mut twin = Twin::new(mesh, law, tc);
+        let c = twin.mesh.contact;
+        for (time, p) in traj.ticks(self.config.tick_hz) {
+            let force = twin.step(p);
+            let disp = |i: usize| -> [f64; 3] {
+                std::array::from_fn(|k| twin.x[i][k] - twin.mesh.rest[i][k])
+            };
+            let max_disp = (0..twin.x.len()).map(|i| norm(disp(i))).fold(0.0, f64::max);
+            row(Row {
+                time,
+                force,
+                contact: disp(c),
+                max_disp,
+            });
+        }
+        Ok(())
+    }
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
