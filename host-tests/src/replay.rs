@@ -100,8 +100,8 @@ impl Replay {
             .map_err(ReplayError::Topology)?;
         let nodes = topo.node_count() as u16;
         let contact = topo.contact();
-        let mut s = Solver::with_arith(topo, table, &self.config, arith)
-            .map_err(ReplayError::Solver)?;
+        let mut s =
+            Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)?;
         let mm = |x: [Length; 3]| x.map(|c| c.to_num::<f64>());
         for (time, p) in traj.ticks(self.config.tick_hz) {
             let f = s.step(p.map(Length::saturating_from_num));
@@ -131,7 +131,9 @@ impl Replay {
         let k_max = crate::cli::reference_max_stiffness(&law);
         let n = substeps(&mesh, k_max, &tc).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
         if n > self.config.max_substeps {
-            return Err(ReplayError::Solver(SolverError::TooManySubsteps { needed: n }));
+            return Err(ReplayError::Solver(SolverError::TooManySubsteps {
+                needed: n,
+            }));
         }
         tc.substeps = n;
         let mut twin = Twin::new(mesh, law, tc);

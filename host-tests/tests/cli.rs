@@ -372,7 +372,15 @@ fn patch_errors_name_the_argument() {
     );
     // --arith is for the fixed backend only.
     assert_usage_error(
-        &mccs(&["patch", "--params", "params/table2.toml", "--indent", "1", "--arith", "narrow"]),
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--arith",
+            "narrow",
+        ]),
         &["--arith"],
     );
 }
@@ -390,14 +398,37 @@ fn table_errors_without_domain_arguments_name_the_file() {
     );
     let path = f.to_str().unwrap();
     for args in [
-        vec!["patch", "--params", path, "--indent", "1", "--backend", "fixed"],
-        vec!["curve", "--params", path, "--from", "0", "--to", "1", "--step", "0.5", "--backend", "fixed"],
+        vec![
+            "patch",
+            "--params",
+            path,
+            "--indent",
+            "1",
+            "--backend",
+            "fixed",
+        ],
+        vec![
+            "curve",
+            "--params",
+            path,
+            "--from",
+            "0",
+            "--to",
+            "1",
+            "--step",
+            "0.5",
+            "--backend",
+            "fixed",
+        ],
     ] {
         let out = mccs(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains("late-kink.toml"), "{args:?}: {err}");
-        assert!(!err.contains("--to") && !err.contains("--from"), "{args:?}: {err}");
+        assert!(
+            !err.contains("--to") && !err.contains("--from"),
+            "{args:?}: {err}"
+        );
         assert_eq!(err.lines().count(), 1);
     }
 }

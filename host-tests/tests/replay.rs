@@ -62,7 +62,10 @@ fn every_node_returns_to_rest_after_a_long_stroke() {
             let last = r.last().unwrap();
             // It was dragged: the contact node went along the stroke.
             let peak = r.iter().map(|r| r.contact[axis].abs()).fold(0.0, f64::max);
-            assert!(peak > 0.5 * stroke.min(5.0), "{engine:?} axis {axis}: peak {peak}");
+            assert!(
+                peak > 0.5 * stroke.min(5.0),
+                "{engine:?} axis {axis}: peak {peak}"
+            );
             assert!(
                 last.max_disp < 1e-3,
                 "{engine:?} axis {axis}, stroke {stroke}: a node stays {} mm from rest (contact at {:?})",
@@ -113,11 +116,24 @@ fn the_cli_prints_one_row_per_tick() {
         "ok.csv",
         "time_s,x_mm,y_mm,z_mm\n0,0,0,1\n0.1,0,0,-1\n0.2,0,0,-1\n",
     );
-    for backend in [vec!["--backend", "reference"], vec!["--backend", "fixed", "--arith", "narrow"]] {
-        let mut args = vec!["replay", "--params", "params/table2.toml", "--probe", traj.to_str().unwrap()];
+    for backend in [
+        vec!["--backend", "reference"],
+        vec!["--backend", "fixed", "--arith", "narrow"],
+    ] {
+        let mut args = vec![
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            traj.to_str().unwrap(),
+        ];
         args.extend(backend);
         let out = mccs(&args);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let text = String::from_utf8(out.stdout).unwrap();
         let mut lines = text.lines();
         assert_eq!(
@@ -130,7 +146,11 @@ fn the_cli_prints_one_row_per_tick() {
         assert_eq!(rows.len(), 201);
         assert_eq!(rows[0][0], 0.0);
         assert_eq!(rows[200][0], 0.2);
-        assert!(rows[200][3] > 0.3, "pressed 1 mm: the force pushes up: {:?}", rows[200]);
+        assert!(
+            rows[200][3] > 0.3,
+            "pressed 1 mm: the force pushes up: {:?}",
+            rows[200]
+        );
     }
 }
 
@@ -141,17 +161,35 @@ fn bad_trajectories_name_the_file_and_line() {
         ("t,x,y,z\n0,0,0,0\n", "line 1"),
         ("time_s,x_mm,y_mm,z_mm\n", "no rows"),
         ("time_s,x_mm,y_mm,z_mm\n0,0,0\n", "line 2"),
-        ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n0,0,0,1\n", "line 3: times must increase"),
+        (
+            "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n0,0,0,1\n",
+            "line 3: times must increase",
+        ),
         ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,nan,0,0\n", "line 3"),
-        ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,0,0,500\n", "line 3: a position beyond"),
-        ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1e9,0,0,0\n", "line 3: longer than"),
+        (
+            "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,0,0,500\n",
+            "line 3: a position beyond",
+        ),
+        (
+            "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1e9,0,0,0\n",
+            "line 3: longer than",
+        ),
     ] {
         let p = temp("bad.csv", text);
-        let out = mccs(&["replay", "--params", "params/table2.toml", "--probe", p.to_str().unwrap()]);
+        let out = mccs(&[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            p.to_str().unwrap(),
+        ]);
         assert_eq!(out.status.code(), Some(2), "{text:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
-        assert!(err.contains("bad.csv") && err.contains(needle), "{text:?}: {err}");
+        assert!(
+            err.contains("bad.csv") && err.contains(needle),
+            "{text:?}: {err}"
+        );
         assert!(out.stdout.is_empty());
     }
     // The parser alone, for the fuzz target's invariants: a good file round-trips.
@@ -173,7 +211,10 @@ fn bad_arguments_name_the_argument() {
         (vec!["--rate", "0"], "--rate"),
         (vec!["--grid", "2"], "--grid"),
         (vec!["--arith", "narrow"], "--arith"),
-        (vec!["--backend", "fixed", "--arith", "narrow", "--spacing", "20"], "--spacing"),
+        (
+            vec!["--backend", "fixed", "--arith", "narrow", "--spacing", "20"],
+            "--spacing",
+        ),
         (vec!["--node-mass", "0.001", "--rate", "100"], "--rate"),
     ] {
         let mut args = vec!["replay", "--params", "params/table2.toml", "--probe", t];

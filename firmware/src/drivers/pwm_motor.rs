@@ -143,10 +143,7 @@ impl<PWM: SetDutyCycle, DIR: OutputPin, EN: OutputPin> PwmMotor<PWM, DIR, EN> {
 
     /// Renders a force along the device's axis. A direction change goes through zero
     /// duty; on a failed write the duty is set to zero if it can be.
-    pub fn write(
-        &mut self,
-        force: Force,
-    ) -> Result<(), ErrorOf<PWM, DIR, EN>> {
+    pub fn write(&mut self, force: Force) -> Result<(), ErrorOf<PWM, DIR, EN>> {
         let duty = self.duty_for(force);
         let up = force > Force::ZERO;
         if duty > 0 && self.up != Some(up) {

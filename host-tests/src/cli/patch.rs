@@ -106,7 +106,12 @@ impl PatchRun {
     }
 
     /// `(time_s, reaction_n)` per tick of the `f64` twin.
-    fn twin(&self, p: &Params, file: &Path, cfg: &SolverConfig) -> Result<Vec<(f64, f64)>, CliError> {
+    fn twin(
+        &self,
+        p: &Params,
+        file: &Path,
+        cfg: &SolverConfig,
+    ) -> Result<Vec<(f64, f64)>, CliError> {
         let law = Reference::new(p).map_err(|e| file_error(file, e))?;
         let mesh = Mesh::standard(self.patch.grid, self.patch.spacing);
         let mut tc = TwinConfig::from_solver(cfg, 0);
@@ -122,7 +127,12 @@ impl PatchRun {
         tc.substeps = n;
         let mut twin = Twin::new(mesh, law, tc);
         Ok((0..self.ticks)
-            .map(|i| (self.time(i), twin.step_held([0.0, 0.0, -self.depth_at(i)])[2]))
+            .map(|i| {
+                (
+                    self.time(i),
+                    twin.step_held([0.0, 0.0, -self.depth_at(i)])[2],
+                )
+            })
             .collect())
     }
 
