@@ -1,14 +1,21 @@
 //! `mccs fit`: the MCCS, MCS and MS models fitted to compression data.
+//!
+//! The output paths are checked before anything is fitted; a data file of more than
+//! [`fit::FIT_ROWS`] rows is fitted on that many (evenly spread, said on stderr) and
+//! measured on all of them; a fit that runs for more than 2 s says where it is on stderr
+//! every 2 s.
 
 use super::{arg_error, io_error, CliError};
-use crate::fit::{self, ModelKind};
+use crate::fit::{self, ModelKind, Progress};
 use crate::paramfile;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 #[derive(clap::Args, Debug)]
 pub(super) struct Args {
-    /// Data file, CSV with the header `strain,force_n`.
+    /// Data file, CSV with the header `strain,force_n` (the loading branch: strain in
+    /// (0, 1) and force > 0, both strictly increasing; 5 … 1,000,000 rows).
     #[arg(long)]
     data: PathBuf,
     /// mccs, mcs, ms or all.
@@ -20,6 +27,31 @@ pub(super) struct Args {
     /// Draw the data and the fitted curves here (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
+}
+
+/// Fails unless `path` can be written: its folder exists and takes a new file, and it is
+/// not a folder or a read-only file itself.
+fn check_writable(arg: &str, path: &Path) -> Result<(), CliError> {
+    let bad = |what: &str| arg_error(arg, &format!("{}: {what}", path.display()));
+    if path.is_dir() {
+        return Err(bad("is a folder"));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(bad("its folder does not exist"));
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.permissions().readonly() {
+            return Err(bad("is read-only"));
+        }
+    }
+    let probe = dir.join(format!(".mccs-write-check-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| bad(&format!("its folder cannot be written: {e}")))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
@@ -36,10 +68,39 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "needs the mccs model (--model mccs or all)",
         ));
     }
+    if let Some(p) = &a.out {
+        check_writable("--out", p)?;
+    }
+    if let Some(p) = &a.plot {
+        check_writable("--plot", p)?;
+    }
     let points = fit::read_data(&a.data).map_err(|e| CliError(e.to_string()))?;
+    if points.len() > fit::FIT_ROWS {
+        eprintln!(
+            "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
+            a.data.display(),
+            points.len(),
+            fit::FIT_ROWS
+        );
+    }
+    let started = Instant::now();
+    let mut next_report = Duration::from_secs(2);
+    let mut progress = |p: Progress| {
+        let t = started.elapsed();
+        if t >= next_report {
+            eprintln!(
+                "mccs: fitting {} (starting point {} of {}), {:.0} s so far",
+                p.kind.name(),
+                p.start + 1,
+                p.starts,
+                t.as_secs_f64()
+            );
+            next_report = t + Duration::from_secs(2);
+        }
+    };
     let mut fits = Vec::new();
     for kind in kinds {
-        let f = fit::fit(kind, &points).ok_or_else(|| {
+        let f = fit::fit_rows(kind, &points, &mut progress).ok_or_else(|| {
             CliError(format!(
                 "{}: the {} model could not be fitted",
                 a.data.display(),
@@ -56,6 +117,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             m.mse
         )
         .map_err(io_error)?;
+        out.flush().map_err(io_error)?;
         fits.push(f);
     }
     let mccs_params = fits.iter().find_map(|f| match f.model {

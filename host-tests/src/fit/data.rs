@@ -31,8 +31,12 @@ impl fmt::Display for DataError {
 
 impl std::error::Error for DataError {}
 
-/// Reads and checks a data file: header `strain,force_n`, at least 5 rows, every value
-/// a finite number, strain and force both strictly increasing.
+/// The most data rows a file may have.
+pub const MAX_ROWS: usize = 1_000_000;
+
+/// Reads and checks a data file: header `strain,force_n`, 5 … [`MAX_ROWS`] rows, every
+/// value a finite number, the loading branch of a compression test (strain in (0, 1),
+/// force > 0, both strictly increasing).
 pub fn read_data(path: &Path) -> Result<Vec<Point>, DataError> {
     let file = path.display().to_string();
     let err = |row: Option<usize>, what: &str| DataError {
@@ -86,6 +90,24 @@ pub fn parse_data(text: &str, file: &str) -> Result<Vec<Point>, DataError> {
             }
         };
         let (e, f) = (value(0, "strain")?, value(1, "force_n")?);
+        // What the models can take: they start unloaded at zero strain (a row at or
+        // below zero carries nothing to fit, and breaks the starting points), and the
+        // MS model's stretch 1 − strain must stay positive.
+        if !(e > 0.0 && e < 1.0) {
+            return Err(err(
+                Some(row),
+                format!("strain {e} is outside (0, 1): the models take compressive strains above zero and below 1"),
+            ));
+        }
+        if f <= 0.0 {
+            return Err(err(
+                Some(row),
+                format!("force_n {f} must be > 0 (the loading branch, from zero load)"),
+            ));
+        }
+        if points.len() >= MAX_ROWS {
+            return Err(err(Some(row), format!("more than {MAX_ROWS} data rows")));
+        }
         if let Some(&(e0, f0)) = points.last() {
             if e <= e0 {
                 return Err(err(Some(row), "strain must increase strictly".into()));

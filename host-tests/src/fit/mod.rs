@@ -31,7 +31,7 @@ mod data;
 mod models;
 mod plot;
 
-pub use data::{demo_data, parse_data, read_data, synthesize, to_csv, DataError, Point};
+pub use data::{demo_data, parse_data, read_data, synthesize, to_csv, DataError, Point, MAX_ROWS};
 pub use models::{ms_force, ms_strain, Fitted, ModelKind, SAMPLE_AREA_MM2};
 use models::{unbounded, D2, LN_C2, RATIO};
 pub use plot::plot;
@@ -49,7 +49,9 @@ pub struct Metrics {
 
 /// Metrics of `model` on `data`.
 pub fn metrics(model: &Fitted, data: &[Point]) -> Metrics {
-    let d: Vec<f64> = data.iter().map(|&(e, f)| model.strain_at(f) - e).collect();
+    let forces: Vec<f64> = data.iter().map(|p| p.1).collect();
+    let strains = model.strains(&forces);
+    let d: Vec<f64> = data.iter().zip(strains).map(|(&(e, _), s)| s - e).collect();
     let n = d.len() as f64;
     Metrics {
         mean_abs: d.iter().map(|x| x.abs()).sum::<f64>() / n,
@@ -62,6 +64,7 @@ pub fn metrics(model: &Fitted, data: &[Point]) -> Metrics {
 struct Problem<'a> {
     kind: ModelKind,
     data: &'a [Point],
+    forces: Vec<f64>,
     theta: DVector<f64>,
 }
 
@@ -71,7 +74,12 @@ impl Problem<'_> {
         if let Fitted::Mccs(p) = &m {
             p.validate().ok()?;
         }
-        let r: Vec<f64> = self.data.iter().map(|&(e, f)| m.strain_at(f) - e).collect();
+        let r: Vec<f64> = self
+            .data
+            .iter()
+            .zip(m.strains(&self.forces))
+            .map(|(&(e, _), s)| s - e)
+            .collect();
         r.iter()
             .all(|x| x.is_finite())
             .then(|| DVector::from_vec(r))
@@ -96,6 +104,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if self.kind == ModelKind::Ms {
+            return self.ms_jacobian();
+        }
         // Central differences in fit space (the models have analytic forms, but not of
         // their derivatives in every parameter).
         let n = self.theta.len();
@@ -113,6 +124,44 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
             j.set_column(k, &((rp - rm) / (2.0 * h)));
         }
         Some(j)
+    }
+}
+
+impl Problem<'_> {
+    /// The MS model's strain is a root of `F(e; θ) = f`: its derivatives follow from the
+    /// implicit function theorem, `∂e/∂θ = −(∂F/∂θ)/(∂F/∂e)`, both by central differences
+    /// of the force at the solved strain — one root solve per row instead of seven.
+    fn ms_jacobian(&self) -> Option<DMatrix<f64>> {
+        let t = self.theta.as_slice();
+        let m = Fitted::from_theta(self.kind, t);
+        let strains = m.strains(&self.forces);
+        let n = t.len();
+        let mut j = DMatrix::zeros(self.data.len(), n);
+        let shifted: Vec<(Fitted, Fitted, f64)> = (0..n)
+            .map(|k| {
+                let h = 1e-6 * (1.0 + t[k].abs());
+                let (mut tp, mut tm) = (t.to_vec(), t.to_vec());
+                tp[k] += h;
+                tm[k] -= h;
+                (
+                    Fitted::from_theta(self.kind, &tp),
+                    Fitted::from_theta(self.kind, &tm),
+                    h,
+                )
+            })
+            .collect();
+        for (i, &e) in strains.iter().enumerate() {
+            let he = 1e-7 * (1.0 - e).max(1e-9);
+            let d_e = (m.force_at(e + he) - m.force_at(e - he)) / (2.0 * he);
+            if !(d_e.is_finite() && d_e > 0.0) {
+                return None;
+            }
+            for (k, (mp, mm, h)) in shifted.iter().enumerate() {
+                let d_t = (mp.force_at(e) - mm.force_at(e)) / (2.0 * h);
+                j[(i, k)] = -d_t / d_e;
+            }
+        }
+        j.iter().all(|x| x.is_finite()).then_some(j)
     }
 }
 
@@ -166,14 +215,67 @@ fn starts(kind: ModelKind, data: &[Point]) -> Vec<Vec<f64>> {
     out
 }
 
+/// The most rows a fit runs on: more are decimated, evenly by row, to this many (the
+/// metrics are still taken on every row).
+pub const FIT_ROWS: usize = 1_000;
+
+/// Where a fit is, for progress reports: the model and its starting point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// The model.
+    pub kind: ModelKind,
+    /// The starting point being fitted (0-based) and how many there are.
+    pub start: usize,
+    /// See `start`.
+    pub starts: usize,
+}
+
+/// At most [`FIT_ROWS`] of `data`, evenly by row, the first and last kept.
+pub fn decimate(data: &[Point]) -> Vec<Point> {
+    if data.len() <= FIT_ROWS {
+        return data.to_vec();
+    }
+    let last = data.len() - 1;
+    (0..FIT_ROWS)
+        .map(|i| data[i * last / (FIT_ROWS - 1)])
+        .collect()
+}
+
 /// Fits `kind` to `data`: Levenberg–Marquardt from every starting point, best kept.
 /// `None` if no start converged to a finite fit.
 pub fn fit(kind: ModelKind, data: &[Point]) -> Option<Fit> {
+    fit_rows(kind, data, &mut |_| {})
+}
+
+/// [`fit`] on at most [`FIT_ROWS`] rows of `data` ([`decimate`]), the metrics on all of
+/// them; `progress` hears of every starting point.
+pub fn fit_rows(
+    kind: ModelKind,
+    data: &[Point],
+    progress: &mut dyn FnMut(Progress),
+) -> Option<Fit> {
+    let rows = decimate(data);
+    let found = fit_on(kind, &rows, progress)?;
+    Some(Fit {
+        metrics: metrics(&found.model, data),
+        model: found.model,
+    })
+}
+
+fn fit_on(kind: ModelKind, data: &[Point], progress: &mut dyn FnMut(Progress)) -> Option<Fit> {
     let mut best: Option<(f64, Vec<f64>)> = None;
-    for start in starts(kind, data) {
+    let all = starts(kind, data);
+    let n = all.len();
+    for (i, start) in all.into_iter().enumerate() {
+        progress(Progress {
+            kind,
+            start: i,
+            starts: n,
+        });
         let problem = Problem {
             kind,
             data,
+            forces: data.iter().map(|p| p.1).collect(),
             theta: DVector::from_vec(start),
         };
         if problem.residuals().is_none() {

@@ -86,10 +86,24 @@ impl Fitted {
     /// The model's strain at force `f` (N), `f ≥ 0`. NaN where it has none (the cone
     /// alone is solid past `F_C`: it returns `H`).
     pub fn strain_at(&self, f: f64) -> f64 {
+        self.strains(&[f])[0]
+    }
+
+    /// The model's strains at forces `forces`, its law derived once.
+    pub fn strains(&self, forces: &[f64]) -> Vec<f64> {
         match self {
-            Self::Mccs(p) => Reference::new(p).map_or(f64::NAN, |r| r.delta(f)),
-            Self::Mcs(c) => Reference::cone_only(c).delta(f),
-            Self::Ms { c1, c2, c3 } => ms_strain(*c1, *c2, *c3, f),
+            Self::Mccs(p) => match Reference::new(p) {
+                Ok(r) => forces.iter().map(|&f| r.delta(f)).collect(),
+                Err(_) => vec![f64::NAN; forces.len()],
+            },
+            Self::Mcs(c) => {
+                let r = Reference::cone_only(c);
+                forces.iter().map(|&f| r.delta(f)).collect()
+            }
+            Self::Ms { c1, c2, c3 } => forces
+                .iter()
+                .map(|&f| ms_strain(*c1, *c2, *c3, f))
+                .collect(),
         }
     }
 
@@ -166,22 +180,61 @@ pub fn ms_force(c1: f64, c2: f64, c3: f64, e: f64) -> f64 {
     -ts * SAMPLE_AREA_MM2
 }
 
-/// Eq. 27's strain at force `f` by bisection (the force grows with strain on [0, 1)).
+/// Eq. 27's strain at force `f` (the force grows with strain on [0, 1)): the root in a
+/// bracket, by the Illinois variant of regula falsi with a bisection step whenever the
+/// bracket fails to halve — superlinear, about 10 evaluations to full precision where
+/// bisection took 100.
 pub fn ms_strain(c1: f64, c2: f64, c3: f64, f: f64) -> f64 {
     if f <= 0.0 {
         return 0.0;
     }
+    let g = |e: f64| ms_force(c1, c2, c3, e) - f;
     let (mut lo, mut hi) = (0.0, 1.0 - 1e-12);
-    let top = ms_force(c1, c2, c3, hi);
-    if top.is_nan() || top < f {
+    let (mut g_lo, mut g_hi) = (g(lo), g(hi));
+    if g_hi.is_nan() || g_hi < 0.0 {
         return hi;
     }
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if ms_force(c1, c2, c3, mid) < f {
-            lo = mid;
+    if !(g_lo < 0.0) {
+        return lo;
+    }
+    // Which end was kept last (−1 low, +1 high), for the Illinois halving.
+    let mut side = 0;
+    for _ in 0..200 {
+        let width = hi - lo;
+        let mut x = hi - g_hi * width / (g_hi - g_lo);
+        if !(x > lo && x < hi) {
+            x = 0.5 * (lo + hi);
+        }
+        let gx = g(x);
+        if gx.is_nan() {
+            return f64::NAN;
+        }
+        if gx < 0.0 {
+            (lo, g_lo) = (x, gx);
+            if side == -1 {
+                g_hi *= 0.5;
+            }
+            side = -1;
         } else {
-            hi = mid;
+            (hi, g_hi) = (x, gx);
+            if side == 1 {
+                g_lo *= 0.5;
+            }
+            side = 1;
+        }
+        if gx == 0.0 || hi - lo <= 1e-15 * hi.max(1e-300) {
+            return x;
+        }
+        if hi - lo > 0.5 * width {
+            // The secant crawled: bisect once.
+            let mid = 0.5 * (lo + hi);
+            let gm = g(mid);
+            if gm < 0.0 {
+                (lo, g_lo) = (mid, gm);
+            } else {
+                (hi, g_hi) = (mid, gm);
+            }
+            side = 0;
         }
     }
     0.5 * (lo + hi)
