@@ -194,7 +194,7 @@ pub fn ms_strain(c1: f64, c2: f64, c3: f64, f: f64) -> f64 {
     if g_hi.is_nan() || g_hi < 0.0 {
         return hi;
     }
-    if !(g_lo < 0.0) {
+    if g_lo.is_nan() || g_lo >= 0.0 {
         return lo;
     }
     // Which end was kept last (−1 low, +1 high), for the Illinois halving.
