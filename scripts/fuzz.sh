@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Runs every fuzz target (fuzz/fuzz_targets/) for SECONDS each (default 60) with
+# cargo-fuzz on the nightly toolchain, and prints the executions each reached:
+#   FUZZ target=<name> seconds=<s> executions=<n> crashes=<n>
+# A crash leaves its input in fuzz/artifacts/<target>/; turn it into a regression test
+# (host-tests) before fixing it. Not part of the test command (see docs/reliability.md).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+if ! rustup toolchain list | grep -q '^nightly'; then
+  echo "fuzz.sh: installing the nightly toolchain (rustup toolchain install nightly)" >&2
+  rustup toolchain install nightly --profile minimal >&2
+fi
+if ! command -v cargo-fuzz >/dev/null 2>&1; then
+  echo "fuzz.sh: cargo install cargo-fuzz (about two minutes, once)" >&2
+  cargo install cargo-fuzz --locked >&2
+fi
+mkdir -p target/fuzz
+status=0
+for target in $(sed -n 's/^name = "\(.*\)"$/\1/p' fuzz/Cargo.toml | grep -v mccs-fuzz); do
+  echo "fuzz.sh: building and running $target for $seconds s" >&2
+  log="target/fuzz/$target.log"
+  mkdir -p "fuzz/corpus/$target"
+  set +e
+  (cd fuzz && cargo +nightly fuzz run "$target" "corpus/$target" -- \
+      -max_total_time="$seconds" -rss_limit_mb=4096 -print_final_stats=1) \
+      < /dev/null > "$log" 2>&1
+  rc=$?
+  set -e
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  crashes=$(ls "fuzz/artifacts/$target" 2>/dev/null | wc -l)
+  echo "FUZZ target=$target seconds=$seconds executions=${execs:-0} crashes=$crashes"
+  if [ "$rc" != 0 ]; then
+    echo "fuzz.sh: $target failed (exit $rc): see $log" >&2
+    grep -E "panicked|ERROR|SUMMARY" "$log" | head -n 5 >&2 || true
+    status=1
+  fi
+done
+exit $status
