@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Instruction counts per core from QEMU under -icount (firmware/src/bin/bench/). The firmware
-# checks its core's budgets in bench/budgets.txt and exits with failure on a breach of an
-# enforced one; this script then compares every figure with the committed baseline
-# bench/baseline.txt and fails if any grew by more than 5 %.
+# Instruction counts per core from QEMU under -icount (firmware/src/bin/bench/). The
+# firmware checks its core's budgets in bench/budgets.txt and exits with failure on a
+# breach of an enforced one; this script then compares every figure with the committed
+# baseline bench/baseline.txt and fails if any grew by more than 5 %.
 # `scripts/bench.sh --update` rewrites the baseline instead of comparing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,18 +11,21 @@ mkdir -p target/qemu
 out=target/qemu/bench.txt
 : > "$out"
 status=0
-for spec in "m4f thumbv7em-none-eabihf" "m3 thumbv7m-none-eabi" "m0 thumbv6m-none-eabi"; do
-  set -- $spec
-  cargo build --quiet --release -p mccs-firmware --target "$2" --bin bench
-  log="target/qemu/bench-$1.log"
+cargo build --quiet -p defmt-log
+for core in m4f m3 m0; do
+  case $core in m4f) t=thumbv7em-none-eabihf ;; m3) t=thumbv7m-none-eabi ;; m0) t=thumbv6m-none-eabi ;; esac
+  echo "bench: $core: building and running in QEMU" >&2
+  cargo build --quiet --release -p mccs-firmware --target "$t" --bin bench
+  log="target/qemu/bench-$core.log"
   set +e
-  timeout 300 cargo run --quiet --release -p mccs-firmware --target "$2" --bin bench 2> >(grep -v "Timer with period zero" >&2) \
-    | defmt-print -e "target/$2/release/bench" > "$log"
+  timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin bench \
+      < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
+    | target/debug/defmt-log "target/$t/release/bench" > "$log"
   rc=${PIPESTATUS[0]}
   set -e
   grep -E "^(BENCH|MEM|FIT|BUDGET|RATIO|MEMORY) " "$log" >> "$out" || true
   if [ "$rc" != 0 ]; then
-    echo "bench: the $1 firmware exited with status $rc (a budget breached, or a fault: see $log)" >&2
+    echo "bench: the $core firmware exited with status $rc (a budget breached, or a fault: see $log)" >&2
     grep -E "result=(OVER|missing)|malformed|panic" "$log" >&2 || true
     status=1
   fi

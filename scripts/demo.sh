@@ -5,4 +5,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
-exec bash scripts/firmware.sh m4f
+source scripts/lib.sh
+LOG_DIR=target/logs/demo
+mkdir -p "$LOG_DIR"
+run_stage build-decoder cargo build -p defmt-log
+run_stage build-firmware cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
+say "...  running the firmware in QEMU (Cortex-M4F, 2 s of simulated ticks)"
+start=$SECONDS
+bash scripts/firmware.sh m4f
+say "ok   demo ($((SECONDS - start)) s)"

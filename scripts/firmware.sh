@@ -4,17 +4,15 @@
 # Exit status: QEMU's (0 when the firmware exits through semihosting with success).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/lib.sh
 core=${1:-m4f}
 shift || true
-case "$core" in
-  m4f) target=thumbv7em-none-eabihf ;;
-  m3) target=thumbv7m-none-eabi ;;
-  m0) target=thumbv6m-none-eabi ;;
-  *) echo "firmware.sh: core must be m4f, m3 or m0, not '$core'" >&2; exit 2 ;;
-esac
+target=$(core_target "$core")
+cargo build --quiet -p defmt-log
 cargo build --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@"
 elf="target/$target/release/haptic"
-# The runner from .cargo/config.toml (QEMU with -icount), output decoded by defmt-print.
-# timeout: a hung firmware must fail, not stall the caller.
-timeout 300 cargo run --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@" 2> >(grep -v "Timer with period zero" >&2) \
-  | defmt-print -e "$elf"
+# The runner from .cargo/config.toml (QEMU with -icount, off the terminal), output
+# decoded. A hung firmware fails after 5 minutes instead of stalling the caller.
+timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@" \
+    < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
+  | target/debug/defmt-log "$elf"

@@ -1,90 +1,143 @@
 #!/usr/bin/env bash
-# The test command: host tests, formatting, clippy, and the thumb builds of the core.
-set -euo pipefail
+# The test command: formatting, clippy, the thumb builds, the firmware on all three cores
+# in QEMU (the main job under a pseudo-terminal), the tick-path check, the bench and its
+# budgets, the firmware's size, the host tests, and the docs' figures against the code.
+#
+# Every stage says what it does, ticks every 10 s while it runs and logs to
+# target/logs/test/<stage>.log (the path is printed when it fails). It ends with a
+# table of the stages and one line, `N passed, N failed` (each stage is one check, each
+# host test one more); the exit status is 0 when nothing failed.
+set -uo pipefail
 cd "$(dirname "$0")/.."
-source scripts/setup.sh
+all_start=$SECONDS
+source scripts/setup.sh || exit 1
+set +e  # setup.sh sets -e; here every stage runs, and the table counts the failures
+source scripts/lib.sh
+LOG_DIR=target/logs/test
+rm -rf "$LOG_DIR"
+mkdir -p "$LOG_DIR" target/qemu
 
-step() { printf '\n== %s\n' "$*" >&2; }
+THUMB=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
 
-step "cargo fmt --check"
-cargo fmt --all -- --check
+clippy_thumb() {
+  for t in "${THUMB[@]}"; do
+    cargo clippy -p mccs --target "$t" -- -D warnings || return 1
+    cargo clippy -p mccs --target "$t" --features defmt -- -D warnings || return 1
+    cargo clippy -p mccs-firmware --target "$t" --lib --bins -- -D warnings || return 1
+  done
+}
 
-step "clippy (host, all targets, -D warnings)"
-cargo clippy --workspace --all-targets -- -D warnings
+core_alone() {
+  # The core builds for every thumb target without any firmware module.
+  for t in "${THUMB[@]}"; do
+    cargo build -p mccs --release --target "$t" || return 1
+    cargo build -p mccs --release --target "$t" --features defmt || return 1
+  done
+}
 
-step "clippy (thumb: the core alone, with and without defmt, and the firmware; -D warnings)"
-for t in thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf; do
-  cargo clippy -p mccs --target "$t" -- -D warnings
-  cargo clippy -p mccs --target "$t" --features defmt -- -D warnings
-  cargo clippy -p mccs-firmware --target "$t" -- -D warnings
+firmware_builds() {
+  for t in "${THUMB[@]}"; do
+    cargo build --release -p mccs-firmware --target "$t" --bins || return 1
+  done
+}
+
+# The main job as a person runs it: scripts/demo.sh in a terminal (script(1) gives it a
+# pseudo-terminal), which must end with its SUMMARY line, checked against the host.
+demo_in_a_terminal() {
+  local out=target/qemu/demo-m4f.log
+  script -qec "bash scripts/demo.sh" /dev/null > "$out.raw" 2>&1 < /dev/null || return 1
+  tr -d '\r' < "$out.raw" | grep -vE '^(\.\.\.  |ok   |setup: )' > "$out"
+  tail -n 1 "$out" | grep -q '^SUMMARY ' || { echo "the demo did not end with its SUMMARY line"; return 1; }
+  target/debug/mccs demo --core m4f --check "$out"
+}
+
+demo_core() {
+  local core=$1 out="target/qemu/demo-$1.log"
+  bash scripts/firmware.sh "$core" > "$out" || return 1
+  tail -n 2 "$out"
+  target/debug/mccs demo --core "$core" --check "$out"
+}
+
+tick_path() {
+  for t in "${THUMB[@]}"; do
+    python3 scripts/check_tick_path.py "target/$t/release/haptic" | tail -n 1 || return 1
+  done
+}
+
+# A panic in the tick exits QEMU with failure, and the tick-path check sees it.
+panic_test() {
+  if bash scripts/firmware.sh m4f --features panic-test > target/qemu/panic.log; then
+    echo "the panic-test firmware exited with success"
+    return 1
+  fi
+  grep "panic: " target/qemu/panic.log || return 1
+  if python3 scripts/check_tick_path.py target/thumbv7em-none-eabihf/release/haptic > /dev/null; then
+    echo "the tick-path check missed the injected panic"
+    return 1
+  fi
+  # Rebuild without the feature, for the stages after.
+  cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
+}
+
+# A breached budget exits the bench with failure.
+budget_test() {
+  local t=thumbv7em-none-eabihf
+  cargo build --release -p mccs-firmware --target "$t" --bin bench --features budget-test || return 1
+  if timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin bench \
+      --features budget-test < /dev/null 2> /dev/null \
+      | target/debug/defmt-log "target/$t/release/bench" > target/qemu/budget-test.log; then
+    echo "the bench firmware passed an impossible budget"
+    return 1
+  fi
+  grep "result=OVER" target/qemu/budget-test.log || return 1
+  cargo build --release -p mccs-firmware --target "$t" --bin bench
+}
+
+# Flash and static RAM of the demo firmware (defmt included), per core.
+sizes() {
+  for t in "${THUMB[@]}"; do
+    python3 scripts/size.py "target/$t/release/haptic" "$t" haptic 65536 16384 || return 1
+  done | tee target/qemu/sizes.txt
+}
+
+host_tests() {
+  cargo test --workspace --no-fail-fast -- --show-output
+}
+
+run_stage fmt cargo fmt --all -- --check
+run_stage clippy-host cargo clippy --workspace --all-targets -- -D warnings
+run_stage clippy-thumb clippy_thumb
+run_stage core-alone-thumb-builds core_alone
+run_stage host-build cargo test --workspace --no-run
+run_stage firmware-builds firmware_builds
+run_stage demo-m4f-in-a-terminal demo_in_a_terminal
+run_stage demo-m3 demo_core m3
+run_stage demo-m0 demo_core m0
+run_stage tick-path tick_path
+run_stage panic-exits-with-failure panic_test
+run_stage bench bash scripts/bench.sh
+run_stage budget-breach-fails budget_test
+run_stage firmware-size sizes
+run_stage host-tests host_tests
+run_stage docs-figures python3 scripts/figures.py check
+
+# The table, and the line CI reads.
+host_log="$LOG_DIR/host-tests.log"
+host_passed=$(grep -Eo 'test result: [a-zA-Z]+\. [0-9]+ passed' "$host_log" 2> /dev/null | awk '{s += $4} END {print s + 0}')
+host_failed=$(grep -Eo '[0-9]+ failed;' "$host_log" 2> /dev/null | awk '{s += $1} END {print s + 0}')
+passed=$host_passed
+failed=$host_failed
+printf '\n%-28s %-6s %s\n' stage result seconds
+for s in "${STAGES[@]}"; do
+  IFS='|' read -r result name took <<< "$s"
+  printf '%-28s %-6s %s\n' "$name" "$result" "$took"
+  if [ "$name" = host-tests ]; then
+    # Counted by its tests; a failure without a failed test (a build error) counts one.
+    if [ "$result" != ok ] && [ "$host_failed" = 0 ]; then failed=$((failed + 1)); fi
+    continue
+  fi
+  if [ "$result" = ok ]; then passed=$((passed + 1)); else failed=$((failed + 1)); fi
 done
-
-step "thumb builds of the core alone (release, no firmware module)"
-for t in thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf; do
-  cargo build -p mccs --release --target "$t"
-  cargo build -p mccs --release --target "$t" --features defmt
-done
-
-step "firmware in QEMU: the demo on all three cores, checked against the host"
-cargo build --quiet --release -p mccs-host --bin mccs
-mkdir -p target/qemu
-for core in m4f m3 m0; do
-  bash scripts/firmware.sh "$core" > "target/qemu/demo-$core.log"
-  tail -n 2 "target/qemu/demo-$core.log"
-  ./target/release/mccs demo --core "$core" --check "target/qemu/demo-$core.log"
-done
-
-step "static check of the per-tick path: no panic, division or floating point"
-for t in thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi; do
-  python3 scripts/check_tick_path.py "target/$t/release/haptic" | tail -n 1
-done
-
-step "firmware in QEMU: a panic exits with failure (and the check above sees it)"
-if bash scripts/firmware.sh m4f --features panic-test > target/qemu/panic.log; then
-  echo "test.sh: the panic-test firmware exited with success" >&2
-  exit 1
-fi
-grep -q "panic: " target/qemu/panic.log
-if python3 scripts/check_tick_path.py target/thumbv7em-none-eabihf/release/haptic > /dev/null; then
-  echo "test.sh: the tick-path check missed the injected panic" >&2
-  exit 1
-fi
-
-step "instruction counts in QEMU: budgets (bench/budgets.txt) and bench/baseline.txt (+5 % at most)"
-bash scripts/bench.sh
-
-step "bench in QEMU: a breached budget exits with failure"
-if timeout 300 cargo run --quiet --release -p mccs-firmware --target thumbv7em-none-eabihf --bin bench --features budget-test \
-    2>/dev/null | defmt-print -e target/thumbv7em-none-eabihf/release/bench > target/qemu/budget-test.log; then
-  echo "test.sh: the bench firmware passed an impossible budget" >&2
-  exit 1
-fi
-grep "result=OVER" target/qemu/budget-test.log
-
-step "memory of the demo firmware (defmt, release): flash ≤ 64 KiB"
-size_tool="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin/llvm-size"
-for t in thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi; do
-  cargo build --quiet --release -p mccs-firmware --target "$t" --bin haptic
-  "$size_tool" -A "target/$t/release/haptic" | python3 -c '
-import sys
-target = sys.argv[1]
-sec = {}
-for line in sys.stdin:
-    p = line.split()
-    if len(p) >= 3 and p[0].startswith(".") and p[1].isdigit():
-        sec[p[0]] = int(p[1])
-flash = sum(sec.get(s, 0) for s in (".vector_table", ".text", ".rodata", ".data", ".gnu.sgstubs"))
-ram = sum(sec.get(s, 0) for s in (".data", ".bss", ".uninit"))
-print(f"SIZE target={target} flash={flash} ram={ram} (static; the stack comes on top)")
-if flash > 64 * 1024:
-    sys.exit(f"test.sh: {target} demo firmware flash {flash} B > 64 KiB")
-' "$t"
-done
-
-step "host tests"
-log=$(mktemp)
-cargo test --workspace 2>&1 | tee "$log"
-passed=$(grep -Eo 'test result: ok\. [0-9]+ passed' "$log" | awk '{s += $4} END {print s + 0}')
-failed=$(grep -Eo '[0-9]+ failed' "$log" | awk '{s += $1} END {print s + 0}')
-rm -f "$log"
-echo "host tests: $passed passed, $failed failed"
+echo "host tests: $host_passed passed, $host_failed failed; logs in $LOG_DIR; $((SECONDS - all_start)) s in all"
+echo "$passed passed, $failed failed"
+[ "$failed" = 0 ]

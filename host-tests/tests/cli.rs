@@ -27,14 +27,17 @@ fn temp_file(name: &str, text: &str) -> PathBuf {
     path
 }
 
-/// Asserts exit 2, empty stdout, and one stderr line containing every `needle`.
+/// Asserts exit 2, empty stdout, and one stderr line containing every `needle` — for a
+/// mistake the argument parser finds, followed by one `usage:` hint line.
 fn assert_usage_error(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
     assert!(out.stdout.is_empty(), "stdout not empty");
-    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
+    let lines: Vec<&str> = err.lines().collect();
+    let one_line = lines.len() == 1 || (lines.len() == 2 && lines[1].starts_with("usage: mccs"));
+    assert!(one_line, "not one line (and a usage hint): {err:?}");
     for n in needles {
-        assert!(err.contains(n), "{err:?} lacks {n:?}");
+        assert!(lines[0].contains(n), "{err:?} lacks {n:?}");
     }
 }
 
@@ -570,4 +573,70 @@ fn fit_rejects_what_the_models_cannot_take_and_checks_outputs_first() {
         .parse()
         .unwrap();
     assert!(mean < 1e-6, "noise-free data fit exactly: {stdout}");
+}
+
+/// The front door: a bare `mccs` prints its full help; a usage error names the argument
+/// and gives a usage hint; `demo --check` takes only a demo log of its core whose SUMMARY
+/// equals the host's run, with the exit statuses its help states.
+#[test]
+fn help_usage_and_the_demo_check() {
+    let out = mccs(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for sub in ["curve", "table", "fit", "demo", "patch", "replay"] {
+        assert!(help.contains(sub), "{help}");
+    }
+    let out = mccs(&["curve", "--params", "x", "--frm", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.lines().next().unwrap().contains("--frm"), "{err}");
+    assert!(
+        err.contains("tip: a similar argument exists: '--from'"),
+        "{err}"
+    );
+    assert!(
+        err.lines().nth(1).unwrap().starts_with("usage: mccs curve"),
+        "{err}"
+    );
+
+    let host = String::from_utf8(mccs(&["demo", "--core", "m3"]).stdout).unwrap();
+    let summary = host.trim();
+    let start = "INFO  mccs haptic demo: core=m3 tick=1000 Hz, …";
+    let cases: [(&str, String, Option<i32>); 6] = [
+        (
+            "good.log",
+            format!("{start}\nINFO  tick=100 …\n{summary}\n"),
+            Some(0),
+        ),
+        ("readme.log", format!("# README\n{summary}\n"), Some(2)),
+        (
+            "other-core.log",
+            format!("INFO  mccs haptic demo: core=m0 …\n{summary}\n"),
+            Some(2),
+        ),
+        (
+            "unfinished.log",
+            format!("{start}\nINFO  tick=100 …\n"),
+            Some(2),
+        ),
+        (
+            "overrun.log",
+            format!("{start}\n{}\n", summary.replace("overruns=0", "overruns=3")),
+            Some(1),
+        ),
+        (
+            "digits.log",
+            format!("{start}\n{}\n", summary.replace("ticks=2000", "ticks=1999")),
+            Some(1),
+        ),
+    ];
+    for (name, text, status) in cases {
+        let f = temp_file(name, &text);
+        let out = mccs(&["demo", "--core", "m3", "--check", f.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), status, "{name}: {err}");
+        if status != Some(0) {
+            assert_eq!(err.lines().count(), 1, "{name}: {err}");
+            assert!(err.contains(name), "{name}: {err}");
+        }
+    }
 }

@@ -223,10 +223,17 @@ fn run_cases<S: Strategy>(
 ) where
     S::Value: std::fmt::Debug,
 {
+    // A fixed seed (so that the figures these runs print are the same every time), or
+    // PROPTEST_RNG_SEED's.
+    let seed = std::env::var("PROPTEST_RNG_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2026);
     let config = ProptestConfig {
         cases,
         max_global_rejects: cases.saturating_mul(20),
         failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
         ..ProptestConfig::default()
     };
     let mut runner = proptest::test_runner::TestRunner::new(config);

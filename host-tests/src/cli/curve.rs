@@ -47,12 +47,32 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
         }
         Backend::Fixed => {
-            with_table!(a.knots, &p, &a.params, Domain::Default, |t| {
+            let rows = with_table!(a.knots, &p, &a.params, Domain::Default, |t| {
                 fixed_curve(&t, &strains)
-            })
+            });
+            warn_outside_domain(&p, &strains);
+            rows
         }
     };
     write_curve(out, &rows)
+}
+
+/// Warns on stderr when strains lie above the fixed table's domain where the law is
+/// still curved: there the table's line is the law's tangent at the domain's edge, an
+/// under-estimate (below the domain, and above the solid point, the lines are exact).
+fn warn_outside_domain(p: &mccs::Params, strains: &[f64]) {
+    let (lo, hi) = mccs::table::DEFAULT_DOMAIN;
+    let Ok(law) = mccs::Law::new(p) else { return };
+    let above = strains
+        .iter()
+        .filter(|&&e| e > hi && e < law.strain_c())
+        .count();
+    if above > 0 {
+        eprintln!(
+            "mccs: warning: {above} strains lie above the fixed table's domain [{lo}, {hi}] and below the solid point {:.6}: there the table gives the tangent at {hi}, not the law",
+            law.strain_c()
+        );
+    }
 }
 
 /// The strains `from + i·step ≤ to`, validated.
@@ -93,7 +113,7 @@ fn fixed_curve<const S: usize>(t: &ForceTable<S>, strains: &[f64]) -> Vec<(f64, 
 
 fn write_curve(out: &mut dyn Write, rows: &[(f64, f64, f64)]) -> Result<(), CliError> {
     let mut w = csv::Writer::from_writer(out);
-    let err = |e: csv::Error| CliError(format!("stdout: {e}"));
+    let err = |e: csv::Error| CliError::new(format!("stdout: {e}"));
     w.write_record(["strain", "force_n", "stiffness_n"])
         .map_err(err)?;
     for (e, f, k) in rows {

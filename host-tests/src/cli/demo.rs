@@ -11,22 +11,24 @@ pub(super) struct Args {
     /// Which core's demo: m4f, m3 or m0.
     #[arg(long, default_value = "m4f")]
     core: String,
-    /// A decoded firmware log to check: exit 1 unless its SUMMARY has overruns=0 and
-    /// the same ticks, and steady and max force within 1 % of the host's.
+    /// A decoded firmware log (scripts/firmware.sh's output) to check against the host's
+    /// run: exit 0 when it is this core's demo log and its SUMMARY line has the host's
+    /// ticks and forces (to the printed digit) and overruns=0; exit 1 when it does not;
+    /// exit 2 when the file cannot be read or is not this core's demo log.
     #[arg(long)]
     check: Option<PathBuf>,
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let spec = demo::spec(&a.core).ok_or_else(|| arg_error("--core", "must be m4f, m3 or m0"))?;
-    let host = demo::run_on_host(&spec).map_err(|e| CliError(format!("demo: {e:?}")))?;
+    let host = demo::run_on_host(&spec).map_err(|e| CliError::new(format!("demo: {e}")))?;
     let line = format!(
         "SUMMARY ticks={} overruns={} max_force_n={} steady_force_n={}",
         host.ticks, host.overruns, host.max_force, host.steady_force
     );
     match a.check {
         None => writeln!(out, "{line}").map_err(io_error),
-        Some(log) => check_demo_log(&log, &host, &line, out),
+        Some(log) => check_demo_log(&log, &a.core, &host, &line, out),
     }
 }
 
@@ -38,57 +40,79 @@ pub struct FirmwareSummary {
     /// Ticks over budget.
     pub overruns: u32,
     /// Largest force, N.
-    pub max_force: f64,
+    pub max_force: f32,
     /// Steady force, N.
-    pub steady_force: f64,
+    pub steady_force: f32,
 }
 
-/// Parses the last `SUMMARY ticks=… overruns=… max_force_n=… steady_force_n=…` line.
-pub fn parse_summary(log: &str) -> Option<FirmwareSummary> {
-    let line = log
-        .lines()
-        .rev()
-        .find(|l| l.trim_start().starts_with("SUMMARY "))?;
-    let field = |name: &str| -> Option<&str> {
-        line.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(name).and_then(|v| v.strip_prefix('=')))
+/// Parses a `SUMMARY ticks=… overruns=… max_force_n=… steady_force_n=…` line: exactly
+/// these four fields, in this order.
+pub fn parse_summary(line: &str) -> Option<FirmwareSummary> {
+    let mut fields = line.trim().strip_prefix("SUMMARY ")?.split_whitespace();
+    let mut next = |name: &str| -> Option<String> {
+        let kv = fields.next()?;
+        Some(kv.strip_prefix(name)?.strip_prefix('=')?.to_owned())
     };
-    Some(FirmwareSummary {
-        ticks: field("ticks")?.parse().ok()?,
-        overruns: field("overruns")?.parse().ok()?,
-        max_force: field("max_force_n")?.parse().ok()?,
-        steady_force: field("steady_force_n")?.parse().ok()?,
-    })
+    let s = FirmwareSummary {
+        ticks: next("ticks")?.parse().ok()?,
+        overruns: next("overruns")?.parse().ok()?,
+        max_force: next("max_force_n")?.parse().ok()?,
+        steady_force: next("steady_force_n")?.parse().ok()?,
+    };
+    fields.next().is_none().then_some(s)
 }
 
+/// The demo log's checks: it is `core`'s demo log (its first line is the firmware's
+/// start line for that core), it ends with one well-formed SUMMARY line, and that line
+/// equals the host's run.
 fn check_demo_log(
     log: &Path,
+    core: &str,
     host: &Summary,
     host_line: &str,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
+    let name = log.display();
     let text = std::fs::read_to_string(log)
-        .map_err(|e| CliError(format!("{}: cannot read: {e}", log.display())))?;
-    let fw = parse_summary(&text)
-        .ok_or_else(|| CliError(format!("{}: no SUMMARY line", log.display())))?;
-    let within = |a: f64, b: f64| (a - b).abs() <= 0.01 * b.abs();
+        .map_err(|e| CliError::new(format!("{name}: cannot read: {e}")))?;
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    let start = format!("mccs haptic demo: core={core} ");
+    if !lines.first().is_some_and(|l| {
+        l.trim_start_matches("INFO")
+            .trim_start()
+            .starts_with(&start)
+    }) {
+        return Err(CliError::new(format!(
+            "{name}: not a {core} demo log (its first line is not the firmware's `{}…`)",
+            start.trim_end()
+        )));
+    }
+    let summaries = lines.iter().filter(|l| l.starts_with("SUMMARY")).count();
+    let last = lines.last().copied().unwrap_or_default();
+    let fw = match (summaries, parse_summary(last)) {
+        (1, Some(fw)) => fw,
+        (0, _) => {
+            return Err(CliError::new(format!(
+                "{name}: no SUMMARY line: the firmware did not finish"
+            )))
+        }
+        _ => {
+            return Err(CliError::new(format!(
+                "{name}: the log must end with its one SUMMARY line"
+            )))
+        }
+    };
     let ok = fw.overruns == 0
         && fw.ticks == host.ticks
-        && within(fw.steady_force, host.steady_force as f64)
-        && within(fw.max_force, host.max_force as f64);
+        && fw.steady_force == host.steady_force
+        && fw.max_force == host.max_force;
     writeln!(out, "host:     {host_line}").map_err(io_error)?;
-    writeln!(
-        out,
-        "firmware: SUMMARY ticks={} overruns={} max_force_n={} steady_force_n={}",
-        fw.ticks, fw.overruns, fw.max_force, fw.steady_force
-    )
-    .map_err(io_error)?;
+    writeln!(out, "firmware: {last}").map_err(io_error)?;
     if ok {
         writeln!(out, "demo check: ok").map_err(io_error)
     } else {
-        Err(CliError(format!(
-            "{}: SUMMARY does not match the host (needs overruns=0, the same ticks, forces within 1 %)",
-            log.display()
+        Err(CliError::check_failed(format!(
+            "{name}: SUMMARY differs from the host's run (needs overruns=0, the same ticks and forces to the printed digit)"
         )))
     }
 }

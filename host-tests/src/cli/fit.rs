@@ -74,7 +74,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     if let Some(p) = &a.plot {
         check_writable("--plot", p)?;
     }
-    let points = fit::read_data(&a.data).map_err(|e| CliError(e.to_string()))?;
+    let points = fit::read_data(&a.data).map_err(|e| CliError::new(e.to_string()))?;
     if points.len() > fit::FIT_ROWS {
         eprintln!(
             "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
@@ -101,7 +101,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let mut fits = Vec::new();
     for kind in kinds {
         let f = fit::fit_rows(kind, &points, &mut progress).ok_or_else(|| {
-            CliError(format!(
+            CliError::new(format!(
                 "{}: the {} model could not be fitted",
                 a.data.display(),
                 kind.name()
@@ -131,12 +131,12 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             paramfile::to_toml(&p)
         );
         std::fs::write(&path, text)
-            .map_err(|e| CliError(format!("{}: cannot write: {e}", path.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
     }
     if let Some(path) = a.plot {
         let title = format!("{}: fitted models", a.data.display());
         fit::plot(&path, &points, &fits, &title)
-            .map_err(|e| CliError(format!("{}: cannot draw: {e}", path.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", path.display())))?;
     }
     Ok(())
 }

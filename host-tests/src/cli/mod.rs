@@ -1,5 +1,6 @@
 //! The `mccs` command-line tool: one module per subcommand, each owning its arguments
-//! (`clap::Args`) and its run. Every failure is a [`CliError`]: one line, exit status 2.
+//! (`clap::Args`) and its run. Every failure is a [`CliError`]: one line, exit status 2
+//! for bad input, 1 for a check that ran and failed (`mccs demo --check`).
 
 use crate::paramfile;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -19,40 +20,65 @@ pub use patch::{reference_max_stiffness, PatchRun};
 pub use patch_args::MAX_GRID_REFERENCE;
 pub use table::render_table;
 
-/// One-line error for the user; the process exits with status 2.
+/// One-line error for the user, and the exit status it gets.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CliError(pub String);
+pub struct CliError {
+    /// The line.
+    pub message: String,
+    /// 2: bad input (a file, a row, an argument); 1: a check ran and failed.
+    pub status: u8,
+}
+
+impl CliError {
+    /// Bad input: exit status 2.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            status: 2,
+        }
+    }
+
+    /// A check that ran and failed: exit status 1.
+    pub fn check_failed(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            status: 1,
+        }
+    }
+}
 
 impl std::fmt::Display for CliError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+        f.write_str(&self.message)
     }
 }
 
 impl From<paramfile::ParamFileError> for CliError {
     fn from(e: paramfile::ParamFileError) -> Self {
-        CliError(e.to_string())
+        CliError::new(e.to_string())
     }
 }
 
 /// `ARG: what`.
 pub(crate) fn arg_error(arg: &str, what: &str) -> CliError {
-    CliError(format!("{arg}: {what}"))
+    CliError::new(format!("{arg}: {what}"))
 }
 
 /// `FILE: what`, for a parameter file whose values break a rule.
 pub(crate) fn file_error(file: &Path, e: impl std::fmt::Display) -> CliError {
-    CliError(format!("{}: {e}", file.display()))
+    CliError::new(format!("{}: {e}", file.display()))
 }
 
 /// A failure writing the output.
 pub(crate) fn io_error(e: std::io::Error) -> CliError {
-    CliError(format!("stdout: {e}"))
+    CliError::new(format!("stdout: {e}"))
 }
 
-/// Multi-component conical spring soft tissue: curves, tables and patch runs.
+/// Multi-component conical spring soft tissue: curves, tables, fits, patch runs and
+/// replays on the host; the firmware's demo and its check. Every subcommand has --help;
+/// docs/cli.md has the whole tour.
 #[derive(Parser, Debug)]
-#[command(name = "mccs", version)]
+#[command(name = "mccs", version, arg_required_else_help = true)]
 pub struct Cli {
     #[command(subcommand)]
     command: Command,

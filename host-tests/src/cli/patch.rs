@@ -32,7 +32,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let p = paramfile::read(&a.params)?;
     let rows = run.reactions(&p, &a.params)?;
     let mut w = csv::Writer::from_writer(out);
-    let err = |e: csv::Error| CliError(format!("stdout: {e}"));
+    let err = |e: csv::Error| CliError::new(format!("stdout: {e}"));
     w.write_record(["time_s", "reaction_n"]).map_err(err)?;
     for (t, r) in rows {
         w.write_record([fmt_strain(t), r.to_string()])

@@ -139,7 +139,7 @@ pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError
                 &format!("the narrow arithmetic holds springs up to {max_mm} mm: use a smaller spacing or --arith wide"),
             )
         }
-        other => return CliError(other.to_string()),
+        other => return CliError::new(other.to_string()),
     };
     arg_error(arg, what)
 }

@@ -31,7 +31,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let p = paramfile::read(&a.params)?;
     // The table is built (and its errors named) before the trajectory is read.
     solver_table(&p, &a.params)?;
-    let traj = trajectory::read(&a.probe).map_err(|e| CliError(e.to_string()))?;
+    let traj = trajectory::read(&a.probe).map_err(|e| CliError::new(e.to_string()))?;
     let replay = Replay {
         grid: a.patch.grid,
         spacing: a.patch.spacing,

@@ -38,7 +38,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     });
     match a.out {
         Some(path) => std::fs::write(&path, src)
-            .map_err(|e| CliError(format!("{}: cannot write: {e}", path.display()))),
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display()))),
         None => out.write_all(src.as_bytes()).map_err(io_error),
     }
 }

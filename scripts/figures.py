@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""The figures quoted in README.md and docs/*.md, held to what the code prints.
+
+A figure in a doc is marked `<!-- fig:KEY -->VALUE<!-- /fig -->` (the markers do not
+render). KEY names a value printed by the test command: every line of its logs of the
+form `TAG k1=v1 k2=v2 …` (BENCH, MEM, FIT, SIZE, SUMMARY, SWEEP, PROPERTY, REPLAY,
+TABLE, …) gives one figure per numeric field, keyed
+`TAG.<the non-numeric values, in order>.<field>`, e.g. `BENCH.m4f.spring.instructions`
+or `SWEEP.wide.max_error_rel`; a SUMMARY line of a demo log is keyed by its core
+(`SUMMARY.m4f.steady_force_n`).
+
+  figures.py check    fail (exit 1) when a marked value differs from what was printed,
+                      or when nothing printed its key; one line each
+  figures.py update   rewrite the marked values from the logs
+  figures.py list     print every figure the logs hold
+
+The logs: target/qemu/*.txt and *.log (the firmware, the bench, the sizes) and
+target/logs/test/host-tests.log (the host tests, run with --show-output).
+"""
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+MARK = re.compile(r"<!-- fig:([A-Za-z0-9_.\-]+) -->(.*?)<!-- /fig -->")
+LINE = re.compile(r"^(?:INFO\s+)?([A-Z][A-Z_]+) ((?:\S+=\S+ ?)+)$")
+NUMBER = re.compile(r"^-?[0-9][0-9.]*(e[-+]?[0-9]+)?(/100)?$")
+
+
+def figures() -> dict:
+    out = {}
+    sources = sorted((ROOT / "target/qemu").glob("*.txt")) + sorted((ROOT / "target/qemu").glob("*.log"))
+    sources.append(ROOT / "target/logs/test/host-tests.log")
+    for path in sources:
+        if not path.exists():
+            continue
+        core = re.match(r"demo-(\w+)\.log", path.name)
+        for raw in path.read_text(errors="replace").splitlines():
+            m = LINE.match(raw.strip())
+            if not m:
+                continue
+            tag, fields = m.group(1), [kv.split("=", 1) for kv in m.group(2).split()]
+            ident = [v for k, v in fields if not NUMBER.match(v)]
+            if tag == "SUMMARY":
+                if not core:
+                    continue
+                ident = [core.group(1)]
+            for k, v in fields:
+                if NUMBER.match(v):
+                    out[".".join([tag] + ident + [k])] = v
+    return out
+
+
+def docs():
+    return [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
+
+
+def main() -> int:
+    mode = sys.argv[1] if len(sys.argv) > 1 else "check"
+    figs = figures()
+    if mode == "list":
+        for k in sorted(figs):
+            print(f"{k} = {figs[k]}")
+        return 0
+    bad = 0
+    marks = 0
+    for doc in docs():
+        text = doc.read_text()
+        def repl(m):
+            nonlocal bad, marks
+            marks += 1
+            key, value = m.group(1), m.group(2)
+            if key not in figs:
+                print(f"{doc.relative_to(ROOT)}: {key}: nothing printed this figure")
+                bad += 1
+                return m.group(0)
+            if mode == "check" and figs[key] != value:
+                print(f"{doc.relative_to(ROOT)}: {key}: the doc says {value}, the code prints {figs[key]} (scripts/figures.py update)")
+                bad += 1
+            return f"<!-- fig:{key} -->{figs[key]}<!-- /fig -->"
+        new = MARK.sub(repl, text)
+        if mode == "update" and new != text:
+            doc.write_text(new)
+            print(f"updated {doc.relative_to(ROOT)}")
+    print(f"figures: {marks} quoted, {marks - bad} as printed, {bad} not")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
