@@ -31,7 +31,11 @@ for core in m4f m3 m0; do
   fi
 done
 cat "$out"
-[ "$status" = 0 ] || exit 1
+if [ "$status" != 0 ]; then
+  echo "bench: failed: a firmware exited with failure:" >&2
+  grep -hE "result=(OVER|missing)|malformed|panic" target/qemu/bench-*.log >&2 || true
+  exit 1
+fi
 if [ "$mode" = "--update" ]; then
   grep -E "^(BENCH|MEM) " "$out" > bench/baseline.txt
   echo "bench: baseline updated"
@@ -45,11 +49,19 @@ def load(path):
         if not line.startswith("BENCH "):
             continue
         f = dict(kv.split("=", 1) for kv in line.split()[1:])
-        out[(f["core"], f["case"])] = int(f["instructions"])
+        # The largest patch grows by its n, not by its instructions.
+        key = "n" if f["case"] == "largest_patch_1khz" else "instructions"
+        out[(f["core"], f["case"])] = int(f[key])
     return out
 now, base = load(sys.argv[1]), load(sys.argv[2])
-bad = [f"{c} {k}: {now.get((c, k))} > {base[(c, k)]} + 5 %" for (c, k) in base
-       if (c, k) not in now or now[(c, k)] > base[(c, k)] * 1.05]
+def worse(c, k):
+    if (c, k) not in now:
+        return True
+    if k == "largest_patch_1khz":
+        return now[(c, k)] < base[(c, k)]
+    return now[(c, k)] > base[(c, k)] * 1.05
+bad = [f"{c} {k}: {now.get((c, k))} against {base[(c, k)]}" + (" (n, smaller)" if k == "largest_patch_1khz" else " + 5 %")
+       for (c, k) in base if worse(c, k)]
 for b in bad:
     print("bench regression:", b)
 budgets = [l for l in open(sys.argv[1]) if l.startswith(("BUDGET ", "RATIO ", "MEMORY "))]

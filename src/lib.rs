@@ -40,7 +40,7 @@ pub use arith::{Arith, DefaultArith, Narrow, Wide};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
-pub use solver::{ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
+pub use solver::{Bound, ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableError,
 };

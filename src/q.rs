@@ -81,6 +81,13 @@ pub fn mulhi_split(a: i32, b: i32) -> i32 {
         .wrapping_add(n >> 16)
 }
 
+/// `c + ⌊a · b / 2³²⌋` (wrapping): one `smmla` on cores with a long multiply; the
+/// caller's ranges keep the sum within `i32`.
+#[inline(always)]
+pub fn mulhi_acc(a: i32, b: i32, c: i32) -> i32 {
+    c.wrapping_add(mulhi(a, b))
+}
+
 /// `⌊(a · b + 2³¹) / 2³²⌋`: the high word of the product, rounded to nearest (`smmulr`
 /// on cores with a long multiply). The M0 adds the low word's top bit to
 /// [`mulhi_split`]: the same bits.

@@ -9,7 +9,7 @@
 //! | tangent stiffness `dF/dε` | [`Stiffness`] `I16F16` | N per unit strain | ±32768 | 1.5e-5 |
 //! | displacement, position | [`Length`] `I8F24` | mm | ±128 mm | 6.0e-8 mm |
 //! | velocity | [`Velocity`] `I16F16` | mm/s | ±32768 mm/s | 1.5e-5 mm/s |
-//! | unit edge direction | raw Q[`DIR_FRAC`] | 1 | ±4 | 1.9e-9 |
+//! | unit edge direction | raw Q[`DIR_FRAC`] | 1 | ±256 | 1.2e-7 |
 //! | inverse rest length `1/l0` | raw Q[`INV_LEN_FRAC`] | 1/mm | < 1 (l0 ≥ 1 mm) | 4.7e-10 |
 //!
 //! The per-tick code works on the raw `i32` bits of these types; the intermediate formats
@@ -36,8 +36,9 @@ pub const STIFF_FRAC: u32 = Stiffness::FRAC_NBITS;
 pub const LEN_FRAC: u32 = Length::FRAC_NBITS;
 /// Fraction bits of [`Velocity`].
 pub const VEL_FRAC: u32 = Velocity::FRAC_NBITS;
-/// Fraction bits of an edge's unit rest vector.
-pub const DIR_FRAC: u32 = 29;
+/// Fraction bits of an edge's unit rest vector: the format of `(x_b − x_a)/l0` in the
+/// spring kernels, so that it is the rest vector plus one high-word product.
+pub const DIR_FRAC: u32 = 23;
 /// Fraction bits of an edge's `1 / l0` (1/mm).
 pub const INV_LEN_FRAC: u32 = 31;
 

@@ -35,33 +35,35 @@ pub struct DemoSpec {
     pub clock_hz: u32,
 }
 
-/// Cortex-M4F (STM32F405, 168 MHz): N = 5 at 1 kHz, 6 substeps per tick.
-/// Budget: 125,000 instructions per tick (`-icount shift=3`, 8 ns each).
+/// Cortex-M4F (STM32F405, 168 MHz): N = 8 (214 springs) at 1 kHz, the default
+/// configuration (3 substeps per tick). Budget: 125,000 instructions per tick
+/// (`-icount shift=3`, 8 ns each).
 pub const M4F: DemoSpec = DemoSpec {
     core: "m4f",
     tick_hz: 1000,
-    grid: 5,
+    grid: 8,
     node_mass: 0.005,
     spring_damping: 1.0,
     icount_shift: 3,
     clock_hz: 168_000_000,
 };
 
-/// Cortex-M3 (LM3S6965, 50 MHz): N = 4 at 1 kHz, 2 substeps per tick (heavier haptic
-/// masses and more damping). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
+/// Cortex-M3 (LM3S6965, 50 MHz): N = 5 at 1 kHz, the default configuration (2 substeps
+/// per tick). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
 pub const M3: DemoSpec = DemoSpec {
     core: "m3",
     tick_hz: 1000,
-    grid: 4,
-    node_mass: 0.03,
-    spring_damping: 3.0,
+    grid: 5,
+    node_mass: 0.005,
+    spring_damping: 1.0,
     icount_shift: 5,
     clock_hz: 50_000_000,
 };
 
-/// Cortex-M0 (48 MHz class): N = 4 at 1 kHz, 2 substeps per tick, the M3's
-/// configuration, in the narrow spring arithmetic ([`mccs::Narrow`]: the M0 has
-/// no 32 × 32 → 64 multiply). Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
+/// Cortex-M0 (48 MHz class): N = 4 at 1 kHz with heavier haptic masses and more damping
+/// (1 substep per tick), in the narrow spring arithmetic ([`mccs::Narrow`]: the M0 has
+/// no 32 × 32 → 64 multiply). N = 5 does not fit its 16 KiB of RAM with the start-up's
+/// stack. Budget: 31,250 instructions per tick (`shift=5`, 32 ns).
 pub const M0: DemoSpec = DemoSpec {
     core: "m0",
     tick_hz: 1000,
@@ -166,11 +168,12 @@ pub type DemoDevice = SimulatedDevice<7>;
 /// (the ground included) and `EDGES` springs.
 pub type DemoControllerOf<const NODES: usize, const EDGES: usize> =
     Controller<DemoDevice, NODES, EDGES, 64>;
-/// A demo controller with capacity for N = 5 (9 free nodes + ground, 61 springs).
-pub type DemoController = DemoControllerOf<10, 61>;
-/// A demo controller with capacity for N = 4 (4 free nodes + ground, 30 springs): the
+/// A demo controller with capacity for N = 8 (36 free nodes + ground, 214 springs): the
+/// M4F demo.
+pub type DemoController = DemoControllerOf<37, 214>;
+/// A demo controller with capacity for N = 5 (9 free nodes + ground, 61 springs): the
 /// M3 and M0 demos, which must fit 16 KiB of RAM on the M0.
-pub type SmallDemoController = DemoControllerOf<5, 30>;
+pub type SmallDemoController = DemoControllerOf<10, 61>;
 
 /// The tissue switched to mid-run: Table 2 with the cone's shear modulus × 1.25.
 pub fn swapped_params() -> Params {
@@ -229,8 +232,8 @@ pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
 
 fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
     static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
-    let mut ctl: Controller<DemoDevice, 10, 61, 64, A> = spec.controller(TABLE2)?;
-    let mut swap = Some(spec.swapped_set::<10, 61, A>()?);
+    let mut ctl: Controller<DemoDevice, 37, 214, 64, A> = spec.controller(TABLE2)?;
+    let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
     for tick in 0..spec.ticks() {
         let s = if tick >= spec.swap_tick() {
             swap.take()

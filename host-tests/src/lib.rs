@@ -10,4 +10,5 @@ pub mod paramfile;
 pub mod patch;
 pub mod reference;
 pub mod replay;
+pub mod stability;
 pub mod trajectory;

@@ -128,30 +128,46 @@ impl TwinConfig {
     }
 }
 
-/// The stability bound of the core's solver docs, computed independently: substeps per
-/// tick for `mesh` with the law's largest tangent stiffness `k_max` (N per unit strain).
+/// Substeps per tick for `mesh` with the law's largest tangent stiffness `k_max` (N per
+/// unit strain), from the conservative bound of the core's docs (`solver::stability`),
+/// computed independently: every spring at most `k_max / l0` stiff in every direction
+/// against its damping `C` in every direction, `θ = k_max / (l0_min C)` or the coupling's
+/// `k_c / (c + b_c)`; `γ` the damping's largest Gershgorin row sum over the mass; `h` half
+/// of `min(2/θ, 2/γ)`. `None` without damping.
 pub fn substeps(mesh: &Mesh, k_max: f64, cfg: &TwinConfig) -> Option<u32> {
     let n = mesh.rest.len();
-    let mut stiff = vec![0.0; n];
-    let mut damp = vec![cfg.node_damping; n];
+    let (cs, cn) = (cfg.spring_damping, cfg.node_damping);
+    let (kc, bc) = (cfg.coupling.0 * 1000.0, cfg.coupling.1);
+    let mut row = vec![cn; n];
+    let mut k_row = vec![0.0; n];
+    let mut shortest = f64::INFINITY;
     for s in &mesh.springs {
+        shortest = shortest.min(s.l0);
+        let both = !mesh.fixed[s.i] && !mesh.fixed[s.j];
         for e in [s.i, s.j] {
-            stiff[e] += k_max / s.l0 * 1000.0;
-            damp[e] += cfg.spring_damping;
+            row[e] += if both { 2.0 * cs } else { cs };
+            k_row[e] += k_max / s.l0 * 1000.0 * if both { 2.0 } else { 1.0 };
         }
     }
-    stiff[mesh.contact] += cfg.coupling.0 * 1000.0;
-    damp[mesh.contact] += cfg.coupling.1;
+    row[mesh.contact] += bc;
+    k_row[mesh.contact] += kc;
     let free = (0..n).filter(|&i| !mesh.fixed[i]);
-    let c_max = free.clone().map(|i| damp[i]).fold(0.0, f64::max);
-    let tau = free
-        .map(|i| damp[i] / stiff[i])
-        .fold(f64::INFINITY, f64::min);
-    if tau <= 0.0 || c_max <= 0.0 {
+    let gamma = free.clone().map(|i| row[i]).fold(0.0, f64::max) / cfg.node_mass;
+    let theta = if cs > 0.0 {
+        let springs = k_max / shortest * 1000.0 / cs;
+        let coupling = if cn + bc > 0.0 {
+            kc / (cn + bc)
+        } else {
+            springs + kc / cs
+        };
+        springs.max(coupling)
+    } else if cn > 0.0 {
+        free.map(|i| k_row[i]).fold(0.0, f64::max) / cn
+    } else {
         return None;
-    }
-    let h = 0.5 * (cfg.node_mass / c_max).min(2.0 * tau);
-    Some((1.0 / (cfg.tick_hz * h)).ceil() as u32)
+    };
+    let h = 0.5 * (2.0 / theta).min(2.0 / gamma);
+    (h.is_finite() && h > 0.0).then(|| (1.0 / (cfg.tick_hz * h)).ceil().max(1.0) as u32)
 }
 
 /// The f64 patch.
@@ -170,6 +186,9 @@ pub struct Twin {
     probe_prev: V,
     coupling_force: V,
     reaction: V,
+    /// When set, every spring is linear with this stiffness (N per unit strain) instead
+    /// of the law: the linearisation the stability bound is computed on.
+    pub linear_stiffness: Option<f64>,
 }
 
 impl Twin {
@@ -186,6 +205,7 @@ impl Twin {
             probe_prev: [0.0; 3],
             coupling_force: [0.0; 3],
             reaction: [0.0; 3],
+            linear_stiffness: None,
         }
     }
 
@@ -200,7 +220,10 @@ impl Twin {
             let d = sub(x[s.j], x[s.i]);
             let l = norm(d);
             let strain = (s.l0 - l) / s.l0;
-            let force = self.law.force(strain);
+            let force = match self.linear_stiffness {
+                Some(k) => k * strain,
+                None => self.law.force(strain),
+            };
             let dv = sub(v[s.j], v[s.i]);
             for k in 0..3 {
                 let along = if l > 0.0 { force * d[k] / l } else { 0.0 };

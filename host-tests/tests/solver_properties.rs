@@ -21,7 +21,7 @@
 use mccs::arith::Arith;
 use mccs::units::{DIR_FRAC, INV_LEN_FRAC};
 use mccs::{
-    Coupling, Force, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, Topology,
+    Bound, Coupling, Force, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, Topology,
     Velocity, Wide,
 };
 use mccs_firmware::{Controller, HapticDevice};
@@ -52,10 +52,10 @@ fn any_case(grids: std::ops::RangeInclusive<usize>) -> impl Strategy<Value = Cas
             (0.05f64.ln()..30f64.ln()).prop_map(f64::exp),
             0.0f64..1.0,
         ),
-        (0.4f64..8.0, 0.0f64..5.0, 3.3f64..12.0),
+        (0.4f64..8.0, 0.0f64..5.0, 3.3f64..12.0, any::<bool>()),
     )
         .prop_map(
-            |((grid, spacing, hz), (mass_g, c, node_c), (kc, bc, fmax))| Case {
+            |((grid, spacing, hz), (mass_g, c, node_c), (kc, bc, fmax, conservative))| Case {
                 grid,
                 spacing,
                 config: SolverConfig {
@@ -71,6 +71,11 @@ fn any_case(grids: std::ops::RangeInclusive<usize>) -> impl Strategy<Value = Cas
                         stiffness: kc,
                         damping: bc,
                         max_force: fmax,
+                    },
+                    bound: if conservative {
+                        Bound::Conservative
+                    } else {
+                        Bound::Estimated
                     },
                 },
             },
@@ -266,7 +271,7 @@ fn short<A: Arith>(name: &str) {
     );
     let s = seen.into_inner().unwrap();
     println!(
-        "PROPERTY short arith={name} cases={} ticks={} device_faults={} max_force_of_limit={:.4}",
+        "PROPERTY case=short arith={name} cases={} ticks={} device_faults={} max_force_of_limit={:.4}",
         s.cases, s.ticks, s.faults, s.force_of_max
     );
 }
@@ -446,7 +451,7 @@ fn long<A: Arith>(name: &str) {
     );
     let s = seen.into_inner().unwrap();
     println!(
-        "PROPERTY settle arith={name} cases={} max_energy_rise_of_allowance={:.3} max_final_disp_mm={:.2e}",
+        "PROPERTY case=settle arith={name} cases={} max_energy_rise_of_allowance={:.3} max_final_disp_mm={:.2e}",
         s.cases, s.rise_of_slack, s.final_disp
     );
 }

@@ -17,7 +17,7 @@ fn a_tick_runs_on_one_whole_parameter_set() {
     let ctl: SmallDemoController = spec
         .controller(ForceTable64::new(&Params::TABLE2).unwrap())
         .unwrap();
-    let a = spec.swapped_set::<5, 30, mccs::DefaultArith>().unwrap();
+    let a = spec.swapped_set::<10, 61, mccs::DefaultArith>().unwrap();
     let b = ctl
         .solver()
         .prepare(*ctl.solver().table(), &spec.config())

@@ -7,7 +7,7 @@ use crate::q::{self, V3};
 use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, DISP_LIMIT};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
-use crate::units::{from_f64, Strain, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE, VEL_FRAC};
+use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE, VEL_FRAC};
 
 /// 32 × 32 → 64 products: the M3/M4F's arithmetic, and the host's default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -18,6 +18,10 @@ pub struct Wide;
 const DAMP_FRAC: u32 = 36;
 /// Fraction bits of the edge vector over the rest length, `w`: Q29 (±2 held).
 const W_FRAC: u32 = 29;
+const _: () = assert!(
+    DIR_FRAC == LEN_FRAC + INV_LEN_FRAC - 32,
+    "dir + the high word"
+);
 /// Fraction bits of `f l0/l`: Q23 (±256 N held).
 const FR_FRAC: u32 = 23;
 // The spring's two products share Q52, whose high word is Q20 N.
@@ -165,19 +169,14 @@ fn spring<const S: usize>(
 ) -> V3 {
     let (dir, inv_len) = (edge.dir, edge.inv_len);
     let Ends { ua, ub, va, vb } = ends;
-    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0, Q29: the high word of Q24 · Q31 is
-    // q in Q23 (|u_b − u_a| < 2³¹: the displacement clamp), held within ±4 (one `ssat`)
-    // so that q · 64 fits; the sum with dir (|dir| ≤ 1) saturates, and then w is held
-    // within ±2. Where q was held, |q| ≥ 4 > 2 + |dir|, so w is held at the same ±2 it
-    // would have been: the spring still pulls (or pushes) along that axis, never the
-    // other way.
-    const Q_FRAC: u32 = LEN_FRAC + INV_LEN_FRAC - 32;
-    const Q_HOLD: i32 = 1 << (31 - (W_FRAC - Q_FRAC));
+    // w = (x_b − x_a) / l0 = dir + (u_b − u_a) / l0: dir (Q23) plus the high word of
+    // Q24 · Q31 (one `smmla`); |u_b − u_a| < 2³¹ (the displacement clamp) and
+    // 1/l0 ≤ 1 keep that high word within ±2³⁰, so the sum cannot overflow. Held within
+    // ±2 per axis (one `ssat`), whatever the displacement: a spring stretched further
+    // pulls as if stretched to 2 l0 along that axis, never the other way. Then Q29.
     let w: V3 = core::array::from_fn(|k| {
-        let q = q::mulhi(ub[k].wrapping_sub(ua[k]), inv_len).clamp(-Q_HOLD, Q_HOLD - 1);
-        dir[k]
-            .saturating_add(q << (W_FRAC - Q_FRAC))
-            .clamp(-W_LIMIT, W_LIMIT - 1)
+        let w23 = q::mulhi_acc(ub[k].wrapping_sub(ua[k]), inv_len, dir[k]);
+        w23.clamp(-(W_LIMIT >> 6), (W_LIMIT >> 6) - 1) << (W_FRAC - DIR_FRAC)
     });
     // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high
     // words is within 2 LSB (3e-8) of the high word of the sum, and costs the M0 no low

@@ -1,6 +1,7 @@
 //! [`SolverConfig`]: the solver's runtime configuration, its ranges, and the key that
 //! names a value out of range.
 
+use super::stability::Bound;
 use super::SolverError;
 use crate::coupling::Coupling;
 
@@ -19,6 +20,8 @@ pub struct SolverConfig {
     pub max_substeps: u32,
     /// The probe coupling.
     pub coupling: Coupling,
+    /// Which stability bound sets the substeps ([`Bound::Estimated`] by default).
+    pub bound: Bound,
 }
 
 impl Default for SolverConfig {
@@ -32,6 +35,7 @@ impl Default for SolverConfig {
             node_damping: 0.05,
             max_substeps: 64,
             coupling: Coupling::default(),
+            bound: Bound::Estimated,
         }
     }
 }

@@ -8,7 +8,8 @@
 //! virtual [`crate::Coupling`]; the device renders the coupling force.
 //!
 //! - `config.rs`: [`SolverConfig`] and its ranges; `error.rs`: [`SolverError`];
-//! - `stability.rs`: the substeps per tick the integrator needs;
+//! - `stability.rs`: the substeps per tick the integrator needs (the one-step matrix, a
+//!   closed-form and an estimated bound);
 //! - `param_set.rs`: [`ParamSet`], prepared away from the tick and switched in between two;
 //! - `step.rs`: the tick itself.
 //!
@@ -42,6 +43,7 @@ pub use config::{ConfigKey, SolverConfig};
 pub use error::SolverError;
 use param_set::Coeffs;
 pub use param_set::ParamSet;
+pub use stability::{Bound, Bounds};
 
 /// The patch solver: topology, force table and state. `NODES` counts the ground slot;
 /// `A` is the arithmetic ([`crate::arith`]: [`crate::arith::Wide`] by default,

@@ -1,20 +1,91 @@
-//! The stability bound: how many substeps per tick the improved Euler integrator needs on
-//! a given topology, table and configuration (start-up only).
+//! The stability bound: the largest substep `h` at which the paper's improved Euler
+//! integrator is stable on a patch, and so the substeps per tick (start-up only; never
+//! per tick).
 //!
-//! For one mass `m` on a spring `K` with damping rate `γ = C/m`, the improved Euler step
-//! `h` is stable exactly when `h < 2/γ` and `h < 2 C/K`: unlike symplectic Euler it
-//! *amplifies* an undamped oscillation (by `1 + h²ω²/2` per step), so it needs damping.
-//! The bound applies that per node, Gershgorin-style, with a safety factor of 2:
-//! `K_i = Σ k_max / l0` over the node's springs (+ the coupling), `C_i = Σ C` over its
-//! springs + the node damping (+ the coupling damper), and
-//! `h ≤ ½ · min(2 m / (2 max C_i), 2 min(C_i / K_i))`, where `k_max` is the table's largest
-//! tangent stiffness. The masses are haptic masses (a few grams per node), not the
-//! tissue's: they set how many substeps a tick needs, not the settled force.
+//! # The integrator's one-step matrix
+//! Linearised around a state, the patch is `M ẍ + C ẋ + K x = 0` (`M` the node masses,
+//! `C` the spring dampings on the full relative velocity plus the node and coupling
+//! dampings, `K` every spring at the table's largest tangent stiffness `k_max / l0` along
+//! its rest direction, plus the coupling's stiffness). With `A = M⁻¹K`, `B = M⁻¹C`, one
+//! step of eqs. 21–22 (`v' = v + h M⁻¹ F`, `x' = x + h (v + v')/2`) maps `(x, v)` by
+//!
+//! ```text
+//! G(h) = | I − h²A/2   h (I − hB/2) |
+//!        | −hA         I − hB       |
+//! ```
+//!
+//! (not two-stage Runge–Kutta: the position uses the new velocity). The step is stable
+//! while the spectral radius `ρ(G(h)) < 1`. For one mode (`ω²`, `γ`) that is
+//! `h < 2γ/ω²` and `h < 2/γ`: unlike symplectic Euler the scheme amplifies an undamped
+//! oscillation, so a stiff, lightly damped mode sets the bound.
+//!
+//! # Two bounds
+//! Both start from a closed form, the one-mode bound applied spring by spring: each
+//! spring's stiffness is at most `k_max / l0` in every direction while its damping is `C`
+//! in every direction, so `K ⪯ θ C` with `θ = k_max / (l0_min C)` (the coupling's
+//! `k_c / (c + b_c)` where that is larger), tension's geometric stiffness included
+//! (`|f|/l ≤ k_max / l0`); and `λ_max(M⁻¹C)` is at most the largest Gershgorin row sum
+//! `γ`. Were `K` and `C` to share their eigenvectors, `h < min(2/θ, 2/γ)` would hold for
+//! every mode. They do not, so the closed form is a per-mode argument, **not** a proof
+//! for the coupled patch; over the 120 configurations of `host-tests/tests/stability.rs`
+//! it never exceeded the exact bound (`STABILITY sweep`, `max_closed_of_exact`: equal
+//! where `2/γ` binds, which is exact for node damping alone).
+//! - [`Bound::Estimated`], the default: the largest `h` with `ρ(G(h)) < 1`, estimated
+//!   matrix-free by running the linearised step (in `f32`) from a fixed start and
+//!   measuring its growth, bisected (geometrically, 7 steps) between a quarter of the
+//!   closed form and four times it; then [`ESTIMATE_MARGIN`] of it, where the motion at
+//!   that step visibly dies out (energy growth at most [`TRUSTED_DECAY`] over the last
+//!   third of the run); where it does not (a lightly damped patch: near the edge its
+//!   growth is too slow for the run to see), the conservative bound. The margin covers
+//!   the estimate's error and the states away from rest (a deep indentation stiffens the
+//!   springs across their direction); the tests hold it to the exact bound (the
+//!   eigenvalues of `G(h)`) on rest and deformed states.
+//! - [`Bound::Conservative`]: [`CONSERVATIVE_FACTOR`] of the closed form, no simulation.
+//!   About a quarter of the exact bound on the standard patch (it cannot use the
+//!   springs' being stiff along one direction only): twice the substeps or more.
+//!
+//! The masses are haptic masses (a few grams per node), not the tissue's: they set how
+//! many substeps a tick needs, not the settled force.
 
 use super::{ConfigKey, SolverConfig, SolverError};
 use crate::arith::{MAX_H_OVER_M, MAX_SUBSTEP};
 use crate::table::ForceTable;
-use crate::topology::Topology;
+use crate::topology::{Topology, GROUND};
+use crate::units::{to_f64, DIR_FRAC};
+
+/// Which stability bound a solver takes its substeps from (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bound {
+    /// The estimated exact bound with its margin: the fewest substeps.
+    #[default]
+    Estimated,
+    /// A fraction of the closed form: about twice the substeps, computed in one loop
+    /// over the springs.
+    Conservative,
+}
+
+/// The fraction of the estimated exact bound a solver takes.
+pub const ESTIMATE_MARGIN: f64 = 0.75;
+
+/// The largest growth (energy at the end of the estimate's run over that halfway) at the
+/// estimated step with its margin for which the estimate is taken; above it, the
+/// patch is too lightly damped for the estimate to see the edge, and the solver takes
+/// the conservative bound.
+pub const TRUSTED_DECAY: f32 = 0.5;
+
+/// The fraction of the closed form that [`Bound::Conservative`] takes.
+pub const CONSERVATIVE_FACTOR: f64 = 0.5;
+
+/// The bounds of one patch and configuration (the tests report them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// The closed form (see the module docs: not a proof), s.
+    pub closed: f64,
+    /// The estimated exact bound (before the margin), s.
+    pub estimated: f64,
+    /// The substep the solver takes with its configuration's [`Bound`], s.
+    pub chosen: f64,
+}
 
 /// Checks `config` and returns the substeps per tick the stability bound asks for.
 pub fn substeps_for<const NODES: usize, const EDGES: usize, const S: usize>(
@@ -22,37 +93,13 @@ pub fn substeps_for<const NODES: usize, const EDGES: usize, const S: usize>(
     table: &ForceTable<S>,
     config: &SolverConfig,
 ) -> Result<u32, SolverError> {
-    config.validate()?;
-    let cp = &config.coupling;
-    // Per node: stiffness K_i (N/m) and damping C_i (N·s/m).
-    let k_max = table.max_stiffness().to_num::<f64>();
-    let mut stiff = [0.0f64; NODES];
-    let mut damp = [config.node_damping; NODES];
-    for e in topo.edges() {
-        let k = k_max * 1000.0 / Topology::<NODES, EDGES>::rest_length(e);
-        for n in [e.a, e.b] {
-            if let (Some(s), Some(d)) = (stiff.get_mut(n as usize), damp.get_mut(n as usize)) {
-                *s += k;
-                *d += config.spring_damping;
-            }
-        }
-    }
-    let contact = topo.contact() as usize;
-    if let (Some(s), Some(d)) = (stiff.get_mut(contact), damp.get_mut(contact)) {
-        *s += cp.stiffness * 1000.0;
-        *d += cp.damping;
-    }
-    let (mut c_max, mut tau_min) = (0.0f64, f64::INFINITY);
-    for i in 1..topo.node_count().min(NODES) {
-        c_max = c_max.max(damp[i]);
-        if stiff[i] > 0.0 {
-            tau_min = tau_min.min(damp[i] / stiff[i]);
-        }
-    }
-    if tau_min.is_nan() || tau_min <= 0.0 || c_max <= 0.0 {
-        return Err(SolverError::NoDamping);
-    }
-    let h_max = 0.5 * (2.0 * config.node_mass / (2.0 * c_max)).min(2.0 * tau_min);
+    let b = bounds(topo, table, config)?;
+    substeps_of(b.chosen, config)
+}
+
+/// The substeps per tick for a substep of at most `h_max`, checked against the
+/// configuration's limit and the arithmetics'.
+fn substeps_of(h_max: f64, config: &SolverConfig) -> Result<u32, SolverError> {
     let needed = libm::ceil(1.0 / (config.tick_hz * h_max));
     if needed.is_nan() || needed > config.max_substeps as f64 {
         let needed = if needed < u32::MAX as f64 {
@@ -72,4 +119,273 @@ pub fn substeps_for<const NODES: usize, const EDGES: usize, const S: usize>(
         return Err(SolverError::Config(ConfigKey::TickHz));
     }
     Ok(n)
+}
+
+/// The closed-form and estimated bounds, and the substep the configuration chooses.
+pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
+    topo: &Topology<NODES, EDGES>,
+    table: &ForceTable<S>,
+    config: &SolverConfig,
+) -> Result<Bounds, SolverError> {
+    config.validate()?;
+    let k_max = table.max_stiffness().to_num::<f64>();
+    let closed = closed_form(topo, k_max, config)?;
+    let (estimated, chosen) = match config.bound {
+        Bound::Conservative => (closed, CONSERVATIVE_FACTOR * closed),
+        Bound::Estimated => {
+            let lin = Linearised::new(topo, k_max, config);
+            let e = estimate(&lin, closed);
+            let h = ESTIMATE_MARGIN * e;
+            // Trusted where the motion visibly dies out at the step taken; a lightly
+            // damped patch, whose growth near the edge is too slow to measure, falls back.
+            if lin.growth(h) <= TRUSTED_DECAY {
+                (e, h)
+            } else {
+                (e, CONSERVATIVE_FACTOR * closed)
+            }
+        }
+    };
+    Ok(Bounds {
+        closed,
+        estimated,
+        chosen,
+    })
+}
+
+/// The closed form `min(2/θ, 2/γ)` of the module docs, s.
+fn closed_form<const NODES: usize, const EDGES: usize>(
+    topo: &Topology<NODES, EDGES>,
+    k_max: f64,
+    config: &SolverConfig,
+) -> Result<f64, SolverError> {
+    let (c_s, c_n) = (config.spring_damping, config.node_damping);
+    let cp = &config.coupling;
+    let contact = topo.contact() as usize;
+    // γ: the largest Gershgorin row sum of C (a spring between two free nodes puts C on
+    // the diagonal and C off it; to the ground, on the diagonal only), over the mass.
+    let mut row = [c_n; NODES];
+    // θ for the springs: the stiffest spring per unit length over its damping (N/m over
+    // N·s/m); without spring damping, every spring's stiffness over the node damping,
+    // through K's Gershgorin row sums.
+    let mut k_row = [0.0f64; NODES];
+    let mut shortest = f64::INFINITY;
+    for e in topo.edges() {
+        let l0 = Topology::<NODES, EDGES>::rest_length(e);
+        shortest = shortest.min(l0);
+        let k = k_max / l0 * 1000.0;
+        let two_ends = e.b != GROUND;
+        for n in [e.a, e.b] {
+            if n == GROUND {
+                continue;
+            }
+            if let (Some(r), Some(kr)) = (row.get_mut(n as usize), k_row.get_mut(n as usize)) {
+                *r += if two_ends { 2.0 * c_s } else { c_s };
+                *kr += if two_ends { 2.0 * k } else { k };
+            }
+        }
+    }
+    if let Some(r) = row.get_mut(contact) {
+        *r += cp.damping;
+    }
+    let gamma = (1..topo.node_count().min(NODES))
+        .map(|i| row[i])
+        .fold(0.0, f64::max)
+        / config.node_mass;
+    let k_c = cp.stiffness * 1000.0;
+    let theta = if c_s > 0.0 {
+        let springs = k_max / shortest * 1000.0 / c_s;
+        let coupling = if c_n + cp.damping > 0.0 {
+            k_c / (c_n + cp.damping)
+        } else {
+            // The coupling against the contact's springs' damping, on top.
+            springs + k_c / c_s
+        };
+        springs.max(coupling)
+    } else if c_n > 0.0 {
+        let k_rows = (1..topo.node_count().min(NODES))
+            .map(|i| k_row[i] + if i == contact { k_c } else { 0.0 })
+            .fold(0.0, f64::max);
+        k_rows / c_n
+    } else {
+        f64::INFINITY
+    };
+    let h = libm::fmin(2.0 / theta, 2.0 / gamma);
+    if h.is_nan() || h <= 0.0 || theta.is_infinite() || gamma <= 0.0 {
+        return Err(SolverError::NoDamping);
+    }
+    Ok(h)
+}
+
+/// The largest `h` with the linearised step's growth at most 1, bisected geometrically
+/// between `closed / 4` and `4 closed` (7 steps: at most 2.2 % below the edge). Should
+/// even `closed / 4` grow, half of it.
+fn estimate<const NODES: usize, const EDGES: usize>(
+    lin: &Linearised<'_, NODES, EDGES>,
+    closed: f64,
+) -> f64 {
+    let stable = |h: f64| lin.growth(h) <= 1.0;
+    let (mut lo, mut hi) = (closed / 4.0, 4.0 * closed);
+    if stable(hi) {
+        return hi;
+    }
+    if !stable(lo) {
+        return 0.5 * lo;
+    }
+    for _ in 0..7 {
+        let mid = libm::sqrt(lo * hi);
+        if stable(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// The patch linearised at rest, in `f32`, as the estimate runs it.
+struct Linearised<'a, const NODES: usize, const EDGES: usize> {
+    topo: &'a Topology<NODES, EDGES>,
+    /// Per spring: `k_max / l0` (N/mm) and its rest direction.
+    springs: [(f32, [f32; 3]); EDGES],
+    /// N·s/mm.
+    c_spring: f32,
+    c_node: f32,
+    /// Coupling N/mm and N·s/mm, at the contact.
+    k_c: f32,
+    b_c: f32,
+    /// 1000 / m: (mm/s²) per N.
+    per_mass: f32,
+}
+
+impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
+    fn new(topo: &'a Topology<NODES, EDGES>, k_max: f64, config: &SolverConfig) -> Self {
+        let mut springs = [(0.0f32, [0.0f32; 3]); EDGES];
+        for (s, e) in springs.iter_mut().zip(topo.edges()) {
+            let l0 = Topology::<NODES, EDGES>::rest_length(e);
+            *s = (
+                (k_max / l0) as f32,
+                e.dir.map(|d| to_f64(d, DIR_FRAC) as f32),
+            );
+        }
+        Self {
+            topo,
+            springs,
+            c_spring: (config.spring_damping / 1000.0) as f32,
+            c_node: (config.node_damping / 1000.0) as f32,
+            k_c: config.coupling.stiffness as f32,
+            b_c: (config.coupling.damping / 1000.0) as f32,
+            per_mass: (1000.0 / config.node_mass) as f32,
+        }
+    }
+
+    /// The linear force on every node slot (N) at displacements `x` (mm) and
+    /// velocities `v` (mm/s); returns the elastic energy `½ xᵀKx` (mJ).
+    fn force(
+        &self,
+        x: &[[f32; 3]; NODES],
+        v: &[[f32; 3]; NODES],
+        f: &mut [[f32; 3]; NODES],
+    ) -> f32 {
+        *f = [[0.0; 3]; NODES];
+        let mut energy = 0.0;
+        let at = |s: &[[f32; 3]; NODES], i: u16| -> [f32; 3] {
+            if i == GROUND {
+                [0.0; 3]
+            } else {
+                s.get(i as usize).copied().unwrap_or([0.0; 3])
+            }
+        };
+        for (e, (k, d)) in self.topo.edges().iter().zip(self.springs.iter()) {
+            let (xa, xb, va, vb) = (at(x, e.a), at(x, e.b), at(v, e.a), at(v, e.b));
+            let along = (0..3).map(|j| (xb[j] - xa[j]) * d[j]).sum::<f32>();
+            energy += 0.5 * k * along * along;
+            let stretch = along * k;
+            let on_a: [f32; 3] =
+                core::array::from_fn(|j| stretch * d[j] + self.c_spring * (vb[j] - va[j]));
+            for (n, sign) in [(e.a, 1.0f32), (e.b, -1.0)] {
+                if n != GROUND {
+                    if let Some(fa) = f.get_mut(n as usize) {
+                        for j in 0..3 {
+                            fa[j] += sign * on_a[j];
+                        }
+                    }
+                }
+            }
+        }
+        let c = self.topo.contact() as usize;
+        for (i, fi) in f
+            .iter_mut()
+            .enumerate()
+            .take(self.topo.node_count())
+            .skip(1)
+        {
+            for j in 0..3 {
+                fi[j] -= self.c_node * v[i][j];
+                if i == c {
+                    fi[j] -= self.k_c * x[i][j] + self.b_c * v[i][j];
+                    energy += 0.5 * self.k_c * x[i][j] * x[i][j];
+                }
+            }
+        }
+        energy
+    }
+
+    /// How much the improved Euler step `h` grows a perturbation: the ratio of its
+    /// energy (kinetic and elastic, which an oscillation trades without changing their
+    /// sum, so that the ratio does not depend on the phase it stops at) over the last 256
+    /// of 768 steps (the first 512 let the decaying modes fall behind the growing one, as
+    /// in a power iteration); infinite where it overflows.
+    fn growth(&self, h: f64) -> f32 {
+        const STEPS: usize = 768;
+        const WINDOW: usize = 256;
+        let n = self.topo.node_count().min(NODES);
+        let (h, hm) = (h as f32, h as f32 * self.per_mass);
+        let mut x = [[0.0f32; 3]; NODES];
+        let mut v = [[0.0f32; 3]; NODES];
+        let mut f = [[0.0f32; 3]; NODES];
+        // A fixed pseudo-random start in every degree of freedom.
+        let mut seed: u32 = 0x2545_f491;
+        for xi in x.iter_mut().take(n).skip(1) {
+            for c in xi.iter_mut() {
+                seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                *c = (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5;
+            }
+        }
+        // Kinetic energy in the elastic energy's unit (mJ: N·mm), m in kg, v in mm/s.
+        let mass = 1000.0 / self.per_mass;
+        let mut half = 0.0;
+        for step in 0..STEPS {
+            let elastic = self.force(&x, &v, &mut f);
+            let kinetic: f32 = v
+                .iter()
+                .map(|c| 0.5e-3 * mass * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]))
+                .sum();
+            let e = elastic + kinetic;
+            if !e.is_finite() {
+                return f32::INFINITY;
+            }
+            if step == STEPS - 1 - WINDOW {
+                half = e;
+            }
+            if step == STEPS - 1 {
+                return if half > 0.0 { e / half } else { f32::INFINITY };
+            }
+            // Renormalise now and then: only the growth matters.
+            if e > 1e12 || (e > 0.0 && e < 1e-12) {
+                let s = 1.0 / libm::sqrtf(e);
+                x.iter_mut().flatten().for_each(|c| *c *= s);
+                v.iter_mut().flatten().for_each(|c| *c *= s);
+                f.iter_mut().flatten().for_each(|c| *c *= s);
+                half *= s * s;
+            }
+            for i in 1..n {
+                for j in 0..3 {
+                    let v_new = v[i][j] + hm * f[i][j];
+                    x[i][j] += 0.5 * h * (v[i][j] + v_new);
+                    v[i][j] = v_new;
+                }
+            }
+        }
+        f32::INFINITY
+    }
 }

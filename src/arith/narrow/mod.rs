@@ -21,7 +21,7 @@ use crate::q::{self, V3};
 use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, VEL_LIMIT_MM_S};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
-use crate::units::{Strain, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE};
+use crate::units::{Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE};
 
 mod step;
 mod table;
@@ -220,10 +220,10 @@ fn spring<const S: usize, const UNIT: bool>(
     damping: &NarrowDamping,
 ) -> V3 {
     let Ends { ua, ub, va, vb } = ends;
-    // Q23 geometry: d (Q29 → Q23) and 1/l0 truncated to Q15 (< 2¹⁵ for l0 ≥ 1 mm).
-    const _: () = assert!(INV_LEN_FRAC == 31 && LEN_FRAC == 24);
+    // Q23 geometry: d (Q23) and 1/l0 truncated to Q15 (< 2¹⁵ for l0 ≥ 1 mm).
+    const _: () = assert!(INV_LEN_FRAC == 31 && LEN_FRAC == 24 && DIR_FRAC == 23);
     let inv = edge.inv_len >> 16;
-    let d: V3 = edge.dir.map(|x| x >> 6);
+    let d: V3 = edge.dir;
     // w = d + (u_b − u_a)/l0, Q24 · Q15 / 2¹⁶ = Q23, held within ±2 per axis; then q = w − d
     // (so that q and w agree where w is held) and the Q13 factor d + w, truncated
     // (|d + w| < 3).

@@ -29,7 +29,7 @@ mod report;
 mod firmware {
     use super::fw_common::exit;
     use super::harness::Harness;
-    use super::report::{check_budgets, fits, Figures};
+    use super::report::{check_budgets, fits, largest_patch, Figures, Steps};
     use super::{cases, harness};
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -74,24 +74,27 @@ mod firmware {
             figs.report("substep_n7", sub(&h, 7) - empty);
             figs.report("substep_n8", sub(&h, 8) - empty);
         }
+        let steps = Steps::new(&table);
+        let sub5 = steps.substeps(5, 1000).unwrap_or(1);
+        let sub8 = steps.substeps(8, 1000).unwrap_or(1);
         // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
         // in f64 (software everywhere).
         figs.report(
             "substep_n5_f32",
-            cases::float::<f32, 10, 61>(&h, 5, &table) - empty,
+            cases::float::<f32, 10, 61>(&h, 5, sub5, &table) - empty,
         );
         figs.report(
             "substep_n5_f64",
-            cases::float::<f64, 10, 61>(&h, 5, &table) - empty,
+            cases::float::<f64, 10, 61>(&h, 5, sub5, &table) - empty,
         );
         if CORE != Core::M0 {
             figs.report(
                 "substep_n8_f32",
-                cases::float::<f32, 37, 214>(&h, 8, &table) - empty,
+                cases::float::<f32, 37, 214>(&h, 8, sub8, &table) - empty,
             );
             figs.report(
                 "substep_n8_f64",
-                cases::float::<f64, 37, 214>(&h, 8, &table) - empty,
+                cases::float::<f64, 37, 214>(&h, 8, sub8, &table) - empty,
             );
         }
         // One whole tick of this core's demo configuration, in contact.
@@ -113,7 +116,8 @@ mod firmware {
         for (case, bytes) in mem {
             figs.record(case, bytes as u32);
         }
-        fits(&figs, &table);
+        fits(&figs, &steps);
+        largest_patch(&figs, &steps);
         let ok = check_budgets(&figs);
         exit(ok)
     }

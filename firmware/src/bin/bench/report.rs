@@ -1,7 +1,8 @@
 //! The figures of a run: recorded by case, printed as `BENCH` lines, turned into the
 //! largest patch that fits a tick (`FIT`), and held to `bench/budgets.txt`.
 
-use mccs::{ForceTable64, Solver, SolverConfig, Topology};
+use mccs::solver::stability::bounds;
+use mccs::{ForceTable64, SolverConfig, Topology};
 use mccs_firmware::target::{Core, CORE};
 
 /// Clock (MHz) and cycles per instruction (×100) assumed to turn instruction counts into
@@ -56,19 +57,15 @@ const SUBSTEP: [&str; 6] = [
 
 /// The largest standard patch whose ticks (substeps × one substep, default
 /// configuration) fit in half a tick at 1 kHz and at 10 kHz, at `CLOCK`.
-pub fn fits(figs: &Figures, table: &ForceTable64) {
+pub fn fits(figs: &Figures, steps: &Steps) {
     let core = CORE.name();
     for tick_hz in [1_000u32, 10_000] {
         let half_tick =
             (CLOCK.0 as u64 * 1_000_000 * 100 / CLOCK.1 as u64 / (2 * tick_hz as u64)) as u32;
-        let cfg = SolverConfig {
-            tick_hz: tick_hz as f64,
-            ..SolverConfig::default()
-        };
         let mut best = (0u32, 0u32, 0u32);
         for n in 3..=8u32 {
             let (Some(substeps), Some(sub)) = (
-                substeps_for(n, table, &cfg),
+                steps.substeps(n, tick_hz),
                 figs.get(SUBSTEP[n as usize - 3]),
             ) else {
                 continue;
@@ -92,15 +89,68 @@ pub fn fits(figs: &Figures, table: &ForceTable64) {
     }
 }
 
-/// Substeps per tick the stability bound asks for on the standard N × N patch.
-fn substeps_for(n: u32, table: &ForceTable64, cfg: &SolverConfig) -> Option<u32> {
+/// The largest standard patch whose tick (substeps × one substep, default
+/// configuration, 1 kHz) fits in half a tick at the core's clock at one instruction per
+/// cycle (issue #17's yardstick; `FIT` above takes a cycles-per-instruction estimate),
+/// as a `BENCH` line: `case=largest_patch_1khz n= substeps= instructions=`.
+pub fn largest_patch(figs: &Figures, steps: &Steps) {
+    let half_tick = CLOCK.0 * 1_000_000 / 2_000;
+    let mut best = (0u32, 0u32, 0u32);
+    for n in 3..=8u32 {
+        let (Some(substeps), Some(sub)) =
+            (steps.substeps(n, 1000), figs.get(SUBSTEP[n as usize - 3]))
+        else {
+            continue;
+        };
+        let tick = substeps.saturating_mul(sub);
+        if tick <= half_tick {
+            best = (n, substeps, tick);
+        }
+    }
+    defmt::println!(
+        "BENCH core={=str} case=largest_patch_1khz n={=u32} substeps={=u32} instructions={=u32} half_tick_instructions={=u32}",
+        CORE.name(),
+        best.0,
+        best.1,
+        best.2,
+        half_tick
+    );
+}
+
+/// The substep (s) the default configuration's stability bound takes on the standard
+/// N × N patch, for N = 3 … 8 (`None` where the core cannot hold the patch): computed
+/// once, since it does not depend on the tick rate (the estimate is the start-up's
+/// longest job).
+pub struct Steps([Option<f64>; 6]);
+
+impl Steps {
+    /// Computes them (out of line: the M0's `main` must not carry these frames).
+    #[inline(never)]
+    pub fn new(table: &ForceTable64) -> Self {
+        let cfg = SolverConfig::default();
+        Self(core::array::from_fn(|i| {
+            chosen_step(i as u32 + 3, table, &cfg)
+        }))
+    }
+
+    /// Substeps per tick at `tick_hz` for the N × N patch.
+    pub fn substeps(&self, n: u32, tick_hz: u32) -> Option<u32> {
+        let h = (*self.0.get((n as usize).checked_sub(3)?)?)?;
+        let s = libm::ceil(1.0 / (tick_hz as f64 * h));
+        (1.0..1e6).contains(&s).then_some(s as u32)
+    }
+}
+
+#[inline(never)]
+fn chosen_step(n: u32, table: &ForceTable64, cfg: &SolverConfig) -> Option<f64> {
+    #[inline(never)]
     fn of<const N: usize, const E: usize>(
         n: u32,
         table: &ForceTable64,
         cfg: &SolverConfig,
-    ) -> Option<u32> {
+    ) -> Option<f64> {
         let topo = Topology::<N, E>::standard_patch(n as usize, 2.5).ok()?;
-        Solver::<N, E, 64>::substeps_for(&topo, table, cfg).ok()
+        Some(bounds(&topo, table, cfg).ok()?.chosen)
     }
     match n {
         3 => of::<2, 9>(n, table, cfg),

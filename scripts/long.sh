@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The long runs that the test command leaves out (docs/reliability.md):
+#   1. the short-trajectory properties of Solver::step at CASES cases per arithmetic
+#      (default 50,000: ten times the test command's, about 10⁷ ticks in all), and the
+#      settling properties at CASES / 100;
+#   2. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
+# Prints the PROPERTY and FUZZ lines; exits with failure if any run fails.
+#   scripts/long.sh [CASES] [FUZZ_SECONDS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cases=${1:-50000}
+fuzz_seconds=${2:-300}
+mkdir -p target/logs/long
+log=target/logs/long/properties.log
+echo "long.sh: the short-trajectory properties at $cases cases per arithmetic (log: $log)" >&2
+start=$(date +%s)
+PROPTEST_CASES=$cases cargo test --release -p mccs-host --test solver_properties \
+    -- --show-output short_trajectories > "$log" 2>&1 &
+pid=$!
+while kill -0 "$pid" 2>/dev/null; do
+  sleep 10
+  kill -0 "$pid" 2>/dev/null && echo "long.sh: ... $(( $(date +%s) - start )) s" >&2
+done
+wait "$pid" || { echo "long.sh: the properties failed; see $log" >&2; exit 1; }
+settle=$(( cases / 100 > 60 ? cases / 100 : 60 ))
+echo "long.sh: the settling properties at $settle cases per arithmetic" >&2
+PROPTEST_CASES=$settle cargo test --release -p mccs-host --test solver_properties \
+    -- --show-output after_lift_off >> "$log" 2>&1 || { echo "long.sh: the settling properties failed; see $log" >&2; exit 1; }
+grep -E "^PROPERTY " "$log"
+echo "long.sh: properties done in $(( $(date +%s) - start )) s; fuzzing $fuzz_seconds s per target" >&2
+bash scripts/fuzz.sh "$fuzz_seconds"
