@@ -51,6 +51,24 @@ def figures() -> dict:
     return out
 
 
+# Instruction counts come from SysTick under -icount, calibrated and averaged: a count
+# can move by one between runs of the same binary. Those figures match within one count
+# or 0.2 %; every other figure to the character.
+JITTER = ("BENCH.", "FIT.", "BUDGET.", "RATIO.")
+
+
+def same(key: str, doc: str, printed: str) -> bool:
+    if doc == printed:
+        return True
+    if not key.startswith(JITTER):
+        return False
+    try:
+        a, b = float(doc), float(printed)
+    except ValueError:
+        return False
+    return abs(a - b) <= max(1.0, 0.002 * abs(b))
+
+
 def docs():
     return [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
@@ -74,7 +92,7 @@ def main() -> int:
                 print(f"{doc.relative_to(ROOT)}: {key}: nothing printed this figure")
                 bad += 1
                 return m.group(0)
-            if mode == "check" and figs[key] != value:
+            if mode == "check" and not same(key, value, figs[key]):
                 print(f"{doc.relative_to(ROOT)}: {key}: the doc says {value}, the code prints {figs[key]} (scripts/figures.py update)")
                 bad += 1
             return f"<!-- fig:{key} -->{figs[key]}<!-- /fig -->"

@@ -81,8 +81,8 @@ pub fn mulhi_split(a: i32, b: i32) -> i32 {
         .wrapping_add(n >> 16)
 }
 
-/// `c + ⌊a · b / 2³²⌋` (wrapping): one `smmla` on cores with a long multiply; the
-/// caller's ranges keep the sum within `i32`.
+/// `c + ⌊a · b / 2³²⌋` (wrapping): one `smmla` on the M4F (its DSP extension), a
+/// `smull` and an add on the M3; the caller's ranges keep the sum within `i32`.
 #[inline(always)]
 pub fn mulhi_acc(a: i32, b: i32, c: i32) -> i32 {
     c.wrapping_add(mulhi(a, b))

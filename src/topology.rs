@@ -97,6 +97,14 @@ impl<const NODES: usize, const EDGES: usize> Default for Topology<NODES, EDGES> 
     }
 }
 
+/// The capacities [`Topology::standard_patch`]`(n, _)` needs: `(NODES, EDGES)`, node
+/// slots (the ground included: `(n − 2)² + 1`) and springs (`5n² − 14n + 6`), for `n ≥ 3`
+/// (n = 5: 10 and 61; n = 8: 37 and 214).
+pub const fn standard_capacity(n: usize) -> (usize, usize) {
+    let inner = n.saturating_sub(2);
+    (inner * inner + 1, (5 * n * n + 6).saturating_sub(14 * n))
+}
+
 impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     /// An empty topology (the ground only). Add nodes and edges, then [`Self::set_contact`].
     pub fn new() -> Self {

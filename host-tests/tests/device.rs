@@ -459,6 +459,32 @@ impl FakePin {
     }
 }
 
+/// A one-axis device on fakes that log to `log`: the PWM and the direction pin fail as
+/// `pwm` and `pin` say, the enable pin never; enabled, 10 N at full duty.
+fn rig(
+    log: &Rc<RefCell<Log>>,
+    sensor: Sensor,
+    pwm: Fail,
+    pin: Fail,
+) -> OneDofDevice<Sensor, FakePwm, FakePin, FakePin> {
+    let motor = PwmMotor::with_enable(
+        FakePwm(log.clone(), pwm, 0),
+        FakePin(log.clone(), pin, 0, false),
+        FakePin(log.clone(), Fail::Never, 0, true),
+        MotorConfig {
+            force_at_full_duty: 10.0,
+        },
+    )
+    .unwrap();
+    let mut device = OneDofDevice {
+        encoder: As5047p::new(sensor, plain()),
+        motor,
+        max_bad_frames: 3,
+    };
+    device.motor.enable().unwrap();
+    device
+}
+
 fn solver() -> Solver<10, 61, 64> {
     let topo = Topology::standard_patch(5, 2.5).unwrap();
     Solver::new(
@@ -487,21 +513,7 @@ fn run(spi: Fail, pin: Fail, pwm: Fail) -> (Option<usize>, Option<usize>, Vec<u1
         (100.0 + mm / MM_PER_COUNT).rem_euclid(16384.0) as u16
     });
     sensor.0.borrow_mut().fail = Box::new(move |n| spi.at(n));
-    let motor = PwmMotor::with_enable(
-        FakePwm(log.clone(), pwm, 0),
-        FakePin(log.clone(), pin, 0, false),
-        FakePin(log.clone(), Fail::Never, 0, true),
-        MotorConfig {
-            force_at_full_duty: 10.0,
-        },
-    )
-    .unwrap();
-    let mut device = OneDofDevice {
-        encoder: As5047p::new(sensor, plain()),
-        motor,
-        max_bad_frames: 3,
-    };
-    device.motor.enable().unwrap();
+    let device = rig(&log, sensor, pwm, pin);
     let mut ctl = Controller::new(solver(), device, 0);
     let mut duties = Vec::new();
     let (mut first_failure, mut latched) = (None, None);
@@ -572,21 +584,7 @@ fn shift(f: Fail, k: usize) -> Fail {
 fn a_failing_safe_state_keeps_trying_and_drops_the_enable_pin() {
     let log = Rc::new(RefCell::new(Log::default()));
     let sensor = Sensor::new(|_| 16384 + 100 - 300);
-    let motor = PwmMotor::with_enable(
-        FakePwm(log.clone(), Fail::From(3), 0),
-        FakePin(log.clone(), Fail::Never, 0, false),
-        FakePin(log.clone(), Fail::Never, 0, true),
-        MotorConfig {
-            force_at_full_duty: 10.0,
-        },
-    )
-    .unwrap();
-    let mut device = OneDofDevice {
-        encoder: As5047p::new(sensor, plain()),
-        motor,
-        max_bad_frames: 3,
-    };
-    device.motor.enable().unwrap();
+    let device = rig(&log, sensor, Fail::From(3), Fail::Never);
     assert!(log.borrow().enabled);
     let mut ctl = Controller::new(solver(), device, 0);
     for _ in 0..20 {

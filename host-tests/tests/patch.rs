@@ -498,3 +498,12 @@ fn robustness<A: Arith>() {
     };
     assert!(Solver::with_arith(topo, table, &tiny, A::default()).is_err());
 }
+
+#[test]
+fn standard_capacity_is_what_the_standard_patch_holds() {
+    for n in 3..=12 {
+        let t = Topology::<145, 1000>::standard_patch(n, 2.5).unwrap();
+        let (nodes, edges) = mccs::topology::standard_capacity(n);
+        assert_eq!((t.node_count(), t.edges().len()), (nodes, edges), "N={n}");
+    }
+}

@@ -81,8 +81,9 @@ pub const CONSERVATIVE_FACTOR: f64 = 0.5;
 pub struct Bounds {
     /// The closed form (see the module docs: not a proof), s.
     pub closed: f64,
-    /// The estimated exact bound (before the margin), s.
-    pub estimated: f64,
+    /// The estimated exact bound (before the margin), s; `None` with
+    /// [`Bound::Conservative`], which does not estimate.
+    pub estimated: Option<f64>,
     /// The substep the solver takes with its configuration's [`Bound`], s.
     pub chosen: f64,
 }
@@ -131,7 +132,7 @@ pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
     let k_max = table.max_stiffness().to_num::<f64>();
     let closed = closed_form(topo, k_max, config)?;
     let (estimated, chosen) = match config.bound {
-        Bound::Conservative => (closed, CONSERVATIVE_FACTOR * closed),
+        Bound::Conservative => (None, CONSERVATIVE_FACTOR * closed),
         Bound::Estimated => {
             let lin = Linearised::new(topo, k_max, config);
             let e = estimate(&lin, closed);
@@ -139,9 +140,9 @@ pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
             // Trusted where the motion visibly dies out at the step taken; a lightly
             // damped patch, whose growth near the edge is too slow to measure, falls back.
             if lin.growth(h) <= TRUSTED_DECAY {
-                (e, h)
+                (Some(e), h)
             } else {
-                (e, CONSERVATIVE_FACTOR * closed)
+                (Some(e), CONSERVATIVE_FACTOR * closed)
             }
         }
     };
@@ -351,24 +352,14 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 *c = (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5;
             }
         }
-        // Kinetic energy in the elastic energy's unit (mJ: N·mm), m in kg, v in mm/s.
-        let mass = 1000.0 / self.per_mass;
-        let mut half = 0.0;
+        let mut at_window = 0.0;
         for step in 0..STEPS {
-            let elastic = self.force(&x, &v, &mut f);
-            let kinetic: f32 = v
-                .iter()
-                .map(|c| 0.5e-3 * mass * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]))
-                .sum();
-            let e = elastic + kinetic;
+            let e = self.energy(&x, &v, &mut f);
             if !e.is_finite() {
                 return f32::INFINITY;
             }
-            if step == STEPS - 1 - WINDOW {
-                half = e;
-            }
-            if step == STEPS - 1 {
-                return if half > 0.0 { e / half } else { f32::INFINITY };
+            if step == STEPS - WINDOW {
+                at_window = e;
             }
             // Renormalise now and then: only the growth matters.
             if e > 1e12 || (e > 0.0 && e < 1e-12) {
@@ -376,7 +367,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 x.iter_mut().flatten().for_each(|c| *c *= s);
                 v.iter_mut().flatten().for_each(|c| *c *= s);
                 f.iter_mut().flatten().for_each(|c| *c *= s);
-                half *= s * s;
+                at_window *= s * s;
             }
             for i in 1..n {
                 for j in 0..3 {
@@ -386,6 +377,27 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 }
             }
         }
-        f32::INFINITY
+        let e = self.energy(&x, &v, &mut f);
+        if e.is_finite() && at_window > 0.0 {
+            e / at_window
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// The energy (mJ: N·mm) at displacements `x` and velocities `v`: elastic, from
+    /// [`Self::force`] (which fills `f`), and kinetic (m in kg, v in mm/s).
+    fn energy(
+        &self,
+        x: &[[f32; 3]; NODES],
+        v: &[[f32; 3]; NODES],
+        f: &mut [[f32; 3]; NODES],
+    ) -> f32 {
+        let mass = 1000.0 / self.per_mass;
+        let kinetic: f32 = v
+            .iter()
+            .map(|c| 0.5e-3 * mass * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]))
+            .sum();
+        self.force(x, v, f) + kinetic
     }
 }

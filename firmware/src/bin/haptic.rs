@@ -45,18 +45,10 @@ mod firmware {
     };
     /// What this core runs (see `mccs_firmware::demo`).
     const SPEC: DemoSpec = demo::spec_for(CORE);
-    /// The controller's capacities: the core's patch (N = 8 on the M4F, N = 5 on the M3,
-    /// N = 4 on the M0, whose 16 KiB of RAM must also hold the start-up's stack).
-    const NODES: usize = match CORE {
-        Core::M4F => 37,
-        Core::M3 => 10,
-        Core::M0 => 5,
-    };
-    const EDGES: usize = match CORE {
-        Core::M4F => 214,
-        Core::M3 => 61,
-        Core::M0 => 30,
-    };
+    /// The controller's capacities: exactly the core's patch (N = 8 on the M4F, N = 5 on
+    /// the M3, N = 4 on the M0, whose 16 KiB of RAM must also hold the start-up's stack).
+    const NODES: usize = mccs::topology::standard_capacity(SPEC.grid).0;
+    const EDGES: usize = mccs::topology::standard_capacity(SPEC.grid).1;
     /// The controller type.
     type Ctl = demo::DemoControllerOf<NODES, EDGES>;
 

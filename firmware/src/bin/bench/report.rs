@@ -55,64 +55,51 @@ const SUBSTEP: [&str; 6] = [
     "substep_n8",
 ];
 
-/// The largest standard patch whose ticks (substeps × one substep, default
-/// configuration) fit in half a tick at 1 kHz and at 10 kHz, at `CLOCK`.
+/// The largest standard patch whose tick (substeps at `tick_hz` × the measured substep,
+/// default configuration) fits in `half_tick` instructions: `(n, substeps, tick)`, or
+/// `None` where none fits.
+fn largest(figs: &Figures, steps: &Steps, tick_hz: u32, half_tick: u32) -> Option<(u32, u32, u32)> {
+    (3..=8u32)
+        .filter_map(|n| {
+            let substeps = steps.substeps(n, tick_hz)?;
+            let tick = substeps.saturating_mul(figs.get(SUBSTEP[n as usize - 3])?);
+            (tick <= half_tick).then_some((n, substeps, tick))
+        })
+        .next_back()
+}
+
+/// The largest standard patch that fits in half a tick at 1 kHz and at 10 kHz, at
+/// `CLOCK` with its cycles-per-instruction estimate: `FIT` lines.
 pub fn fits(figs: &Figures, steps: &Steps) {
     let core = CORE.name();
     for tick_hz in [1_000u32, 10_000] {
         let half_tick =
             (CLOCK.0 as u64 * 1_000_000 * 100 / CLOCK.1 as u64 / (2 * tick_hz as u64)) as u32;
-        let mut best = (0u32, 0u32, 0u32);
-        for n in 3..=8u32 {
-            let (Some(substeps), Some(sub)) = (
-                steps.substeps(n, tick_hz),
-                figs.get(SUBSTEP[n as usize - 3]),
-            ) else {
-                continue;
-            };
-            let tick = substeps.saturating_mul(sub);
-            if tick <= half_tick {
-                best = (n, substeps, tick);
-            }
-        }
-        if best.0 == 0 {
-            defmt::println!(
+        match largest(figs, steps, tick_hz, half_tick) {
+            None => defmt::println!(
                 "FIT core={=str} tick_hz={=u32} mhz={=u32} cpi={=u32}/100 half_tick_instructions={=u32} largest_n=none",
                 core, tick_hz, CLOCK.0, CLOCK.1, half_tick
-            );
-        } else {
-            defmt::println!(
+            ),
+            Some((n, substeps, tick)) => defmt::println!(
                 "FIT core={=str} tick_hz={=u32} mhz={=u32} cpi={=u32}/100 half_tick_instructions={=u32} largest_n={=u32} substeps={=u32} tick_instructions={=u32}",
-                core, tick_hz, CLOCK.0, CLOCK.1, half_tick, best.0, best.1, best.2
-            );
+                core, tick_hz, CLOCK.0, CLOCK.1, half_tick, n, substeps, tick
+            ),
         }
     }
 }
 
-/// The largest standard patch whose tick (substeps × one substep, default
-/// configuration, 1 kHz) fits in half a tick at the core's clock at one instruction per
-/// cycle (issue #17's yardstick; `FIT` above takes a cycles-per-instruction estimate),
-/// as a `BENCH` line: `case=largest_patch_1khz n= substeps= instructions=`.
+/// The largest standard patch that fits in half a 1 kHz tick at the core's clock at one
+/// instruction per cycle (issue #17's yardstick), as a `BENCH` line:
+/// `case=largest_patch_1khz n= substeps= instructions=` (all 0 where none fits).
 pub fn largest_patch(figs: &Figures, steps: &Steps) {
     let half_tick = CLOCK.0 * 1_000_000 / 2_000;
-    let mut best = (0u32, 0u32, 0u32);
-    for n in 3..=8u32 {
-        let (Some(substeps), Some(sub)) =
-            (steps.substeps(n, 1000), figs.get(SUBSTEP[n as usize - 3]))
-        else {
-            continue;
-        };
-        let tick = substeps.saturating_mul(sub);
-        if tick <= half_tick {
-            best = (n, substeps, tick);
-        }
-    }
+    let (n, substeps, tick) = largest(figs, steps, 1_000, half_tick).unwrap_or((0, 0, 0));
     defmt::println!(
         "BENCH core={=str} case=largest_patch_1khz n={=u32} substeps={=u32} instructions={=u32} half_tick_instructions={=u32}",
         CORE.name(),
-        best.0,
-        best.1,
-        best.2,
+        n,
+        substeps,
+        tick,
         half_tick
     );
 }
