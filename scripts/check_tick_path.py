@@ -12,7 +12,10 @@ fail if anything reached is, or contains, one of:
 - a hardware floating-point instruction (`v….f32` / `v….f64`),
 - an indirect call (whose target this check cannot see).
 
-Usage: check_tick_path.py ELF [ENTRY]   (prints the reachable functions; exit 1 on a find)
+Usage: check_tick_path.py ELF [ENTRY [INIT]]   (prints the reachable functions; exit 1 on
+a find). ENTRY is the tick's handler (default SysTick); INIT a regular expression naming
+its first-run initialisation (default `haptic::firmware::init`). The board firmware:
+`check_tick_path.py target/thumbv7em-none-eabihf/release/haptic-f405 TIM2 haptic_f405::firmware::init`.
 """
 import re
 import subprocess
@@ -52,7 +55,7 @@ def main() -> int:
     if entry not in funcs:
         print(f"check_tick_path: {elf}: no function {entry}")
         return 1
-    skip = re.compile(r"haptic::firmware::init\b")
+    skip = re.compile((sys.argv[3] if len(sys.argv) > 3 else r"haptic::firmware::init") + r"\b")
     seen, todo, problems = set(), [entry], []
     while todo:
         f = todo.pop()

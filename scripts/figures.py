@@ -7,7 +7,7 @@ form `TAG k1=v1 k2=v2 …` (BENCH, MEM, FIT, SIZE, SUMMARY, SWEEP, PROPERTY, REP
 TABLE, …) gives one figure per numeric field, keyed
 `TAG.<the non-numeric values, in order>.<field>`, e.g. `BENCH.m4f.spring.instructions`
 or `SWEEP.wide.max_error_rel`; a SUMMARY line of a demo log is keyed by its core
-(`SUMMARY.m4f.steady_force_n`).
+(`SUMMARY.m4f.steady_force_n`), a board's by its name (`SUMMARY.f405.fault_tick`).
 
   figures.py check    fail (exit 1) when a marked value differs from what was printed,
                       or when nothing printed its key; one line each
@@ -42,9 +42,13 @@ def figures() -> dict:
             tag, fields = m.group(1), [kv.split("=", 1) for kv in m.group(2).split()]
             ident = [v for k, v in fields if not NUMBER.match(v)]
             if tag == "SUMMARY":
-                if not core:
+                board = [v for k, v in fields if k == "board"]
+                if core:
+                    ident = [core.group(1)]
+                elif board:
+                    ident = board
+                else:
                     continue
-                ident = [core.group(1)]
             for k, v in fields:
                 if NUMBER.match(v):
                     out[".".join([tag] + ident + [k])] = v

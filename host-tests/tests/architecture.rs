@@ -1,6 +1,6 @@
-//! `docs/architecture.md` against the code: every module of the core and of the firmware
-//! crate has a row, every row names a module that exists, each module imports only what
-//! its row allows, and the modules' imports form no circle.
+//! `docs/architecture.md` against the code: every module of the core, of the firmware
+//! crate and of the board crate has a row, every row names a module that exists, each
+//! module imports only what its row allows, and the modules' imports form no circle.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -189,6 +189,12 @@ fn circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
 fn the_core_matches_its_drawing_and_has_no_circle() {
     let graph = check_crate(&root().join("src"), "The core");
     assert_eq!(circle(&graph), None, "import circle in the core");
+}
+
+#[test]
+fn the_board_crate_matches_its_drawing_and_has_no_circle() {
+    let graph = check_crate(&root().join("boards/f405/src"), "The board firmware");
+    assert_eq!(circle(&graph), None, "import circle in the board crate");
 }
 
 #[test]

@@ -26,6 +26,18 @@ pub struct MotorConfig {
     pub force_at_full_duty: f64,
 }
 
+impl MotorConfig {
+    /// Checks a force at full duty: a finite number of 0.001 … 1024 N.
+    pub fn check(force_at_full_duty: f64) -> Result<(), MotorConfigError> {
+        let f = force_at_full_duty;
+        if f.is_finite() && (0.001..=1024.0).contains(&f) {
+            Ok(())
+        } else {
+            Err(MotorConfigError::ForceAtFullDuty)
+        }
+    }
+}
+
 /// The motor configuration cannot be used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MotorConfigError {
@@ -109,9 +121,7 @@ impl<PWM: SetDutyCycle, DIR: OutputPin, EN: OutputPin> PwmMotor<PWM, DIR, EN> {
         config: MotorConfig,
     ) -> Result<Self, MotorConfigError> {
         let f = config.force_at_full_duty;
-        if !(f.is_finite() && (0.001..=1024.0).contains(&f)) {
-            return Err(MotorConfigError::ForceAtFullDuty);
-        }
+        MotorConfig::check(f)?;
         let full = libm::round(f * (1u64 << 20) as f64) as u64;
         let full = full.clamp(1, u32::MAX as u64) as u32;
         let pre = full.leading_zeros();

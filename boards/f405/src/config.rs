@@ -1,0 +1,310 @@
+//! `BoardConfig`: the board's constants in one place — clocks, the tick, the SPI and PWM
+//! rates, the watchdog, the encoder's mounting, the motor's constant and the patch — with
+//! the checks that keep them consistent, and the clock arithmetic of the HAL they feed
+//! (SPI divider, PWM resolution, tick timer) so that a host test can hold them to the
+//! parts' limits. The pin map is type-level (the HAL's pins are types): `src/pins.rs`,
+//! one table with this one in docs/firmware.md.
+
+use mccs::SolverConfig;
+use mccs_firmware::drivers::as5047p::EncoderConfig;
+use mccs_firmware::drivers::pwm_motor::{MotorConfig, MotorConfigError};
+
+/// The AS5047P's fastest SPI clock, Hz (datasheet: 10 MHz).
+pub const AS5047P_MAX_SPI_HZ: u32 = 10_000_000;
+/// The tick timer's counter rate, Hz: the tick statistics are in µs.
+pub const TICK_COUNTER_HZ: u32 = 1_000_000;
+/// The timer clock QEMU 7.2 gives the STM32F4 timers whatever the RCC says (its
+/// `stm32f2xx_timer` model runs at 1 GHz of virtual time).
+pub const QEMU_TIMER_CLOCK_HZ: u32 = 1_000_000_000;
+/// The STM32F405's APB2 limit, Hz (SPI1's clock, TIM1's at ×2).
+pub const PCLK2_MAX_HZ: u32 = 84_000_000;
+/// The STM32F405's APB1 limit, Hz (TIM2's clock at ×2).
+pub const PCLK1_MAX_HZ: u32 = 42_000_000;
+
+/// Everything a port to another board changes, apart from the pins.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardConfig {
+    /// HSE crystal, Hz (8 MHz on most STM32F405 boards: 4 … 26 MHz).
+    pub hse_hz: u32,
+    /// Core clock from the PLL, Hz (24 … 168 MHz).
+    pub sysclk_hz: u32,
+    /// Haptic tick rate, Hz (TIM2 update interrupt; the solver's tick): 100 … 10,000,
+    /// dividing 1 MHz exactly.
+    pub tick_hz: u32,
+    /// SPI1 clock asked of the HAL, Hz. The HAL divides APB2 by a power of two and
+    /// rounds the divider *down* (asking 10 MHz of 84 MHz gives 10.5 MHz), so this is
+    /// held to the clock it gives: at most the AS5047P's 10 MHz.
+    pub spi_request_hz: u32,
+    /// PWM frequency on TIM1 CH1, Hz (20 kHz: above hearing). At least 1,000 duty steps.
+    pub pwm_hz: u32,
+    /// Independent watchdog timeout, ms: 10 ticks … 10,000 ms. LSI is 17–47 kHz
+    /// (nominally 32 kHz), so the real timeout is 0.68 … 1.9 × this.
+    pub watchdog_ms: u32,
+    /// Encoder angle at zero travel, counts (0 … 16383).
+    pub encoder_zero: u16,
+    /// Probe travel per encoder count, mm (|x| < 0.01; the sign is the direction):
+    /// `2π r / (16384 i)` for a lever of radius r mm through a capstan of ratio i.
+    pub mm_per_count: f64,
+    /// The fastest the probe moves, mm/s: the encoder's plausibility check.
+    pub max_speed_mm_s: f64,
+    /// Encoder frames between diagnostic reads (DIAAGC), 0 for never.
+    pub diag_every: u16,
+    /// Bad encoder frames in a row tolerated before the safe state.
+    pub max_bad_frames: u32,
+    /// Force at the probe at 100 % duty, N (0.001 … 1024): `k_t · I_max · i / (r/1000)`.
+    pub force_at_full_duty: f64,
+    /// The patch: N × N surface nodes (the standard patch, 2.5 mm spacing).
+    pub grid: usize,
+    /// Haptic node mass, kg.
+    pub node_mass: f64,
+    /// Spring damping, N·s/m.
+    pub spring_damping: f64,
+    /// Ticks a QEMU run (`--features qemu`) lasts before its SUMMARY.
+    pub qemu_ticks: u32,
+}
+
+/// The STM32F405 board: 8 MHz crystal, 168 MHz, a 1 kHz tick, the AS5047P at 5.25 MHz,
+/// 20 kHz PWM, a 50 ms watchdog; a 75 mm lever on a 10:1 capstan, a 3 N motor; the
+/// N = 8 patch of the M4F demo.
+pub const BOARD: BoardConfig = BoardConfig {
+    hse_hz: 8_000_000,
+    sysclk_hz: 168_000_000,
+    tick_hz: 1000,
+    spi_request_hz: 7_000_000,
+    pwm_hz: 20_000,
+    watchdog_ms: 50,
+    encoder_zero: 0,
+    mm_per_count: 0.002876,
+    max_speed_mm_s: 500.0,
+    diag_every: 100,
+    max_bad_frames: 8,
+    force_at_full_duty: 3.0,
+    grid: 8,
+    node_mass: 0.005,
+    spring_damping: 1.0,
+    qemu_ticks: 1000,
+};
+
+/// A board constant out of its range: which one, in words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoardConfigError {
+    /// `hse_hz` is not 4 … 26 MHz.
+    Hse,
+    /// `sysclk_hz` is not 24 … 168 MHz.
+    Sysclk,
+    /// `tick_hz` is not 100 … 10,000 Hz dividing 1 MHz.
+    Tick,
+    /// The SPI clock the HAL would give is above the AS5047P's 10 MHz, or zero.
+    SpiTooFast,
+    /// The PWM would have fewer than 1,000 duty steps, or `pwm_hz` is zero.
+    PwmResolution,
+    /// `watchdog_ms` is not 10 ticks … 10,000 ms.
+    Watchdog,
+    /// `encoder_zero` is above 16383, or `mm_per_count` is not finite and 0 < |x| < 0.01.
+    Encoder,
+    /// `max_speed_mm_s` is not a finite positive number.
+    Speed,
+    /// The motor constant.
+    Motor(MotorConfigError),
+    /// `grid` is not 3 … 8 (the controller's capacity), or the mass or damping is not
+    /// a finite positive number.
+    Patch,
+}
+
+impl BoardConfigError {
+    /// The message: one source for `Display` and the `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Hse => "hse_hz: must be 4 … 26 MHz",
+            Self::Sysclk => "sysclk_hz: must be 24 … 168 MHz",
+            Self::Tick => "tick_hz: must be 100 … 10000 Hz and divide 1 MHz",
+            Self::SpiTooFast => {
+                "spi_request_hz: the HAL's divider would clock the AS5047P above 10 MHz (or not at all)"
+            }
+            Self::PwmResolution => "pwm_hz: fewer than 1000 duty steps at this timer clock",
+            Self::Watchdog => "watchdog_ms: must be 10 ticks … 10000 ms",
+            Self::Encoder => "encoder_zero ≤ 16383 and 0 < |mm_per_count| < 0.01",
+            Self::Speed => "max_speed_mm_s: must be finite and positive",
+            Self::Motor(_) => "force_at_full_duty: must be 0.001 … 1024 N",
+            Self::Patch => "grid 3 … 8, node_mass and spring_damping finite and positive",
+        }
+    }
+}
+
+impl core::fmt::Display for BoardConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+/// The SPI clock the HAL gives for `request_hz` from a peripheral clock `pclk_hz`: the
+/// divider `pclk / request` rounded *down* to a power of two (2 … 256), as
+/// stm32f4xx-hal 0.22 picks it.
+pub const fn spi_clock_hz(pclk_hz: u32, request_hz: u32) -> u32 {
+    if request_hz == 0 {
+        return 0;
+    }
+    let divider = match pclk_hz / request_hz {
+        0..=2 => 2,
+        3..=5 => 4,
+        6..=11 => 8,
+        12..=23 => 16,
+        24..=47 => 32,
+        48..=95 => 64,
+        96..=191 => 128,
+        _ => 256,
+    };
+    pclk_hz / divider
+}
+
+/// The PWM's duty steps (full scale) at `pwm_hz` from the timer clock, as the HAL sets
+/// the timer (prescaler only when the period overflows 16 bits).
+pub const fn pwm_max_duty(timer_clock_hz: u32, pwm_hz: u32) -> u32 {
+    if pwm_hz == 0 || timer_clock_hz < pwm_hz {
+        return 0;
+    }
+    let ticks = timer_clock_hz / pwm_hz;
+    let psc = (ticks - 1) / (1 << 16);
+    ticks / (psc + 1)
+}
+
+/// The tick timer's prescaler and auto-reload: the counter at [`TICK_COUNTER_HZ`]
+/// (1 µs), an update every `1e6 / tick_hz` counts. `None` when the timer clock is not a
+/// whole number of MHz (≤ 65.536 GHz) or the tick does not divide 1 MHz.
+pub const fn tick_timer(timer_clock_hz: u32, tick_hz: u32) -> Option<(u16, u32)> {
+    if tick_hz == 0
+        || timer_clock_hz % TICK_COUNTER_HZ != 0
+        || timer_clock_hz < TICK_COUNTER_HZ
+        || TICK_COUNTER_HZ % tick_hz != 0
+    {
+        return None;
+    }
+    let psc = timer_clock_hz / TICK_COUNTER_HZ - 1;
+    if psc > u16::MAX as u32 {
+        return None;
+    }
+    Some((psc as u16, TICK_COUNTER_HZ / tick_hz - 1))
+}
+
+/// The clocks the HAL sets from a [`BoardConfig`]: APB1 and APB2 at their limits (or
+/// the core clock, if lower), timers at twice their bus clock when it is divided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Clocks {
+    /// Core clock, Hz.
+    pub sysclk_hz: u32,
+    /// APB2 (SPI1), Hz.
+    pub pclk2_hz: u32,
+    /// TIM1 (APB2 timers), Hz.
+    pub tim1_hz: u32,
+    /// TIM2 (APB1 timers), Hz.
+    pub tim2_hz: u32,
+}
+
+impl Clocks {
+    /// The clock tree for a core clock, as stm32f4xx-hal 0.22 sets it by default: each
+    /// APB at its limit or below, its divider `⌈sysclk / limit⌉` rounded up to a power
+    /// of two, its timers at twice its clock when divided.
+    pub const fn for_sysclk(sysclk_hz: u32) -> Self {
+        let (pclk1, tim2) = apb(sysclk_hz, PCLK1_MAX_HZ);
+        let (pclk2, tim1) = apb(sysclk_hz, PCLK2_MAX_HZ);
+        let _ = pclk1;
+        Self {
+            sysclk_hz,
+            pclk2_hz: pclk2,
+            tim1_hz: tim1,
+            tim2_hz: tim2,
+        }
+    }
+}
+
+/// One APB bus: its clock and its timers' clock.
+const fn apb(hclk_hz: u32, max_hz: u32) -> (u32, u32) {
+    let divider = match hclk_hz.div_ceil(max_hz) {
+        0 | 1 => 1,
+        2 => 2,
+        3..=5 => 4,
+        6..=11 => 8,
+        _ => 16,
+    };
+    let pclk = hclk_hz / divider;
+    (pclk, if divider == 1 { pclk } else { 2 * pclk })
+}
+
+impl BoardConfig {
+    /// Checks every constant against the parts' limits, at the clock tree it sets.
+    pub fn check(&self) -> Result<(), BoardConfigError> {
+        use BoardConfigError as E;
+        if !(4_000_000..=26_000_000).contains(&self.hse_hz) {
+            return Err(E::Hse);
+        }
+        if !(24_000_000..=168_000_000).contains(&self.sysclk_hz) {
+            return Err(E::Sysclk);
+        }
+        if !(100..=10_000).contains(&self.tick_hz) || TICK_COUNTER_HZ % self.tick_hz != 0 {
+            return Err(E::Tick);
+        }
+        let clocks = Clocks::for_sysclk(self.sysclk_hz);
+        let spi = spi_clock_hz(clocks.pclk2_hz, self.spi_request_hz);
+        if spi == 0 || spi > AS5047P_MAX_SPI_HZ {
+            return Err(E::SpiTooFast);
+        }
+        if pwm_max_duty(clocks.tim1_hz, self.pwm_hz) < 1000 {
+            return Err(E::PwmResolution);
+        }
+        if tick_timer(clocks.tim2_hz, self.tick_hz).is_none() {
+            return Err(E::Tick);
+        }
+        let tick_ms = 1000.0 / self.tick_hz as f64;
+        if (self.watchdog_ms as f64) < 10.0 * tick_ms || self.watchdog_ms > 10_000 {
+            return Err(E::Watchdog);
+        }
+        let mpc = self.mm_per_count;
+        if self.encoder_zero > 0x3FFF || !mpc.is_finite() || mpc == 0.0 || libm::fabs(mpc) >= 0.01 {
+            return Err(E::Encoder);
+        }
+        if !(self.max_speed_mm_s.is_finite() && self.max_speed_mm_s > 0.0) {
+            return Err(E::Speed);
+        }
+        MotorConfig::check(self.force_at_full_duty).map_err(E::Motor)?;
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !(3..=8).contains(&self.grid)
+            || !positive(self.node_mass)
+            || !positive(self.spring_damping)
+        {
+            return Err(E::Patch);
+        }
+        Ok(())
+    }
+
+    /// The encoder's configuration: the plausibility step from the fastest probe speed
+    /// at the tick rate (one frame per tick).
+    pub fn encoder(&self) -> EncoderConfig {
+        EncoderConfig {
+            zero: self.encoder_zero,
+            mm_per_count: self.mm_per_count,
+            max_step: EncoderConfig::max_step_for(
+                self.mm_per_count,
+                self.max_speed_mm_s,
+                self.tick_hz as f64,
+            ),
+            diag_every: self.diag_every,
+        }
+    }
+
+    /// The motor's configuration.
+    pub fn motor(&self) -> MotorConfig {
+        MotorConfig {
+            force_at_full_duty: self.force_at_full_duty,
+        }
+    }
+
+    /// The solver's configuration.
+    pub fn solver(&self) -> SolverConfig {
+        SolverConfig {
+            tick_hz: self.tick_hz as f64,
+            node_mass: self.node_mass,
+            spring_damping: self.spring_damping,
+            ..SolverConfig::default()
+        }
+    }
+}

@@ -1,0 +1,25 @@
+//! # haptic-f405 — mccs on an STM32F405 board
+//!
+//! The board firmware (`src/bin/haptic-f405.rs`, built for `thumbv7em-none-eabihf`)
+//! runs the `mccs` patch in a TIM2 interrupt on a 1-DOF device: an AS5047P encoder on
+//! SPI1 and a DC motor on TIM1's PWM, with an independent watchdog fed by the tick.
+//! This library is the part that is the same on every board and is tested on the host:
+//!
+//! - [`config`]: [`BoardConfig`](config::BoardConfig), every constant a port changes
+//!   but the pins, held to the parts' limits, and the HAL's clock arithmetic;
+//! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
+//! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
+//! - `pins` (firmware builds only): the pin map.
+//!
+//! docs/firmware.md, "Bring-up on a board", is the firmware engineer's guide.
+#![cfg_attr(not(test), no_std)]
+#![deny(missing_docs)]
+
+pub mod config;
+pub mod device;
+#[cfg(target_os = "none")]
+pub mod pins;
+pub mod telemetry;
+
+pub use config::{BoardConfig, BoardConfigError, BOARD};
+pub use telemetry::BoardTelemetry;

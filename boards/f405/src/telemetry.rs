@@ -1,0 +1,125 @@
+//! What the board's tick publishes for the main loop: the controller's telemetry, the
+//! tick's length (µs on the tick timer, core cycles on the DWT), the encoder's error
+//! counters and the tick on which the safe state was entered; and the verdict of a QEMU
+//! run, whose encoder reads zeros.
+
+use crate::config::BoardConfig;
+use mccs_firmware::drivers::as5047p::EncoderErrors;
+use mccs_firmware::{Fault, Telemetry};
+
+/// The board's run statistics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoardTelemetry {
+    /// The controller's.
+    pub run: Telemetry,
+    /// The longest tick so far, µs from the timer's update to the tick's end (the
+    /// interrupt's latency included).
+    pub worst_us: u32,
+    /// The longest tick so far, core cycles from the interrupt's entry (DWT; 0 where
+    /// there is no cycle counter, as in QEMU).
+    pub worst_cycles: u32,
+    /// The encoder's error counters.
+    pub encoder: EncoderErrors,
+    /// The tick (0-based) on which the safe state was entered.
+    pub fault_tick: Option<u32>,
+}
+
+impl BoardTelemetry {
+    /// Before the first tick.
+    pub const fn new() -> Self {
+        Self {
+            run: Telemetry::new(),
+            worst_us: 0,
+            worst_cycles: 0,
+            encoder: EncoderErrors {
+                parity: 0,
+                flagged: 0,
+                implausible: 0,
+                diagnostic: 0,
+                consecutive: 0,
+            },
+            fault_tick: None,
+        }
+    }
+
+    /// Records one tick: the controller's telemetry after it, its length and the
+    /// encoder's counters.
+    pub fn record(&mut self, run: Telemetry, us: u32, cycles: u32, encoder: EncoderErrors) {
+        if self.fault_tick.is_none() && run.fault.is_some() {
+            self.fault_tick = Some(run.ticks.saturating_sub(1));
+        }
+        self.run = run;
+        self.worst_us = self.worst_us.max(us);
+        self.worst_cycles = self.worst_cycles.max(cycles);
+        self.encoder = encoder;
+    }
+}
+
+impl Default for BoardTelemetry {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The tick on which an encoder that reads all zeros (MISO low, or QEMU's SPI, which has
+/// no device behind it) puts the board in its safe state, by the encoder's rules: the
+/// first frame answers no command; every later one answers a DIAAGC read with `LF` = 0,
+/// a failed diagnostic; the read fails on the `max_bad_frames + 1`-th in a row. `None`
+/// when diagnostics are off (`diag_every` = 0): zeros then read as angle 0, which
+/// only the plausibility check can catch, and only once the probe has moved.
+pub const fn zeros_fault_tick(config: &BoardConfig) -> Option<u32> {
+    if config.diag_every == 0 {
+        None
+    } else {
+        Some(config.max_bad_frames.saturating_add(1))
+    }
+}
+
+/// Why a QEMU run is not what the board's fault rules say it must be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QemuMismatch {
+    /// It did not run `qemu_ticks` ticks.
+    Ticks,
+    /// A tick overran its period.
+    Overrun,
+    /// The safe state was not entered through a failed read on the tick
+    /// [`zeros_fault_tick`] says.
+    Fault,
+    /// Putting the device in its safe state reported an error.
+    SafeState,
+}
+
+impl QemuMismatch {
+    /// The message.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Ticks => "the run did not last qemu_ticks ticks",
+            Self::Overrun => "a tick overran its period",
+            Self::Fault => "the encoder's zeros did not fault the read on the expected tick",
+            Self::SafeState => "the safe state reported an error",
+        }
+    }
+}
+
+/// Holds a QEMU run (the encoder reads zeros there) to the fault rules.
+pub fn qemu_verdict(config: &BoardConfig, t: &BoardTelemetry) -> Result<(), QemuMismatch> {
+    if t.run.ticks != config.qemu_ticks {
+        return Err(QemuMismatch::Ticks);
+    }
+    if t.run.overruns != 0 {
+        return Err(QemuMismatch::Overrun);
+    }
+    let expected = zeros_fault_tick(config);
+    let fault = if expected.is_some() {
+        Some(Fault::Read)
+    } else {
+        None
+    };
+    if t.run.fault != fault || t.fault_tick != expected {
+        return Err(QemuMismatch::Fault);
+    }
+    if t.run.safe_state_errors != 0 {
+        return Err(QemuMismatch::SafeState);
+    }
+    Ok(())
+}
