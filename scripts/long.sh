@@ -3,7 +3,8 @@
 #   1. the short-trajectory properties of Solver::step at CASES cases per arithmetic
 #      (default 50,000: ten times the test command's, about 10⁷ ticks in all), and the
 #      settling properties at CASES / 100;
-#   2. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
+#   2. the force-table bound over 10⁵ random springs (host-tests/tests/table_bound.rs);
+#   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
 # Prints the PROPERTY and FUZZ lines; exits with failure if any run fails.
 #   scripts/long.sh [CASES] [FUZZ_SECONDS]
 set -euo pipefail
@@ -27,5 +28,10 @@ echo "long.sh: the settling properties at $settle cases per arithmetic" >&2
 PROPTEST_CASES=$settle cargo test --release -p mccs-host --test solver_properties \
     -- --show-output after_lift_off >> "$log" 2>&1 || { echo "long.sh: the settling properties failed; see $log" >&2; exit 1; }
 grep -E "^PROPERTY " "$log"
+echo "long.sh: the force-table bound over 10^5 random springs (a few minutes)" >&2
+TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test table_bound \
+    -- --show-output every_table > target/logs/long/table_bound.log 2>&1 \
+  || { echo "long.sh: the table bound failed; see target/logs/long/table_bound.log" >&2; exit 1; }
+grep -E "^TABLEBOUND " target/logs/long/table_bound.log
 echo "long.sh: properties done in $(( $(date +%s) - start )) s; fuzzing $fuzz_seconds s per target" >&2
 bash scripts/fuzz.sh "$fuzz_seconds"

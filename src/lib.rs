@@ -42,7 +42,8 @@ pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
 pub use solver::{Bound, ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
-    ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableError,
+    ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableBound,
+    TableError,
 };
 pub use topology::{Edge, End, Topology, TopologyError, GROUND};
 pub use units::{Force, Length, Stiffness, Strain, Velocity};

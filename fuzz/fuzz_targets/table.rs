@@ -62,6 +62,8 @@ fuzz_target!(|i: Input| {
         shift: b[2],
         stiff_scale: a[7],
         stiff_post: a[8],
+        err_force_ppb: b[0],
+        err_stiffness_ppb: b[1],
         segments,
     };
     let t = ForceTable::from_raw(raw);

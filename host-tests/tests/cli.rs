@@ -436,6 +436,86 @@ fn table_errors_without_domain_arguments_name_the_file() {
     }
 }
 
+/// `mccs table` states the table's measured error in its header and on stderr, and
+/// refuses a table over the product's bound with one line (exit 2) naming the file, what
+/// the table reaches and what to change; `--accept-error` emits it, marked.
+#[test]
+fn table_states_its_measured_bound_and_refuses_what_misses_it() {
+    let out = mccs(&["table", "--params", "params/table2.toml"]);
+    assert!(out.status.success());
+    let src = String::from_utf8(out.stdout).unwrap();
+    let second = src.lines().nth(1).unwrap();
+    assert!(
+        second.starts_with(
+            "// Accuracy, measured against the f64 law over [-0.5, 0.95]: force error "
+        ) && second.ends_with("within the product's bound (force 2e-5, stiffness 1e-3)."),
+        "{second}"
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("mccs table: measured against the f64 law"),
+        "{err}"
+    );
+    // A soft cone against a series spring 2000 times stiffer (the spring).
+    let f = temp_file(
+        "stiff-series.toml",
+        "[cone]\nwire_diameter = 0.1\nsmall_diameter = 0.3\nlarge_diameter = 0.8\nactive_coils = 5.0\ncompressible_height = 0.6\nshear_modulus = 1.8472e4\n[linear]\nwire_diameter = 0.068\nmean_diameter = 0.2\nactive_coils = 10.0\nshear_modulus = 1.386e7\n",
+    );
+    let path = f.to_str().unwrap();
+    for (knots, advice) in [
+        ("65", "more knots (--knots 129)"),
+        ("129", "a narrower domain"),
+    ] {
+        let out = mccs(&["table", "--params", path, "--knots", knots]);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(out.stdout.is_empty());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        for part in [
+            "stiff-series.toml",
+            "misses the bound",
+            "k_p/k = 2.01e3",
+            advice,
+            "--accept-error",
+        ] {
+            assert!(err.contains(part), "{part}: {err}");
+        }
+    }
+    let out = mccs(&[
+        "table",
+        "--params",
+        path,
+        "--knots",
+        "129",
+        "--accept-error",
+    ]);
+    assert!(out.status.success());
+    let src = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        src.lines()
+            .nth(1)
+            .unwrap()
+            .contains("OVER the product's bound"),
+        "{src}"
+    );
+    // The solvers run it, with a warning.
+    let out = mccs(&[
+        "curve",
+        "--params",
+        path,
+        "--from",
+        "0",
+        "--to",
+        "0.5",
+        "--step",
+        "0.25",
+        "--backend",
+        "fixed",
+    ]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("misses the accuracy bound"));
+}
+
 #[test]
 fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
     let dir = std::env::temp_dir().join(format!("mccs-fit-{}", std::process::id()));

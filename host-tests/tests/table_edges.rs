@@ -39,6 +39,8 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             shift: b.4,
             stiff_scale: c.0,
             stiff_post: c.1,
+            err_force_ppb: c.0 as u32,
+            err_stiffness_ppb: c.1 as u32,
             segments,
         })
 }

@@ -3,7 +3,7 @@
 //! ([`hermite`]), the coefficients' unit ([`coefficient_shift`]), the stiffness scale
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
-use super::{ForceTable, RawTable, TableError, DEFAULT_DOMAIN};
+use super::{measure, ForceTable, RawTable, TableBound, TableError, DEFAULT_DOMAIN, UNMEASURED};
 use crate::law::Law;
 use crate::params::Params;
 use crate::units::{checked_from_f64, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
@@ -23,7 +23,40 @@ impl<const S: usize> ForceTable<S> {
         Self::from_law(&law, from, to)
     }
 
-    /// Builds the table for an already derived law.
+    /// Builds the table for `params` over `[from, to]`, and refuses it unless its
+    /// measured error is within `bound` ([`TableBound::PRODUCT`] is the product's
+    /// promise): [`TableError::BoundNotMet`] carries what it reached.
+    pub fn with_bound(
+        params: &Params,
+        from: f64,
+        to: f64,
+        bound: &TableBound,
+    ) -> Result<Self, TableError> {
+        let law = Law::new(params)?;
+        let t = Self::from_law(&law, from, to)?.measured(&law, from, to);
+        if t.max_error().is_some_and(|e| e.within(bound)) {
+            Ok(t)
+        } else {
+            Err(TableError::BoundNotMet {
+                force_ppb: t.raw.err_force_ppb,
+                stiffness_ppb: t.raw.err_stiffness_ppb,
+            })
+        }
+    }
+
+    /// The table with its error against `law` over `[from, to]` measured ([`measure`])
+    /// and recorded ([`ForceTable::max_error`]). `law` and the domain must be the ones it
+    /// was built from.
+    #[inline(never)]
+    pub fn measured(mut self, law: &Law, from: f64, to: f64) -> Self {
+        let (force, stiffness) = measure(&self, law, from, to).to_ppb();
+        self.raw.err_force_ppb = force;
+        self.raw.err_stiffness_ppb = stiffness;
+        self
+    }
+
+    /// Builds the table for an already derived law (not measured: see
+    /// [`ForceTable::measured`]).
     #[inline(never)]
     pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let grid = Grid::place::<S>(law, from, to)?;
@@ -46,6 +79,8 @@ impl<const S: usize> ForceTable<S> {
             shift,
             stiff_scale,
             stiff_post,
+            err_force_ppb: UNMEASURED,
+            err_stiffness_ppb: UNMEASURED,
             segments: segs.coefficients,
         }))
     }

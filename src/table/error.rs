@@ -18,6 +18,15 @@ pub enum TableError {
     OutOfRange,
     /// Fewer than one segment.
     NoSegments,
+    /// The table's measured error is over the bound asked for
+    /// ([`crate::ForceTable::with_bound`]); it reached this (parts per 10⁹: force of
+    /// `F(to)`, stiffness relative).
+    BoundNotMet {
+        /// Force error reached, ppb of `F(to)`.
+        force_ppb: u32,
+        /// Stiffness error reached, ppb (relative).
+        stiffness_ppb: u32,
+    },
     /// A raw table's header breaks the invariants the builder keeps
     /// ([`crate::ForceTable::validate`]): it was not emitted by `mccs table`, or was edited.
     Inconsistent,
@@ -40,6 +49,9 @@ impl TableError {
                 "params: forces or stiffnesses in the domain exceed the fixed-point formats (±2048 N, ±32768 N/strain)"
             }
             Self::NoSegments => "knots: at least 2 are needed",
+            Self::BoundNotMet { .. } => {
+                "table: its measured error is over the bound (more knots or a narrower domain)"
+            }
             Self::Inconsistent => {
                 "table: its header is inconsistent (not as `mccs table` emits it)"
             }
@@ -57,6 +69,15 @@ impl fmt::Display for TableError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Param(e) => e.fmt(f),
+            Self::BoundNotMet {
+                force_ppb,
+                stiffness_ppb,
+            } => write!(
+                f,
+                "table: its measured error, force {:.1e} of F(to) and stiffness {:.1e} relative, is over the bound (more knots or a narrower domain)",
+                *force_ppb as f64 * 1e-9,
+                *stiffness_ppb as f64 * 1e-9
+            ),
             other => f.write_str(other.message()),
         }
     }

@@ -14,7 +14,7 @@
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
 //! the law bends harder than the grid resolves, so that the curve stays monotone), as
 //! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
-//! per segment, 1072 bytes in all for 65 knots) so that each Horner step is one product
+//! per segment, 1080 bytes in all for 65 knots with the header) so that each Horner step is one product
 //! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
 //! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
 //! the kink, the line through zero with `k` rounded down), so the curve is continuous and
@@ -39,15 +39,20 @@
 //! same bits ([`crate::q`]). Instruction counts per core: `docs/performance.md`.
 //!
 //! # Accuracy
-//! Measured against the `f64` reference by `host-tests/tests/table_accuracy.rs`:
+//! Each table carries its own measured error against the `f64` law over its domain
+//! ([`ForceTable::max_error`], [`TableBound`]); [`ForceTable::with_bound`] refuses a table
+//! that misses a bound ([`TableError::BoundNotMet`]). Measured against the independent
+//! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound.rs`:
 //! `docs/accuracy.md`.
 
 use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
 use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
+mod bound;
 mod build;
 mod error;
 
+pub use bound::{measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
 pub use error::TableError;
 
 /// The default strain domain `[ε_min, ε_max]`.
@@ -88,6 +93,12 @@ pub struct RawTable<const S: usize> {
     pub stiff_scale: i32,
     /// See `stiff_scale`.
     pub stiff_post: i32,
+    /// The largest force error against the `f64` law over the domain, measured when the
+    /// table was built: parts per 10⁹ of `F(to)` ([`ForceTable::max_error`]);
+    /// [`UNMEASURED`] in both fields when it was not measured.
+    pub err_force_ppb: u32,
+    /// The largest stiffness error (relative, away from the law's kinks), parts per 10⁹.
+    pub err_stiffness_ppb: u32,
     /// Per segment `[C0, C1, C2, C3] = [c0, 2 c1, 4 c2, 8 c3]` of the cubic
     /// `F(τ) = c0 + c1 τ + c2 τ² + c3 τ³`, `τ ∈ [0, 1)`: the degree-`j` coefficient carries
     /// `2^j` so that each Horner step is one product by `τ/2` ([`crate::q::mul_t`]).
@@ -144,6 +155,18 @@ impl<const S: usize> ForceTable<S> {
             Ok(())
         } else {
             Err(TableError::Inconsistent)
+        }
+    }
+
+    /// The largest force and stiffness errors against the `f64` law over the table's
+    /// domain, measured when it was built ([`measure`]): what the firmware runs with.
+    /// `None` for a table built without measuring ([`ForceTable::new`] and the like).
+    pub fn max_error(&self) -> Option<TableBound> {
+        let r = &self.raw;
+        if r.err_force_ppb == UNMEASURED && r.err_stiffness_ppb == UNMEASURED {
+            None
+        } else {
+            Some(TableBound::from_ppb(r.err_force_ppb, r.err_stiffness_ppb))
         }
     }
 

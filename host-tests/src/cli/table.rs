@@ -3,7 +3,7 @@
 
 use super::{arg_error, file_error, io_error, CliError};
 use crate::paramfile;
-use mccs::{ForceTable, Params, TableError};
+use mccs::{ForceTable, Params, TableBound, TableError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -24,6 +24,10 @@ pub(super) struct Args {
     /// Write here instead of standard output.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Emit the table even if its measured error is over the product's bound (force
+    /// 2e-5 of F(to), stiffness 1e-3 relative); the header states what it reached.
+    #[arg(long)]
+    accept_error: bool,
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
@@ -34,7 +38,40 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         a.params.display()
     );
     let src = with_table!(knots, &p, &a.params, Domain::Args(from, to), |t| {
-        render_table(&header, &t)
+        let reached = t.max_error().unwrap_or(UNKNOWN);
+        let bound = TableBound::PRODUCT;
+        let figures = format!(
+            "measured against the f64 law over [{from:?}, {to:?}]: force error {:.1e} of F({to:?}), stiffness error {:.1e} (relative; not within {:?} strain of the law's kinks)",
+            reached.force,
+            reached.stiffness,
+            mccs::table::KINK_MARGIN
+        );
+        if !reached.within(&bound) && !a.accept_error {
+            let law = mccs::Law::new(&p).map_err(|e| file_error(&a.params, e))?;
+            return Err(file_error(
+                &a.params,
+                format!(
+                    "the {knots}-knot table misses the bound (force {:.0e}, stiffness {:.0e}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e} (k_p/k = {:.2e}); use {}, or emit it anyway with --accept-error",
+                    bound.force,
+                    bound.stiffness,
+                    reached.force,
+                    reached.stiffness,
+                    law.k_p / law.k,
+                    if knots < 129 {
+                        "more knots (--knots 129) or a narrower domain (--from/--to)"
+                    } else {
+                        "a narrower domain (--from/--to)"
+                    }
+                ),
+            ));
+        }
+        eprintln!("mccs table: {figures}");
+        let verdict = if reached.within(&bound) {
+            "within the product's bound (force 2e-5, stiffness 1e-3)"
+        } else {
+            "OVER the product's bound (force 2e-5, stiffness 1e-3): emitted with --accept-error"
+        };
+        render_table(&format!("{header}// Accuracy, {figures}: {verdict}.\n"), &t)
     });
     match a.out {
         Some(path) => std::fs::write(&path, src)
@@ -42,6 +79,12 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         None => out.write_all(src.as_bytes()).map_err(io_error),
     }
 }
+
+/// What an unmeasured table is taken to reach (every table here is measured).
+const UNKNOWN: TableBound = TableBound {
+    force: f64::INFINITY,
+    stiffness: f64::INFINITY,
+};
 
 /// Where a table's domain comes from: the `--from`/`--to` arguments (their errors
 /// name them), or the default domain (errors name the parameter file).
@@ -102,27 +145,29 @@ pub(super) fn table<const S: usize>(
         return Err(arg_error("--to", "must be > --from"));
     }
     let law = mccs::Law::new(p).map_err(|e| file_error(file, e))?;
-    ForceTable::<S>::from_law(&law, from, to).map_err(|e| match e {
-        TableError::NoNonlinearPhase if to <= law.strain_t() => arg_error(
-            "--to",
-            &format!(
-                "must exceed {:.6}, where this spring's law stops being linear",
-                law.strain_t()
+    ForceTable::<S>::from_law(&law, from, to)
+        .map(|t| t.measured(&law, from, to))
+        .map_err(|e| match e {
+            TableError::NoNonlinearPhase if to <= law.strain_t() => arg_error(
+                "--to",
+                &format!(
+                    "must exceed {:.6}, where this spring's law stops being linear",
+                    law.strain_t()
+                ),
             ),
-        ),
-        TableError::NoNonlinearPhase => arg_error(
-            "--from",
-            &format!(
-                "must be below {:.6}, where this spring's cone is solid",
-                law.strain_c()
+            TableError::NoNonlinearPhase => arg_error(
+                "--from",
+                &format!(
+                    "must be below {:.6}, where this spring's cone is solid",
+                    law.strain_c()
+                ),
             ),
-        ),
-        TableError::TooNarrow => arg_error(
-            "--from/--to",
-            "the nonlinear phase inside them is too narrow for this many knots",
-        ),
-        other => file_error(file, other),
-    })
+            TableError::TooNarrow => arg_error(
+                "--from/--to",
+                "the nonlinear phase inside them is too narrow for this many knots",
+            ),
+            other => file_error(file, other),
+        })
 }
 
 /// The table the solvers run: 65 knots over the default domain. Its errors name the
@@ -135,7 +180,9 @@ pub(super) fn solver_table(p: &Params, file: &Path) -> Result<mccs::ForceTable64
 fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable<S>, CliError> {
     let (from, to) = mccs::table::DEFAULT_DOMAIN;
     let law = mccs::Law::new(p).map_err(|e| file_error(file, e))?;
-    ForceTable::<S>::from_law(&law, from, to).map_err(|e| match e {
+    ForceTable::<S>::from_law(&law, from, to)
+        .map(|t| t.measured(&law, from, to))
+        .map_err(|e| match e {
         TableError::NoNonlinearPhase if to <= law.strain_t() => file_error(
             file,
             format!(
@@ -151,6 +198,18 @@ fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable
             ),
         ),
         other => file_error(file, other),
+    })
+    .inspect(|t| {
+        let reached = t.max_error().unwrap_or(UNKNOWN);
+        if !reached.within(&TableBound::PRODUCT) {
+            eprintln!(
+                "mccs: warning: {}: the {}-knot force table misses the accuracy bound (force 2e-5 of F({to}), stiffness 1e-3): it reaches {:.1e} and {:.1e} (see `mccs table`)",
+                file.display(),
+                S + 1,
+                reached.force,
+                reached.stiffness
+            );
+        }
     })
 }
 
@@ -175,6 +234,8 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
         ("shift", r.shift as i64),
         ("stiff_scale", r.stiff_scale as i64),
         ("stiff_post", r.stiff_post as i64),
+        ("err_force_ppb", r.err_force_ppb as i64),
+        ("err_stiffness_ppb", r.err_stiffness_ppb as i64),
     ] {
         s.push_str(&format!("    {name}: {v},\n"));
     }
