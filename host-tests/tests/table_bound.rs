@@ -141,9 +141,10 @@ struct Tally {
 }
 
 /// Whether the fixed-point formats alone put the bound out of reach: one Q20 force LSB
-/// (9.5e-7 N) is more than the force bound (`F(0.95)` below 0.048 N), or one Q16
-/// stiffness LSB (1.5e-5) more than the stiffness bound of the law's smallest stiffness
-/// on the domain (below 0.015 N per unit strain).
+/// (9.5e-7 N), or one Q16 LSB of the tension line's slope over the domain's tension end
+/// (2⁻¹⁶ × 0.5 = 7.6e-6 N), is more than the force bound (`F(0.95)` below 0.048 N, or
+/// below 0.38 N); or one Q16 stiffness LSB (1.5e-5) is more than the stiffness bound of
+/// the law's smallest stiffness on the domain (below 0.015 N per unit strain).
 fn format_limited(p: &Params, bound: &TableBound) -> bool {
     let r = Reference::new(p).unwrap();
     let force_lsb = 1.0 / (1u64 << 20) as f64;
@@ -151,7 +152,9 @@ fn format_limited(p: &Params, bound: &TableBound) -> bool {
     let smallest = (0..=1000)
         .map(|i| r.stiffness(DOMAIN.0 + (DOMAIN.1 - DOMAIN.0) * i as f64 / 1000.0))
         .fold(f64::INFINITY, f64::min);
-    force_lsb > bound.force * r.force(DOMAIN.1) || stiffness_lsb > bound.stiffness * smallest
+    let tension_slope_lsb = stiffness_lsb * DOMAIN.0.abs();
+    force_lsb.max(tension_slope_lsb) > bound.force * r.force(DOMAIN.1)
+        || stiffness_lsb > bound.stiffness * smallest
 }
 
 #[test]
