@@ -1,6 +1,6 @@
 //! The table builder's arguments (any spring scale, domain and knot count) and any raw
-//! table: a typed error or a valid table, and every evaluation, in both arithmetics,
-//! without a panic.
+//! table: a typed error or a valid table, its measured error, the bound's verdict, and
+//! every evaluation, in both arithmetics, without a panic.
 #![no_main]
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
@@ -32,6 +32,13 @@ fn build<const S: usize>(p: &Params, from: f64, to: f64, strains: &[i32]) {
     if let Ok(t) = ForceTable::<S>::with_domain(p, from, to) {
         assert_eq!(t.validate(), Ok(()));
         evaluate(&t, strains);
+        // The measurement of its error, and the refusal against the product's bound.
+        if let Ok(law) = mccs::Law::new(p) {
+            let m = t.measured(&law, from, to).max_error();
+            assert!(m.is_some_and(|e| e.force >= 0.0 && e.stiffness >= 0.0));
+            let bounded = ForceTable::<S>::with_bound(p, from, to, &mccs::TableBound::PRODUCT);
+            assert!(matches!(bounded, Ok(_) | Err(mccs::TableError::BoundNotMet { .. })));
+        }
     }
 }
 

@@ -17,8 +17,8 @@
 #[cfg(not(target_os = "none"))]
 fn main() {
     eprintln!(
-        "haptic-f405 is firmware: build it for the STM32F405, e.g. `cargo f405-build`, or run \
-         it in QEMU with `cargo f405-qemu` (see docs/firmware.md)"
+        "haptic-f405 is firmware: build it for the STM32F405 with `cargo f405-build`, flash it \
+         with `cargo f405-run`, or run it in QEMU with `bash scripts/f405-qemu.sh` (see docs/firmware.md)"
     );
     std::process::exit(2);
 }
