@@ -456,11 +456,13 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         err.starts_with("mccs table: measured against the f64 law"),
         "{err}"
     );
-    // A soft cone against a series spring 2000 times stiffer (the spring).
-    let f = temp_file(
-        "stiff-series.toml",
-        "[cone]\nwire_diameter = 0.1\nsmall_diameter = 0.3\nlarge_diameter = 0.8\nactive_coils = 5.0\ncompressible_height = 0.6\nshear_modulus = 1.8472e4\n[linear]\nwire_diameter = 0.068\nmean_diameter = 0.2\nactive_coils = 10.0\nshear_modulus = 1.386e7\n",
-    );
+    // Table 2 with a cone 10× softer against a series spring 2000 times stiffer than it
+    // (the spring).
+    let stiff_series = TABLE2
+        .replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e4")
+        .replace("shear_modulus = 4.9151e5", "shear_modulus = 1.386e7");
+    assert_ne!(stiff_series, TABLE2);
+    let f = temp_file("stiff-series.toml", &stiff_series);
     let path = f.to_str().unwrap();
     for (knots, advice) in [
         ("65", "more knots (--knots 129)"),

@@ -4,7 +4,7 @@
 //! (`RawTable::err_force_ppb`, `err_stiffness_ppb`; [`ForceTable::max_error`]), and the
 //! bound the product promises ([`TableBound::PRODUCT`]). A table built on a device with
 //! [`ForceTable::new`] is not measured unless asked: the measurement costs about 4 KiB
-//! of flash and `33 S` evaluations of the `f64` law.
+//! of flash and about `65 S + 1000` evaluations of the `f64` law.
 //!
 //! The measurement ([`measure`]) evaluates the table and the law at every knot and at
 //! [`POINTS_PER_SEGMENT`] points inside each segment, at as many points on the lines
@@ -135,9 +135,6 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
             at(lo + step * (i as f64 + j as f64 / n as f64));
         }
     }
-    // Just outside the margin round each kink, where a corner the grid cannot follow
-    // leaves its largest stiffness error, changing fast: densely over the first 5 % of a
-    // margin beyond it (2 n points, 1.6e-6 strain apart), then out to 2.3 margins.
     // At and round the cone's own transition Δ(F_T) (a jump in curvature, not in slope,
     // when the preload is not F_T): the error has a corner there.
     let e_t = law.delta(law.f_t);
@@ -146,6 +143,9 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
             at(e_t + side * KINK_MARGIN * 0.05 * j as f64 / (2 * n) as f64);
         }
     }
+    // Just outside the margin round each kink, where a corner the grid cannot follow
+    // leaves its largest stiffness error, changing fast: densely over the first 5 % of a
+    // margin beyond it (2 n points, 1.6e-6 strain apart), then out to 2.3 margins.
     for x in kinks {
         for j in 0..2 * n {
             for side in [-1.0, 1.0] {

@@ -72,12 +72,14 @@ impl fmt::Display for TableError {
             Self::BoundNotMet {
                 force_ppb,
                 stiffness_ppb,
-            } => write!(
-                f,
-                "table: its measured error, force {:.1e} of F(to) and stiffness {:.1e} relative, is over the bound (more knots or a narrower domain)",
-                *force_ppb as f64 * 1e-9,
-                *stiffness_ppb as f64 * 1e-9
-            ),
+            } => {
+                let reached = crate::TableBound::from_ppb(*force_ppb, *stiffness_ppb);
+                write!(
+                    f,
+                    "table: its measured error, force {:.1e} of F(to) and stiffness {:.1e} relative, is over the bound (more knots or a narrower domain)",
+                    reached.force, reached.stiffness
+                )
+            }
             other => f.write_str(other.message()),
         }
     }

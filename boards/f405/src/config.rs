@@ -205,9 +205,8 @@ impl Clocks {
     /// APB at its limit or below, its divider `⌈sysclk / limit⌉` rounded up to a power
     /// of two, its timers at twice its clock when divided.
     pub const fn for_sysclk(sysclk_hz: u32) -> Self {
-        let (pclk1, tim2) = apb(sysclk_hz, PCLK1_MAX_HZ);
+        let (_, tim2) = apb(sysclk_hz, PCLK1_MAX_HZ);
         let (pclk2, tim1) = apb(sysclk_hz, PCLK2_MAX_HZ);
-        let _ = pclk1;
         Self {
             sysclk_hz,
             pclk2_hz: pclk2,

@@ -40,6 +40,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let src = with_table!(knots, &p, &a.params, Domain::Args(from, to), |t| {
         let reached = t.max_error().unwrap_or(UNKNOWN);
         let bound = TableBound::PRODUCT;
+        let promise = product_bound();
         let figures = format!(
             "measured against the f64 law over [{from:?}, {to:?}]: force error {:.1e} of F({to:?}), stiffness error {:.1e} (relative; not within {:?} strain of the law's kinks)",
             reached.force,
@@ -51,9 +52,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             return Err(file_error(
                 &a.params,
                 format!(
-                    "the {knots}-knot table misses the bound (force {:.0e}, stiffness {:.0e}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e} (k_p/k = {:.2e}); use {}, or emit it anyway with --accept-error",
-                    bound.force,
-                    bound.stiffness,
+                    "the {knots}-knot table misses the bound ({promise}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e} (k_p/k = {:.2e}); use {}, or emit it anyway with --accept-error",
                     reached.force,
                     reached.stiffness,
                     law.k_p / law.k,
@@ -67,9 +66,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         }
         eprintln!("mccs table: {figures}");
         let verdict = if reached.within(&bound) {
-            "within the product's bound (force 2e-5, stiffness 1e-3)"
+            format!("within the product's bound ({promise})")
         } else {
-            "OVER the product's bound (force 2e-5, stiffness 1e-3): emitted with --accept-error"
+            format!("OVER the product's bound ({promise}): emitted with --accept-error")
         };
         render_table(&format!("{header}// Accuracy, {figures}: {verdict}.\n"), &t)
     });
@@ -78,6 +77,12 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display()))),
         None => out.write_all(src.as_bytes()).map_err(io_error),
     }
+}
+
+/// The product's bound in words: `force 2e-5, stiffness 1e-3`.
+fn product_bound() -> String {
+    let b = TableBound::PRODUCT;
+    format!("force {:.0e}, stiffness {:.0e}", b.force, b.stiffness)
 }
 
 /// What an unmeasured table is taken to reach (every table here is measured).
@@ -203,9 +208,10 @@ fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable
         let reached = t.max_error().unwrap_or(UNKNOWN);
         if !reached.within(&TableBound::PRODUCT) {
             eprintln!(
-                "mccs: warning: {}: the {}-knot force table misses the accuracy bound (force 2e-5 of F({to}), stiffness 1e-3): it reaches {:.1e} and {:.1e} (see `mccs table`)",
+                "mccs: warning: {}: the {}-knot force table misses the accuracy bound ({}): it reaches {:.1e} and {:.1e} (see `mccs table`)",
                 file.display(),
                 S + 1,
+                product_bound(),
                 reached.force,
                 reached.stiffness
             );
