@@ -10,5 +10,6 @@ pub mod paramfile;
 pub mod patch;
 pub mod reference;
 pub mod replay;
+pub mod roam;
 pub mod stability;
 pub mod trajectory;

@@ -47,12 +47,22 @@ impl Mesh {
     /// layer (index `n² + i·n + j`); springs with both ends fixed are left out.
     pub fn standard(n: usize, spacing: f64) -> Mesh {
         let c = (n / 2) as f64;
+        Mesh::grid(n, spacing, |i, j| {
+            [(i as f64 - c) * spacing, (j as f64 - c) * spacing, 0.0]
+        })
+    }
+
+    /// The standard patch's nodes and springs over any rest surface: surface node `(i, j)`
+    /// at `surface(i, j)` (mm), its base node `spacing` below it; the outer ring and the
+    /// base fixed; the contact node `(n/2, n/2)`.
+    pub fn grid(n: usize, spacing: f64, surface: impl Fn(usize, usize) -> V) -> Mesh {
         let mut rest = Vec::new();
         let mut fixed = Vec::new();
         for layer in [0.0, -spacing] {
             for i in 0..n {
                 for j in 0..n {
-                    rest.push([(i as f64 - c) * spacing, (j as f64 - c) * spacing, layer]);
+                    let p = surface(i, j);
+                    rest.push([p[0], p[1], p[2] + layer]);
                     let ring = i == 0 || j == 0 || i == n - 1 || j == n - 1;
                     fixed.push(layer < 0.0 || ring);
                 }

@@ -1,0 +1,377 @@
+//! The roaming twin (`mccs_host::roam`) against physics: a frictionless slide feels the
+//! static indentation at every point, kinetic friction holds its ratio, a stick holds,
+//! the window's shifts are not felt and do not thrash, and the contact is unilateral.
+//! Prints `ROAM` lines (the figures in docs/roaming.md).
+
+use mccs::{Params, SolverConfig};
+use mccs_host::patch::{TwinConfig, V};
+use mccs_host::reference::Reference;
+use mccs_host::roam::{Friction, RoamConfig, RoamError, RoamTwin, Shape, TickOut, Tissue};
+
+const SPACING: f64 = 2.5;
+/// Substeps per 1 kHz tick: the N = 5 patch's exact bound is 679 µs (docs/performance.md).
+const SUBSTEPS: u32 = 3;
+
+fn config(friction: Friction, shape: Shape) -> RoamConfig {
+    RoamConfig {
+        tissue: Tissue::new(64, 64, SPACING, shape).unwrap(),
+        n: 5,
+        dynamics: TwinConfig::from_solver(&SolverConfig::default(), SUBSTEPS),
+        friction,
+        probe_radius: 0.0,
+        window_hysteresis: 0.1,
+    }
+}
+
+fn twin(friction: Friction, x: f64, y: f64) -> RoamTwin {
+    let law = Reference::new(&Params::TABLE2).unwrap();
+    RoamTwin::new(config(friction, Shape::Flat), law, x, y).unwrap()
+}
+
+fn dot(a: V, b: V) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Normal and tangential parts of the device force against the contact normal.
+fn split(o: &TickOut) -> (f64, f64) {
+    let n = dot(o.force, o.normal);
+    let t = [0, 1, 2].map(|k| o.force[k] - n * o.normal[k]);
+    (n, dot(t, t).sqrt())
+}
+
+/// The probe lowered at `(x, y)` from above to `depth` below the rest surface over
+/// `ramp` ticks.
+fn press(tw: &mut RoamTwin, x: f64, y: f64, depth: f64, ramp: usize) -> TickOut {
+    let mut o = TickOut::default();
+    for t in 0..=ramp {
+        let z = 0.5 - (0.5 + depth) * t as f64 / ramp as f64;
+        o = tw.step([x, y, z]);
+    }
+    o
+}
+
+/// The static indentation force at `(x, y)`: pressed there and held until settled.
+fn settled(x: f64, y: f64, depth: f64) -> f64 {
+    let mut tw = twin(Friction::NONE, x, y);
+    press(&mut tw, x, y, depth, 200);
+    let mut o = TickOut::default();
+    for _ in 0..1500 {
+        o = tw.step([x, y, -depth]);
+    }
+    split(&o).0
+}
+
+#[test]
+fn frictionless_slide_feels_the_static_indentation_everywhere() {
+    let (depth, speed, from, length) = (1.0, 10.0, -15.0, 30.0);
+    let y = 0.4;
+    let mut tw = twin(Friction::NONE, from, y);
+    press(&mut tw, from, y, depth, 200);
+    for _ in 0..1000 {
+        tw.step([from, y, -depth]);
+    }
+    let ticks = (length / speed * 1000.0) as usize;
+    let (mut worst_normal, mut worst_tangent, mut worst_step) = (0.0f64, 0.0f64, 0.0f64);
+    let mut prev: Option<TickOut> = None;
+    let mut shifts = 0;
+    for t in 1..=ticks {
+        let x = from + speed * t as f64 / 1000.0;
+        let o = tw.step([x, y, -depth]);
+        let (fn_, ft) = split(&o);
+        worst_tangent = worst_tangent.max(ft / fn_);
+        if let (Some(p), true) = (prev, o.shifted) {
+            shifts += 1;
+            let d = [0, 1, 2].map(|k| o.force[k] - p.force[k]);
+            worst_step = worst_step.max(dot(d, d).sqrt() / fn_);
+        }
+        if t % 271 == 0 {
+            let s = settled(x, y, depth);
+            let rel = (fn_ - s).abs() / s;
+            worst_normal = worst_normal.max(rel);
+            println!("slide x={x:.2} normal={fn_:.5} static={s:.5} rel={rel:.2e}");
+        }
+        prev = Some(o);
+    }
+    println!(
+        "ROAM case=frictionless_slide normal_vs_static={worst_normal:.2e} \
+         tangent_over_normal={worst_tangent:.2e} shift_step_over_normal={worst_step:.2e} \
+         shifts={shifts}"
+    );
+    assert!(shifts >= 10, "the window shifted {shifts} times over 30 mm");
+    assert!(
+        worst_normal <= 0.01,
+        "normal force off the static one by {worst_normal:.3e}"
+    );
+    assert!(
+        worst_tangent <= 0.01,
+        "tangential / normal {worst_tangent:.3e}"
+    );
+    assert!(
+        worst_step <= 0.02,
+        "a shift's force step is {worst_step:.3e} of the normal force"
+    );
+}
+
+#[test]
+fn kinetic_friction_holds_its_ratio_while_sliding() {
+    let f = Friction::new(0.4, 0.3).unwrap();
+    let (depth, speed, from) = (1.0, 10.0, -10.0);
+    let mut tw = twin(f, from, 0.0);
+    press(&mut tw, from, 0.0, depth, 200);
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for t in 1..=2000 {
+        let x = from + speed * t as f64 / 1000.0;
+        let o = tw.step([x, 0.0, -depth]);
+        let slipping = tw.contact().unwrap().slip.0;
+        if t > 500 {
+            assert!(slipping, "tick {t}: not slipping while dragged");
+            let (fn_, ft) = split(&o);
+            lo = lo.min(ft / fn_);
+            hi = hi.max(ft / fn_);
+        }
+    }
+    println!("ROAM case=kinetic_friction mu_k=0.3 ratio_min={lo:.4} ratio_max={hi:.4}");
+    assert!(
+        lo >= 0.3 * 0.98 && hi <= 0.3 * 1.02,
+        "ratio {lo:.4} … {hi:.4}"
+    );
+}
+
+#[test]
+fn a_pull_within_static_friction_sticks() {
+    let f = Friction::new(0.6, 0.4).unwrap();
+    let depth = 1.0;
+    let mut tw = twin(f, 0.3, 0.2);
+    press(&mut tw, 0.3, 0.2, depth, 200);
+    let start = tw.contact().unwrap().anchor;
+    // A tangential pull to half the static cone (the proxy is about `depth` above the
+    // probe: well within tan θ = 0.3 < 0.6), slowly.
+    for t in 1..=500 {
+        let dx = 0.3 * depth * t as f64 / 500.0;
+        tw.step([0.3 + dx, 0.2, -depth]);
+    }
+    let held = tw.contact().unwrap();
+    assert!(!held.slip.0, "slipping within the static cone");
+    assert_eq!(held.anchor.cell, start.cell);
+    let moved = (0..3)
+        .map(|k| (held.anchor.bary[k] - start.bary[k]).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-9, "the proxy moved on the surface: {moved:.3e}");
+    // Past the static cone it slips.
+    for t in 1..=500 {
+        let dx = 0.3 * depth + 1.5 * depth * t as f64 / 500.0;
+        tw.step([0.3 + dx, 0.2, -depth]);
+    }
+    assert!(
+        tw.contact().unwrap().slip.0,
+        "not slipping past the static cone"
+    );
+}
+
+#[test]
+fn a_probe_held_on_a_window_boundary_does_not_thrash() {
+    // Tissue node 32 is at x = 1.25 mm (64 nodes, centred). The window centred there
+    // moves when the contact is 0.6 spacings away: the probe trembles ±0.2 mm around
+    // that threshold.
+    let centre = 1.25;
+    let x = centre + 0.6 * SPACING;
+    let mut tw = twin(Friction::NONE, centre, 0.0);
+    press(&mut tw, centre, 0.0, 1.0, 200);
+    assert_eq!(tw.centre().0, 32);
+    for t in 0..200 {
+        tw.step([centre + (x - centre) * t as f64 / 200.0, 0.0, -1.0]);
+    }
+    let before = tw.shifts;
+    for t in 0..3000 {
+        let dx = 0.2 * (t as f64 * 0.05).sin();
+        tw.step([x + dx, 0.0, -1.0]);
+    }
+    let shifts = tw.shifts - before;
+    println!("ROAM case=boundary_tremor shifts={shifts}");
+    assert!(
+        shifts <= 1,
+        "{shifts} shifts under a 0.2 mm tremor on the boundary"
+    );
+    assert_eq!(tw.centre().0, 33, "the window did not follow the contact");
+}
+
+#[test]
+fn a_sphere_touches_at_its_radius() {
+    let law = Reference::new(&Params::TABLE2).unwrap();
+    let cfg = RoamConfig {
+        probe_radius: 1.0,
+        ..config(Friction::NONE, Shape::Flat)
+    };
+    let mut tw = RoamTwin::new(cfg, law, 0.0, 0.0).unwrap();
+    assert_eq!(tw.step([0.0, 0.0, 1.05]).force, [0.0; 3]);
+    assert!(tw.contact().is_none());
+    tw.step([0.0, 0.0, 0.95]);
+    assert!(tw.contact().is_some());
+    // Held (no coupling damping): 0.05 mm into the 1 N/mm coupling, less the surface's
+    // give.
+    let o = tw.step([0.0, 0.0, 0.95]);
+    assert!(
+        o.force[2] > 0.0 && o.force[2] <= 0.05 + 1e-9,
+        "{:?}",
+        o.force
+    );
+}
+
+#[test]
+fn the_contact_is_unilateral() {
+    let mut tw = twin(Friction::new(0.6, 0.4).unwrap(), 0.0, 0.0);
+    for t in 0..200 {
+        let o = tw.step([0.01 * t as f64, 0.0, 0.3]);
+        assert_eq!(o.force, [0.0; 3]);
+        assert!(tw.contact().is_none());
+    }
+    press(&mut tw, 2.0, 0.0, 1.0, 100);
+    assert!(tw.contact().is_some());
+    // Lifted: the contact ends, and no force pulls the probe down on the way up.
+    for t in 0..300 {
+        let z = -1.0 + 2.0 * t as f64 / 300.0;
+        let o = tw.step([2.0, 0.0, z]);
+        assert!(
+            o.force[2] >= 0.0,
+            "pulled down at z = {z:.3}: {:?}",
+            o.force
+        );
+    }
+    assert!(tw.contact().is_none());
+}
+
+#[test]
+fn on_a_cap_a_frictionless_push_follows_the_surface_normal() {
+    let law = Reference::new(&Params::TABLE2).unwrap();
+    let cfg = config(Friction::NONE, Shape::Cap { radius: 160.0 });
+    let (x, y) = (20.0, -10.0);
+    let mut tw = RoamTwin::new(cfg, law, x, y).unwrap();
+    let z0 = cfg.tissue.height(x, y);
+    let mut o = TickOut::default();
+    for t in 0..=1200 {
+        let z = z0 + 0.5 - 1.5 * (t.min(200) as f64 / 200.0);
+        o = tw.step([x, y, z]);
+    }
+    let (fn_, ft) = split(&o);
+    // The rest surface's normal there.
+    let r = 160.0f64;
+    let c = [x / r, y / r, (r * r - x * x - y * y).sqrt() / r];
+    let cos = dot(o.force, c) / dot(o.force, o.force).sqrt();
+    println!("ROAM case=cap_push normal={fn_:.4} tangent={ft:.2e} cos_to_rest_normal={cos:.5}");
+    assert!(
+        ft <= 1e-3 * fn_,
+        "tangential {ft:.3e} against normal {fn_:.3e}"
+    );
+    assert!(
+        cos > 0.999,
+        "the force is {:.2}° off the rest normal",
+        cos.acos().to_degrees()
+    );
+}
+
+#[test]
+fn bad_configurations_are_refused() {
+    let law = || Reference::new(&Params::TABLE2).unwrap();
+    assert_eq!(
+        Tissue::new(2, 10, 2.5, Shape::Flat),
+        Err(RoamError::TissueSize)
+    );
+    assert_eq!(
+        Tissue::new(65, 10, 2.5, Shape::Flat),
+        Err(RoamError::TissueSize)
+    );
+    assert_eq!(
+        Tissue::new(10, 10, 0.5, Shape::Flat),
+        Err(RoamError::Spacing)
+    );
+    assert_eq!(
+        Tissue::new(64, 64, 4.0, Shape::Flat),
+        Err(RoamError::TissueExtent)
+    );
+    assert_eq!(
+        Tissue::new(64, 64, 2.5, Shape::Cap { radius: 50.0 }),
+        Err(RoamError::CapRadius)
+    );
+    assert_eq!(Friction::new(-0.1, 0.0), Err(RoamError::Friction));
+    assert_eq!(Friction::new(0.3, f64::NAN), Err(RoamError::Friction));
+    let ok = config(Friction::NONE, Shape::Flat);
+    for (bad, err) in [
+        (RoamConfig { n: 2, ..ok }, RoamError::Window),
+        (RoamConfig { n: 65, ..ok }, RoamError::Window),
+        (
+            RoamConfig {
+                probe_radius: 2.0,
+                ..ok
+            },
+            RoamError::ProbeRadius,
+        ),
+        (
+            RoamConfig {
+                probe_radius: -1.0,
+                ..ok
+            },
+            RoamError::ProbeRadius,
+        ),
+        (
+            RoamConfig {
+                window_hysteresis: 0.0,
+                ..ok
+            },
+            RoamError::Hysteresis,
+        ),
+        (
+            RoamConfig {
+                friction: Friction {
+                    mu_s: 3.0,
+                    ..Friction::NONE
+                },
+                ..ok
+            },
+            RoamError::Friction,
+        ),
+    ] {
+        assert_eq!(RoamTwin::new(bad, law(), 0.0, 0.0).err(), Some(err));
+    }
+}
+
+mod friction_cone {
+    use super::*;
+    use mccs_host::roam::Slip;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        /// Over any sequence of goals, the proxy ends inside the cone of the state it is
+        /// in, never moves while sticking inside the static cone, moves only toward the
+        /// goal, and is the goal without friction.
+        #[test]
+        fn the_proxy_stays_in_its_cone(
+            mu in (0.0f64..1.5, 0.0f64..1.5),
+            moves in prop::collection::vec((-2.0f64..2.0, -2.0f64..2.0, 0.05f64..2.0), 1..40),
+        ) {
+            let f = Friction::new(mu.0, mu.1).unwrap();
+            let n = [0.0, 0.0, 1.0];
+            let mut slip = Slip::default();
+            let mut proxy = [0.0, 0.0, 0.0];
+            for (gx, gy, depth) in moves {
+                let goal = [gx, gy, 0.0];
+                let before = slip;
+                let r0 = ((proxy[0] - gx).powi(2) + (proxy[1] - gy).powi(2)).sqrt();
+                let next = slip.advance(&f, proxy, goal, depth, n);
+                let r = ((next[0] - gx).powi(2) + (next[1] - gy).powi(2)).sqrt();
+                if f.mu_s == 0.0 && f.mu_k == 0.0 {
+                    prop_assert_eq!(next, goal);
+                } else {
+                    let mu_now = if slip.0 { f.mu_k } else { f.mu_s };
+                    prop_assert!(r <= mu_now * depth + 1e-12, "outside the cone");
+                    prop_assert!(r <= r0 + 1e-12, "moved away from the goal");
+                    if !before.0 && r0 <= f.mu_s * depth && f.mu_k <= f.mu_s {
+                        prop_assert_eq!(next, proxy, "moved while sticking");
+                        prop_assert!(!slip.0);
+                    }
+                }
+                proxy = next;
+            }
+        }
+    }
+}
