@@ -1,10 +1,12 @@
 //! Replaying a probe trajectory against the standard patch, in the fixed-point core
 //! (`mccs::Solver`, either arithmetic) or the `f64` twin (`patch::Twin`): per tick the
 //! device force, the contact node's displacement, and the largest displacement of any
-//! node.
+//! node. Or, with a tissue, against the `f64` roaming probe (`roam::RoamTwin`): per tick
+//! the device force, the proxy, the contact's state and the window's shifts.
 
-use crate::patch::{substeps, Mesh, Twin, TwinConfig};
+use crate::patch::{substeps, Mesh, Twin, TwinConfig, V};
 use crate::reference::Reference;
+use crate::roam::{Friction, RoamConfig, RoamError, RoamTwin, Tissue};
 use crate::trajectory::Trajectory;
 use mccs::{Arith, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
 
@@ -48,6 +50,8 @@ pub enum ReplayError {
     Table(mccs::TableError),
     /// The grid or spacing.
     Topology(mccs::TopologyError),
+    /// The roaming configuration.
+    Roam(RoamError),
 }
 
 impl std::fmt::Display for ReplayError {
@@ -56,6 +60,7 @@ impl std::fmt::Display for ReplayError {
             Self::Solver(e) => e.fmt(f),
             Self::Table(e) => e.fmt(f),
             Self::Topology(e) => e.fmt(f),
+            Self::Roam(e) => e.fmt(f),
         }
     }
 }
@@ -149,6 +154,85 @@ impl Replay {
                 force,
                 contact: disp(c),
                 max_disp,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A roaming replay's tissue, friction and probe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roaming {
+    /// The tissue (its spacing is the window's).
+    pub tissue: Tissue,
+    /// Friction.
+    pub friction: Friction,
+    /// Probe radius, mm.
+    pub probe_radius: f64,
+}
+
+/// One tick of a roaming replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoamRow {
+    /// The probe sample's time, s.
+    pub time: f64,
+    /// The device force, N.
+    pub force: V,
+    /// The proxy's centre, mm (the probe out of contact).
+    pub proxy: V,
+    /// Whether the probe touches.
+    pub contact: bool,
+    /// Whether the contact slips.
+    pub slipping: bool,
+    /// Window shifts so far.
+    pub window_shifts: u32,
+}
+
+impl Replay {
+    /// Runs `traj` (tissue frame: origin at the tissue's centre, its top at z = 0)
+    /// through the `f64` roaming probe: an `grid × grid` window of `roaming.tissue`,
+    /// centred at the first sample, at the substeps the patch twin's rule gives the flat
+    /// window.
+    pub fn roam(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        roaming: &Roaming,
+        mut row: impl FnMut(RoamRow),
+    ) -> Result<(), ReplayError> {
+        let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
+        let mesh = Mesh::standard(self.grid, roaming.tissue.spacing);
+        let mut dynamics = TwinConfig::from_solver(&self.config, 0);
+        let k_max = crate::cli::reference_max_stiffness(&law);
+        let n =
+            substeps(&mesh, k_max, &dynamics).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
+        if n > self.config.max_substeps {
+            return Err(ReplayError::Solver(SolverError::TooManySubsteps {
+                needed: n,
+            }));
+        }
+        dynamics.substeps = n;
+        let cfg = RoamConfig {
+            tissue: roaming.tissue,
+            n: self.grid,
+            dynamics,
+            friction: roaming.friction,
+            probe_radius: roaming.probe_radius,
+            window_hysteresis: 0.1,
+        };
+        let mut ticks = traj.ticks(self.config.tick_hz).peekable();
+        let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
+        let mut twin = RoamTwin::new(cfg, law, start[0], start[1]).map_err(ReplayError::Roam)?;
+        for (time, p) in ticks {
+            let out = twin.step(p);
+            let contact = twin.contact();
+            row(RoamRow {
+                time,
+                force: out.force,
+                proxy: out.proxy,
+                contact: contact.is_some(),
+                slipping: contact.is_some_and(|c| c.slip.0),
+                window_shifts: twin.shifts,
             });
         }
         Ok(())

@@ -1,11 +1,12 @@
 //! `mccs replay`: a recorded probe trajectory against the standard patch, one CSV row
-//! per tick.
+//! per tick; with `--tissue`, against the `f64` roaming probe (docs/roaming.md).
 
 use super::patch_args::{config_error, PatchArgs, TuningArgs};
 use super::table::solver_table;
-use super::{file_error, io_error, CliError};
+use super::{arg_error, file_error, io_error, Backend, CliError};
 use crate::paramfile;
-use crate::replay::{Replay, ReplayError};
+use crate::replay::{Replay, ReplayError, RoamRow, Roaming};
+use crate::roam::{Friction, RoamError, Shape, Tissue};
 use crate::trajectory;
 use std::io::Write;
 use std::path::PathBuf;
@@ -23,11 +24,101 @@ pub(super) struct Args {
     patch: PatchArgs,
     #[command(flatten)]
     tuning: TuningArgs,
+    /// Roam a tissue of W,H nodes (3 … 64 each, at --spacing; --grid is the window) with
+    /// a proxy that slides on its surface; the trajectory is then in the tissue's frame
+    /// (origin at its centre, top at z = 0). The f64 reference only.
+    #[arg(long, value_name = "W,H")]
+    tissue: Option<String>,
+    /// Static and kinetic friction MU_S,MU_K (0 … 2 each; with --tissue; default 0,0).
+    #[arg(long, value_name = "MU_S,MU_K")]
+    friction: Option<String>,
+    /// Probe radius, mm (0 … spacing/2; with --tissue; default 0).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    probe_radius: Option<f64>,
+    /// Shape the tissue as a spherical cap of this radius, mm (with --tissue).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    cap_radius: Option<f64>,
+}
+
+/// `A,B` as two numbers, or an error naming `arg`.
+fn pair<T: std::str::FromStr>(arg: &str, text: &str, what: &str) -> Result<(T, T), CliError> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts.as_slice() {
+        [a, b] => match (a.parse(), b.parse()) {
+            (Ok(a), Ok(b)) => Ok((a, b)),
+            _ => Err(arg_error(arg, what)),
+        },
+        _ => Err(arg_error(arg, what)),
+    }
+}
+
+impl Args {
+    /// The roaming arguments, if `--tissue` is given; each error names its argument.
+    fn roaming(&self) -> Result<Option<Roaming>, CliError> {
+        let Some(tissue) = &self.tissue else {
+            for (given, arg) in [
+                (self.friction.is_some(), "--friction"),
+                (self.probe_radius.is_some(), "--probe-radius"),
+                (self.cap_radius.is_some(), "--cap-radius"),
+            ] {
+                if given {
+                    return Err(arg_error(arg, "only with --tissue"));
+                }
+            }
+            return Ok(None);
+        };
+        if self.patch.backend != Backend::Reference {
+            return Err(arg_error(
+                "--tissue",
+                "roaming runs on --backend reference only: the fixed-point core does not roam yet (docs/roaming.md)",
+            ));
+        }
+        let (w, h) = pair::<usize>(
+            "--tissue",
+            tissue,
+            "must be W,H: two whole numbers of nodes, 3 … 64",
+        )?;
+        let (mu_s, mu_k) = match &self.friction {
+            Some(f) => pair::<f64>("--friction", f, "must be MU_S,MU_K: two numbers, 0 … 2")?,
+            None => (0.0, 0.0),
+        };
+        let shape = match self.cap_radius {
+            Some(radius) => Shape::Cap { radius },
+            None => Shape::Flat,
+        };
+        let named = |e: RoamError| {
+            let arg = match e {
+                RoamError::TissueSize => "--tissue",
+                RoamError::Spacing | RoamError::TissueExtent => "--spacing",
+                RoamError::CapRadius => "--cap-radius",
+                RoamError::Window => "--grid",
+                RoamError::Friction => "--friction",
+                RoamError::ProbeRadius => "--probe-radius",
+                RoamError::Hysteresis => "--tissue",
+            };
+            arg_error(arg, &e.to_string())
+        };
+        let tissue = Tissue::new(w, h, self.patch.spacing, shape).map_err(named)?;
+        let friction = Friction::new(mu_s, mu_k).map_err(named)?;
+        let probe_radius = self.probe_radius.unwrap_or(0.0);
+        if !(probe_radius.is_finite() && (0.0..=tissue.spacing / 2.0).contains(&probe_radius)) {
+            return Err(named(RoamError::ProbeRadius));
+        }
+        if self.patch.grid > w.min(h) {
+            return Err(named(RoamError::Window));
+        }
+        Ok(Some(Roaming {
+            tissue,
+            friction,
+            probe_radius,
+        }))
+    }
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     a.patch.check()?;
     let cfg = a.tuning.config(a.patch.rate)?;
+    let roaming = a.roaming()?;
     let p = paramfile::read(&a.params)?;
     // The table is built (and its errors named) before the trajectory is read.
     solver_table(&p, &a.params)?;
@@ -39,6 +130,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         engine: a.patch.engine(),
     };
     let mut w = std::io::BufWriter::new(out);
+    if let Some(roaming) = roaming {
+        return roam(&replay, &p, &traj, &roaming, &mut w, &a);
+    }
     writeln!(
         w,
         "time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm"
@@ -67,6 +161,53 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         })
         .map_err(|e| match e {
             ReplayError::Solver(s) => config_error(s, &cfg),
+            other => file_error(&a.params, other),
+        })?;
+    if let Some(e) = failed {
+        return Err(io_error(e));
+    }
+    w.flush().map_err(io_error)
+}
+
+/// The roaming replay's CSV.
+fn roam(
+    replay: &Replay,
+    p: &mccs::Params,
+    traj: &trajectory::Trajectory,
+    roaming: &Roaming,
+    w: &mut impl Write,
+    a: &Args,
+) -> Result<(), CliError> {
+    writeln!(
+        w,
+        "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts"
+    )
+    .map_err(io_error)?;
+    let mut failed = None;
+    replay
+        .roam(p, traj, roaming, |r: RoamRow| {
+            if failed.is_some() {
+                return;
+            }
+            let line = format!(
+                "{},{},{},{},{},{},{},{},{},{}",
+                fmt_time(r.time),
+                r.force[0],
+                r.force[1],
+                r.force[2],
+                r.proxy[0],
+                r.proxy[1],
+                r.proxy[2],
+                r.contact as u8,
+                r.slipping as u8,
+                r.window_shifts
+            );
+            if let Err(e) = writeln!(w, "{line}") {
+                failed = Some(e);
+            }
+        })
+        .map_err(|e| match e {
+            ReplayError::Solver(s) => config_error(s, &replay.config),
             other => file_error(&a.params, other),
         })?;
     if let Some(e) = failed {
