@@ -375,3 +375,51 @@ mod friction_cone {
         }
     }
 }
+
+#[test]
+fn on_a_cap_the_window_follows_a_slide_without_a_felt_step() {
+    // Across the top of a cap (R = 160 mm) at 1 mm depth along the rest normal: the
+    // window's mesh is rebuilt at every shift (its rest geometry changes with its
+    // place); the step a shift causes stays within 2 % of the normal force.
+    let law = Reference::new(&Params::TABLE2).unwrap();
+    let cfg = config(Friction::NONE, Shape::Cap { radius: 160.0 });
+    let (from, length, depth, y) = (-12.0, 24.0, 1.0, 0.4);
+    let mut tw = RoamTwin::new(cfg, law, from, y).unwrap();
+    let at = |x: f64| {
+        let n = cfg.tissue.normal(x, y);
+        let z = cfg.tissue.height(x, y);
+        [x - depth * n[0], y - depth * n[1], z - depth * n[2]]
+    };
+    for t in 0..=1200 {
+        let p = at(from);
+        let lift = 0.5 - 1.5 * (t.min(200) as f64 / 200.0);
+        tw.step([p[0], p[1], p[2] + depth + lift]);
+    }
+    let (mut worst_step, mut worst_tangent, mut shifts) = (0.0f64, 0.0f64, 0);
+    let mut prev = None;
+    for t in 1..=(length / 10.0 * 1000.0) as usize {
+        let o = tw.step(at(from + 10.0 * t as f64 / 1000.0));
+        let (fn_, ft) = split(&o);
+        worst_tangent = worst_tangent.max(ft / fn_);
+        if let (Some(p), true) = (prev, o.shifted) {
+            let p: TickOut = p;
+            shifts += 1;
+            let d = [0, 1, 2].map(|k| o.force[k] - p.force[k]);
+            worst_step = worst_step.max(dot(d, d).sqrt() / fn_);
+        }
+        prev = Some(o);
+    }
+    println!(
+        "ROAM case=cap_slide shifts={shifts} shift_step_over_normal={worst_step:.2e} \
+         tangent_over_normal={worst_tangent:.2e}"
+    );
+    assert!(shifts >= 8, "{shifts} shifts");
+    assert!(
+        worst_step <= 0.02,
+        "a shift's step is {worst_step:.3e} of the normal force"
+    );
+    assert!(
+        worst_tangent <= 0.01,
+        "tangential / normal {worst_tangent:.3e}"
+    );
+}
