@@ -423,3 +423,17 @@ fn on_a_cap_the_window_follows_a_slide_without_a_felt_step() {
         "tangential / normal {worst_tangent:.3e}"
     );
 }
+
+#[test]
+fn a_replay_that_starts_in_contact_feels_no_start_up_kick() {
+    // The first tick has no previous probe: its velocity is zero, so the coupling's
+    // damping adds nothing (a probe starting 1 mm deep feels 1 mm of coupling at most).
+    let mut tw = twin(Friction::NONE, 0.0, 0.0);
+    let o = tw.step([0.0, 0.0, -1.0]);
+    assert!(tw.contact().is_some());
+    assert!(
+        o.force[2] > 0.0 && o.force[2] <= 1.0 + 1e-9,
+        "{:?}",
+        o.force
+    );
+}

@@ -147,7 +147,8 @@ pub struct RoamTwin {
     /// The window's first corner, tissue grid coordinates.
     corner: (usize, usize),
     contact: Option<Contact>,
-    probe_prev: V,
+    /// The last tick's probe (`None` before the first: its velocity is then zero).
+    probe_prev: Option<V>,
     out: TickOut,
     /// Window shifts so far.
     pub shifts: u32,
@@ -169,7 +170,7 @@ impl RoamTwin {
             twin: Twin::new(mesh, law, cfg.dynamics),
             corner,
             contact: None,
-            probe_prev: [x, y, 0.0],
+            probe_prev: None,
             out: TickOut::default(),
             shifts: 0,
         })
@@ -223,8 +224,9 @@ impl RoamTwin {
     /// One tick with the probe's centre at `probe` (mm, tissue frame).
     pub fn step(&mut self, probe: V) -> TickOut {
         let hz = self.cfg.dynamics.tick_hz;
-        let pv = [0, 1, 2].map(|k| (probe[k] - self.probe_prev[k]) * hz);
-        self.probe_prev = probe;
+        let prev = self.probe_prev.unwrap_or(probe);
+        let pv = [0, 1, 2].map(|k| (probe[k] - prev[k]) * hz);
+        self.probe_prev = Some(probe);
         self.update_contact(probe);
         self.out.shifted = self.follow(probe);
         for _ in 0..self.cfg.dynamics.substeps {
