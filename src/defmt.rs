@@ -1,7 +1,7 @@
 //! Every `defmt::Format` impl of the core, in one place (feature `defmt`). Each writes the
 //! same text as the type's `Display`, from the same `message()`/`reason()` strings.
 
-use crate::{ConfigKey, ParamError, ParamKey, SolverError, TableError, TopologyError};
+use crate::{ConfigKey, ParamError, ParamKey, ProxyError, SolverError, TableError, TopologyError};
 use defmt::{write, Format, Formatter};
 
 impl Format for ParamKey {
@@ -22,6 +22,12 @@ impl Format for TableError {
             Self::Param(e) => write!(f, "{}", e),
             other => write!(f, "{=str}", other.message()),
         }
+    }
+}
+
+impl Format for ProxyError {
+    fn format(&self, f: Formatter) {
+        write!(f, "{=str}", self.message())
     }
 }
 

@@ -26,6 +26,7 @@ pub mod arith;
 pub mod coupling;
 pub mod law;
 pub mod params;
+pub mod proxy;
 pub mod q;
 pub mod solver;
 pub mod state;
@@ -40,6 +41,7 @@ pub use arith::{Arith, DefaultArith, Narrow, Wide};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
+pub use proxy::{Proxy, ProxyConfig, ProxyError};
 pub use solver::{Bound, ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableBound,

@@ -267,6 +267,11 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         self.contact
     }
 
+    /// Rest position of node `i` (Q24 mm), `None` if it does not exist.
+    pub(crate) fn rest_q24(&self, i: usize) -> Option<[i32; 3]> {
+        self.rest.get(i).copied()
+    }
+
     /// Rest position of node `i` (mm), `None` if it does not exist.
     pub fn rest(&self, i: u16) -> Option<[f64; 3]> {
         self.rest.get(i as usize).map(|p| p.map(from_q24))

@@ -34,6 +34,7 @@ use crate::topology::{Topology, GROUND};
 use crate::units::{Length, Velocity};
 
 mod config;
+mod contact;
 mod error;
 mod param_set;
 pub mod stability;

@@ -10,16 +10,22 @@ use crate::units::{Force, Length, VEL_FRAC};
 
 /// How the contact node is driven.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Drive {
+pub(super) enum Drive {
     /// By the probe through the coupling.
     Probe { probe: V3, probe_vel: V3 },
     /// Held at a commanded displacement moving at a commanded velocity.
     Hold { disp: V3, vel: V3 },
+    /// By the probe through a proxy on the surface ([`crate::proxy`]).
+    Proxy {
+        probe: V3,
+        probe_vel: V3,
+        proxy: crate::proxy::Proxy,
+    },
 }
 
 /// The velocity (Q16 mm/s) of a position (Q24 mm) going from `from` to `to` in one tick
 /// at `tick_hz`, saturating.
-fn tick_velocity(from: V3, to: V3, tick_hz: i32) -> V3 {
+pub(super) fn tick_velocity(from: V3, to: V3, tick_hz: i32) -> V3 {
     const SH: u32 = crate::units::LEN_FRAC - VEL_FRAC;
     core::array::from_fn(|i| q::sat(((to[i] as i64 - from[i] as i64) * tick_hz as i64) >> SH))
 }
@@ -69,7 +75,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// One substep: spring forces, then the improved Euler update of every free node.
-    fn substep(&mut self, drive: Drive) {
+    pub(super) fn substep(&mut self, drive: Drive) {
         A::spring_forces(
             &self.table,
             &self.c.arith,
@@ -88,6 +94,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
             Drive::Hold { .. } => self.coupling_force = [0; 3],
+            Drive::Proxy {
+                probe,
+                probe_vel,
+                proxy,
+            } => self.proxy_reaction(&proxy, probe, probe_vel),
         }
         let count = self.topo.node_count().min(NODES);
         if let Some(free) = self.nodes.get_mut(1..count) {

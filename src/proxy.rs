@@ -1,0 +1,351 @@
+//! `Proxy`: a god-object contact that slides on the standard patch's surface with Coulomb
+//! friction (issue #19), in fixed point: the `f64` reference is `mccs_host::roam`
+//! (`docs/roaming.md`), whose model this follows on a flat patch that does not move.
+//!
+//! The surface is the patch's `n × n` surface nodes (outer ring fixed at rest), each
+//! cell split along its `(i, j)`–`(i+1, j+1)` diagonal. A surface point is held in grid
+//! coordinates `(u, v)` (Q16 spacings from the patch's corner), so it moves with the
+//! deformed nodes. Depth is measured along `z` (the rest normal of a flat patch).
+//!
+//! Per tick ([`Proxy::update`]): the goal is the deformed surface's point above or below
+//! the probe (found from the rest grid by a product by `1/s`, then two corrections by the
+//! deformed surface's offset: no search, no division), plus `r` up; the probe is in
+//! contact while it is below the goal. Sticking, the proxy stays while its offset across
+//! `z` is within `μ_s` times its height above the probe; past it the contact slips and
+//! the proxy moves toward the goal onto `μ_k` times that height (three passes, since the
+//! surface's height under the proxy changes it); it sticks again below the hysteresis
+//! cone `tan(0.6 atan μ_k)`. Per substep ([`Proxy::force`]): the coupling
+//! `k_c (proxy − probe)` plus its damping along `z`, held to the device maximum in
+//! magnitude, never pulling the surface up; its reaction goes onto the proxy's triangle
+//! with the proxy's weights.
+//!
+//! Formats: positions Q24 mm, velocities Q16 mm/s, forces Q20 N, grid coordinates and
+//! weights Q16, friction coefficients Q16. The only square roots are reciprocal ones by
+//! five Newton steps ([`rsqrt`]), for a slip and for a force over the device maximum.
+
+use crate::coupling::CouplingQ;
+use crate::q::{mul_wide, sat, V3};
+use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
+
+/// Fraction bits of grid coordinates and weights.
+const G_FRAC: u32 = 16;
+const ONE_G: i32 = 1 << G_FRAC;
+
+/// What a proxy is built from (start-up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProxyConfig {
+    /// The patch's side `n` (its `Topology::standard_patch` grid, 3 … 200).
+    pub grid: usize,
+    /// The patch's spacing, mm (1 … 100, within the topology's ±100 mm).
+    pub spacing: f64,
+    /// Static friction coefficient (0 … 2).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient (0 … 2).
+    pub mu_k: f64,
+    /// Probe radius, mm (0 … spacing/2).
+    pub probe_radius: f64,
+}
+
+/// Why a proxy configuration is refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProxyError {
+    /// A grid outside 3 … 200, a spacing outside 1 … 100 mm or beyond ±100 mm, or not
+    /// the solver's standard patch.
+    Grid,
+    /// A friction coefficient outside 0 … 2.
+    Friction,
+    /// A probe radius outside 0 … spacing/2.
+    ProbeRadius,
+}
+
+impl ProxyError {
+    /// The message: one source for `Display` and the `defmt` impl.
+    pub const fn message(&self) -> &'static str {
+        match self {
+            Self::Grid => "proxy: not this solver's standard patch, or a grid outside 3..=200 with a spacing of 1 … 100 mm within ±100 mm",
+            Self::Friction => "proxy: mu_s and mu_k must be within [0, 2]",
+            Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
+        }
+    }
+}
+
+impl core::fmt::Display for ProxyError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+impl core::error::Error for ProxyError {}
+
+/// A proxy: its configuration in fixed point and its state (where it is on the surface,
+/// and whether it slips).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Proxy {
+    n: i32,
+    /// Spacing, Q24 mm.
+    spacing: i32,
+    /// `1/s`, Q30 per mm.
+    inv_s: i32,
+    /// `μ_s`, `μ_k` and the hysteresis cone `tan(0.6 atan μ_k)`, Q16.
+    mu_s: i32,
+    mu_k: i32,
+    mu_h: i32,
+    /// Probe radius, Q24 mm.
+    radius: i32,
+    /// The proxy's grid coordinates, when in contact.
+    at: Option<[i32; 2]>,
+    slipping: bool,
+}
+
+/// Surface node `(a, b)`'s current position (Q24 mm), as the solver gives it.
+pub(crate) trait Surface {
+    /// Position of surface node `(a, b)`, `a, b < n`.
+    fn position(&self, a: usize, b: usize) -> V3;
+    /// Velocity of surface node `(a, b)` (Q16 mm/s).
+    fn velocity(&self, a: usize, b: usize) -> V3;
+}
+
+impl Proxy {
+    /// A proxy out of contact.
+    pub fn new(c: &ProxyConfig) -> Result<Proxy, ProxyError> {
+        let half = (c.grid / 2) as f64 * c.spacing;
+        if !(3..=200).contains(&c.grid)
+            || !c.spacing.is_finite()
+            || !(1.0..=100.0).contains(&c.spacing)
+            || half > 100.0
+        {
+            return Err(ProxyError::Grid);
+        }
+        let ok = |m: f64| m.is_finite() && (0.0..=2.0).contains(&m);
+        if !ok(c.mu_s) || !ok(c.mu_k) {
+            return Err(ProxyError::Friction);
+        }
+        let r = c.probe_radius;
+        if !(r.is_finite() && (0.0..=c.spacing / 2.0).contains(&r)) {
+            return Err(ProxyError::ProbeRadius);
+        }
+        let mu_h = if c.mu_k > c.mu_s {
+            0.0
+        } else {
+            libm::tan(0.6 * libm::atan(c.mu_k))
+        };
+        Ok(Proxy {
+            n: c.grid as i32,
+            spacing: from_f64(c.spacing, LEN_FRAC),
+            inv_s: from_f64(1.0 / c.spacing, 30),
+            mu_s: from_f64(c.mu_s, G_FRAC),
+            mu_k: from_f64(c.mu_k, G_FRAC),
+            mu_h: from_f64(mu_h, G_FRAC),
+            radius: from_f64(r, LEN_FRAC),
+            at: None,
+            slipping: false,
+        })
+    }
+
+    /// The proxy's grid coordinates (Q16 spacings from the patch's corner), when in
+    /// contact.
+    pub fn grid_position(&self) -> Option<[i32; 2]> {
+        self.at
+    }
+
+    /// The grid's side `n` and spacing (Q24 mm).
+    pub fn grid(&self) -> (usize, i32) {
+        (self.n as usize, self.spacing)
+    }
+
+    /// Whether the contact slips.
+    pub fn slipping(&self) -> bool {
+        self.at.is_some() && self.slipping
+    }
+
+    /// Out of contact.
+    pub fn release(&mut self) {
+        self.at = None;
+        self.slipping = false;
+    }
+
+    /// The triangle holding grid point `g` (clamped to the patch) and its weights (Q16).
+    fn triangle(&self, g: [i32; 2]) -> ([(usize, usize); 3], [i32; 3]) {
+        let top = (self.n - 1) << G_FRAC;
+        let (u, v) = (g[0].max(0).min(top), g[1].max(0).min(top));
+        let (i, j) = ((u >> G_FRAC).min(self.n - 2), (v >> G_FRAC).min(self.n - 2));
+        let (fu, fv) = (u - (i << G_FRAC), v - (j << G_FRAC));
+        let (i, j) = (i as usize, j as usize);
+        if fv > fu {
+            (
+                [(i, j), (i + 1, j + 1), (i, j + 1)],
+                [ONE_G - fv, fu, fv - fu],
+            )
+        } else {
+            (
+                [(i, j), (i + 1, j), (i + 1, j + 1)],
+                [ONE_G - fu, fu - fv, fv],
+            )
+        }
+    }
+
+    /// `Σ w_k x_k` for the triangle's corners' values `x` (Q24 or Q16 per the values).
+    fn blend(w: [i32; 3], x: [V3; 3]) -> V3 {
+        core::array::from_fn(
+            |d| sat((0..3).map(|k| mul_wide(w[k], x[k][d])).sum::<i64>() >> G_FRAC),
+        )
+    }
+
+    /// The deformed surface's point at grid `g`.
+    fn point(&self, s: &impl Surface, g: [i32; 2]) -> V3 {
+        let (c, w) = self.triangle(g);
+        Self::blend(w, c.map(|(a, b)| s.position(a, b)))
+    }
+
+    /// Grid coordinates of patch-frame `(x, y)` on the rest grid (Q16).
+    fn rest_grid(&self, x: i32, y: i32) -> [i32; 2] {
+        // Q24 mm · Q30 /mm = Q54 → Q16: >> 38; the patch's corner is n/2 spacings away.
+        let c = (self.n / 2) << G_FRAC;
+        [x, y].map(|p| sat((mul_wide(p, self.inv_s) >> 38) + c as i64))
+    }
+
+    /// The deformed surface's point above or below patch-frame `(x, y)`: from the rest
+    /// grid, two corrections by the surface's offset there (nodes move sideways far less
+    /// than a spacing).
+    fn locate(&self, s: &impl Surface, x: i32, y: i32) -> [i32; 2] {
+        let mut g = self.rest_grid(x, y);
+        for _ in 0..2 {
+            let p = self.point(s, g);
+            let d = self.rest_grid(x.saturating_sub(p[0]), y.saturating_sub(p[1]));
+            let c = (self.n / 2) << G_FRAC;
+            g = [g[0].saturating_add(d[0] - c), g[1].saturating_add(d[1] - c)];
+        }
+        let top = (self.n - 1) << G_FRAC;
+        g.map(|x| x.max(0).min(top))
+    }
+
+    /// The proxy's centre for grid `g`: the surface point plus `r` up.
+    fn centre(&self, s: &impl Surface, g: [i32; 2]) -> V3 {
+        let p = self.point(s, g);
+        [p[0], p[1], p[2].saturating_add(self.radius)]
+    }
+
+    /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame).
+    pub(crate) fn update(&mut self, s: &impl Surface, probe: V3) {
+        let goal_g = self.locate(s, probe[0], probe[1]);
+        let goal = self.centre(s, goal_g);
+        if goal[2] <= probe[2] {
+            self.release();
+            return;
+        }
+        let Some(mut at) = self.at else {
+            self.at = Some(goal_g);
+            self.slipping = false;
+            return;
+        };
+        let frictionless = self.mu_s == 0 && self.mu_k == 0;
+        if frictionless {
+            self.at = Some(goal_g);
+            self.slipping = true;
+            return;
+        }
+        for pass in 0..3 {
+            let proxy = self.centre(s, at);
+            let depth = proxy[2].saturating_sub(probe[2]).max(0);
+            // The offset across z, and the cones, in Q20 (squares within i64).
+            let t = [
+                proxy[0].saturating_sub(goal[0]) >> 4,
+                proxy[1].saturating_sub(goal[1]) >> 4,
+            ];
+            let t2 = mul_wide(t[0], t[0]) + mul_wide(t[1], t[1]);
+            let cone = |mu: i32| {
+                let r = sat(mul_wide(depth >> 4, mu) >> G_FRAC);
+                (r, mul_wide(r, r))
+            };
+            if pass == 0 {
+                self.slipping = if self.mu_k > self.mu_s {
+                    true
+                } else if self.slipping {
+                    t2 >= cone(self.mu_h).1
+                } else {
+                    t2 > cone(self.mu_s).1
+                };
+            }
+            let (radius, radius2) = cone(if self.slipping { self.mu_k } else { self.mu_s });
+            if t2 <= radius2 {
+                break;
+            }
+            // On the cone: goal + t · radius/|t|, the ratio by a reciprocal square root.
+            let lambda = scale_to(radius, t2);
+            let next = [0, 1].map(|k| {
+                let off = proxy[k].saturating_sub(goal[k]);
+                goal[k].saturating_add(sat(mul_wide(off, lambda) >> G_FRAC))
+            });
+            at = self.locate(s, next[0], next[1]);
+            if !self.slipping {
+                break;
+            }
+        }
+        self.at = Some(at);
+    }
+
+    /// The device's force (Q20 N) in one substep, with the probe at `probe` moving at
+    /// `probe_vel` (Q16 mm/s), and the proxy's triangle with its weights to put the
+    /// reaction (minus the force) on; zero out of contact.
+    pub(crate) fn force(
+        &self,
+        s: &impl Surface,
+        coupling: &CouplingQ,
+        probe: V3,
+        probe_vel: V3,
+    ) -> (V3, [(usize, usize); 3], [i32; 3]) {
+        let Some(g) = self.at else {
+            return ([0; 3], [(0, 0); 3], [0; 3]);
+        };
+        let (corners, w) = self.triangle(g);
+        let p = Self::blend(w, corners.map(|(a, b)| s.position(a, b)));
+        let pv = Self::blend(w, corners.map(|(a, b)| s.velocity(a, b)));
+        let proxy = [p[0], p[1], p[2].saturating_add(self.radius)];
+        // Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after >> 20.
+        const SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
+        const _: () = assert!(VEL_FRAC + 24 - FORCE_FRAC == SH);
+        let mut f: V3 = core::array::from_fn(|k| {
+            sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> SH)
+        });
+        let closing = pv[2].saturating_sub(probe_vel[2]);
+        f[2] = f[2].saturating_add(sat(mul_wide(closing, coupling.damping) >> SH));
+        if f[2] < 0 {
+            return ([0; 3], corners, w);
+        }
+        // Held to the device maximum in magnitude (Q12 for the squares).
+        let f2: i64 = f.iter().map(|&x| mul_wide(x >> 8, x >> 8)).sum();
+        let max = coupling.max_force;
+        if f2 > mul_wide(max >> 8, max >> 8) {
+            let lambda = scale_to(max >> 8, f2);
+            f = f.map(|x| sat(mul_wide(x, lambda) >> G_FRAC));
+        }
+        (f, corners, w)
+    }
+}
+
+/// `r / √x` in Q16 for `0 < r` and `r² < x` (a value below 1): `x` a square in the
+/// square of `r`'s format. Five Newton steps for `1/√M`, `M ∈ [¼, 1)` the normalised
+/// `x`, from a linear first guess (error below 25 %): better than 1e-9.
+fn scale_to(r: i32, x: i64) -> i32 {
+    let y = rsqrt(x);
+    // r/√x = r · y · 2^(e/2 − 62), y Q30: in Q16, r · y >> (46 − e/2) (e is even).
+    let (y, e) = y;
+    let sh = 46 - (e >> 1);
+    sat((r.max(0) as i64 * y) >> sh).min(ONE_G)
+}
+
+/// `1/√x` for `x > 0` as `(y, e)`: `1/√x = y · 2^(e/2 − 62)`, `y` in Q30 within (1, 2].
+fn rsqrt(x: i64) -> (i64, u32) {
+    let x = x.max(1) as u64;
+    let e = x.leading_zeros() & !1;
+    let m = x << e; // [2^62, 2^64): M = m / 2^64 ∈ [¼, 1).
+    let m30 = (m >> 34) as i64; // M in Q30.
+                                // First guess 2.5 − 1.5 M (Q30), then y ← y (3 − M y²)/2.
+    let mut y = (5i64 << 29) - ((3 * m30) >> 1);
+    for _ in 0..5 {
+        let y2 = (y * y) >> 30;
+        let my2 = (m30 * y2) >> 30;
+        y = (y * ((3i64 << 30) - my2)) >> 31;
+    }
+    (y, e)
+}

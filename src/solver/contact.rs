@@ -1,0 +1,117 @@
+//! The solver driven through a [`Proxy`] on its surface (issue #19): the standard patch's
+//! surface nodes as the proxy sees them, and the tick.
+
+use super::step::{tick_velocity, Drive};
+use super::Solver;
+use crate::arith::Arith;
+use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
+use crate::q::{mul_wide, sat, V3};
+use crate::units::{from_f64, Force, Length, LEN_FRAC};
+
+/// The standard patch's surface as a proxy reads it: node `(a, b)` of the `n × n` grid,
+/// the outer ring at rest.
+struct View<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
+    solver: &'a Solver<NODES, EDGES, S, A>,
+    n: usize,
+    /// Spacing, Q24 mm.
+    spacing: i32,
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
+    View<'_, NODES, EDGES, S, A>
+{
+    /// The node of surface point `(a, b)`, `None` on the ring.
+    fn node(&self, a: usize, b: usize) -> Option<usize> {
+        let n = self.n;
+        (a >= 1 && b >= 1 && a + 1 < n && b + 1 < n).then(|| 1 + (a - 1) * (n - 2) + (b - 1))
+    }
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
+    for View<'_, NODES, EDGES, S, A>
+{
+    fn position(&self, a: usize, b: usize) -> V3 {
+        let c = (self.n / 2) as i32;
+        let ring = [
+            (a as i32 - c).saturating_mul(self.spacing),
+            (b as i32 - c).saturating_mul(self.spacing),
+            0,
+        ];
+        match self.node(a, b) {
+            Some(i) => {
+                let rest = self.solver.topo.rest_q24(i).unwrap_or(ring);
+                let u = self.solver.node_disp(i);
+                core::array::from_fn(|k| rest[k].saturating_add(u[k]))
+            }
+            None => ring,
+        }
+    }
+
+    fn velocity(&self, a: usize, b: usize) -> V3 {
+        self.node(a, b).map_or([0; 3], |i| self.solver.node_vel(i))
+    }
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
+    /// A proxy for this solver's patch, which must be the standard patch of `config`'s grid
+    /// and spacing (its node count and its first free node's rest position are checked).
+    pub fn proxy(&self, config: &ProxyConfig) -> Result<Proxy, ProxyError> {
+        let proxy = Proxy::new(config)?;
+        let n = config.grid;
+        let c = (n / 2) as f64;
+        let first = [(1.0 - c) * config.spacing, (1.0 - c) * config.spacing, 0.0];
+        let matches = self.topo.node_count() == (n - 2) * (n - 2) + 1
+            && self.topo.rest_q24(1) == Some(first.map(|x| from_f64(x, LEN_FRAC)));
+        if matches {
+            Ok(proxy)
+        } else {
+            Err(ProxyError::Grid)
+        }
+    }
+
+    fn view(&self, proxy: &Proxy) -> View<'_, NODES, EDGES, S, A> {
+        let (n, spacing) = proxy.grid();
+        View {
+            solver: self,
+            n,
+            spacing,
+        }
+    }
+
+    /// One haptic tick with the probe at `probe` (mm, patch frame) touching the surface
+    /// through `proxy` (from [`Solver::proxy`]): the proxy's contact and friction once,
+    /// then the substeps with the coupling between probe and proxy. Returns the force the
+    /// device must render (N, held to the coupling's maximum in magnitude).
+    pub fn step_proxy(&mut self, probe: [Length; 3], proxy: &mut Proxy) -> [Force; 3] {
+        let p = probe.map(Length::to_bits);
+        let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
+        self.probe_prev = p;
+        proxy.update(&self.view(proxy), p);
+        for _ in 0..self.substeps {
+            self.substep(Drive::Proxy {
+                probe: p,
+                probe_vel,
+                proxy: *proxy,
+            });
+        }
+        self.coupling_force
+            .map(|f| Force::from_bits(f.saturating_neg()))
+    }
+
+    /// The proxy's coupling in one substep: its reaction onto the proxy's triangle (free
+    /// nodes only), and the force on the tissue kept as the coupling force.
+    pub(super) fn proxy_reaction(&mut self, proxy: &Proxy, probe: V3, probe_vel: V3) {
+        let view = self.view(proxy);
+        let (f, corners, w) = proxy.force(&view, &self.c.coupling, probe, probe_vel);
+        let nodes = corners.map(|(a, b)| view.node(a, b));
+        for (node, w) in nodes.into_iter().zip(w) {
+            if let Some(n) = node.and_then(|i| self.nodes.get_mut(i)) {
+                for k in 0..3 {
+                    let share = sat(mul_wide(w, f[k]) >> 16);
+                    n.f[k] = n.f[k].saturating_sub(share);
+                }
+            }
+        }
+        self.coupling_force = f.map(i32::saturating_neg);
+    }
+}
