@@ -4,7 +4,9 @@
 
 use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
-use mccs::{Arith, DefaultArith, Edge, Force, ForceTable64, Length, Solver, Stiffness, Strain};
+use mccs::{
+    Arith, DefaultArith, Edge, Force, ForceTable64, Length, Proxy, Solver, Stiffness, Strain,
+};
 
 /// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
 #[inline(never)]
@@ -45,4 +47,14 @@ pub fn tick<const N: usize, const E: usize>(
     probe: [Length; 3],
 ) -> [Force; 3] {
     solver.step(probe)
+}
+
+/// One tick of a solver through a proxy on its surface, never inlined.
+#[inline(never)]
+pub fn tick_proxy<const N: usize, const E: usize>(
+    solver: &mut Solver<N, E, 64>,
+    probe: [Length; 3],
+    proxy: &mut Proxy,
+) -> [Force; 3] {
+    solver.step_proxy(probe, proxy)
 }

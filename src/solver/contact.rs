@@ -1,7 +1,7 @@
 //! The solver driven through a [`Proxy`] on its surface (issue #19): the standard patch's
 //! surface nodes as the proxy sees them, and the tick.
 
-use super::step::{tick_velocity, Drive};
+use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
@@ -88,11 +88,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.probe_prev = p;
         proxy.update(&self.view(proxy), p);
         for _ in 0..self.substeps {
-            self.substep(Drive::Proxy {
-                probe: p,
-                probe_vel,
-                proxy: *proxy,
-            });
+            self.spring_forces();
+            self.proxy_reaction(proxy, p, probe_vel);
+            self.integrate_free();
         }
         self.coupling_force
             .map(|f| Force::from_bits(f.saturating_neg()))
@@ -100,7 +98,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 
     /// The proxy's coupling in one substep: its reaction onto the proxy's triangle (free
     /// nodes only), and the force on the tissue kept as the coupling force.
-    pub(super) fn proxy_reaction(&mut self, proxy: &Proxy, probe: V3, probe_vel: V3) {
+    fn proxy_reaction(&mut self, proxy: &Proxy, probe: V3, probe_vel: V3) {
         let view = self.view(proxy);
         let (f, corners, w) = proxy.force(&view, &self.c.coupling, probe, probe_vel);
         let nodes = corners.map(|(a, b)| view.node(a, b));

@@ -10,17 +10,11 @@ use crate::units::{Force, Length, VEL_FRAC};
 
 /// How the contact node is driven.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Drive {
+enum Drive {
     /// By the probe through the coupling.
     Probe { probe: V3, probe_vel: V3 },
     /// Held at a commanded displacement moving at a commanded velocity.
     Hold { disp: V3, vel: V3 },
-    /// By the probe through a proxy on the surface ([`crate::proxy`]).
-    Proxy {
-        probe: V3,
-        probe_vel: V3,
-        proxy: crate::proxy::Proxy,
-    },
 }
 
 /// The velocity (Q16 mm/s) of a position (Q24 mm) going from `from` to `to` in one tick
@@ -74,8 +68,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         });
     }
 
-    /// One substep: spring forces, then the improved Euler update of every free node.
-    pub(super) fn substep(&mut self, drive: Drive) {
+    /// Every spring's force into the nodes' accumulators.
+    #[inline(always)]
+    pub(super) fn spring_forces(&mut self) {
         A::spring_forces(
             &self.table,
             &self.c.arith,
@@ -83,6 +78,20 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             &mut self.warm,
             &mut self.nodes,
         );
+    }
+
+    /// The improved Euler update of every free node (which clears the accumulators).
+    #[inline(always)]
+    pub(super) fn integrate_free(&mut self) {
+        let count = self.topo.node_count().min(NODES);
+        if let Some(free) = self.nodes.get_mut(1..count) {
+            A::integrate(&self.c.arith, free);
+        }
+    }
+
+    /// One substep: spring forces, then the improved Euler update of every free node.
+    fn substep(&mut self, drive: Drive) {
+        self.spring_forces();
         let c = self.contact;
         self.reaction = self.nodes.get(c).map_or([0; 3], |n| n.f);
         match drive {
@@ -94,16 +103,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
             Drive::Hold { .. } => self.coupling_force = [0; 3],
-            Drive::Proxy {
-                probe,
-                probe_vel,
-                proxy,
-            } => self.proxy_reaction(&proxy, probe, probe_vel),
         }
-        let count = self.topo.node_count().min(NODES);
-        if let Some(free) = self.nodes.get_mut(1..count) {
-            A::integrate(&self.c.arith, free);
-        }
+        self.integrate_free();
         if let Drive::Hold { disp, vel } = drive {
             let v = vel.map(|x| self.stored_velocity(x.clamp(-VEL_LIMIT, VEL_LIMIT - 1)));
             if let Some(n) = self.nodes.get_mut(c) {

@@ -1,5 +1,6 @@
 //! The measured cases: one table evaluation, one spring, one substep of the standard
-//! patch (fixed point and floating point), and one tick of this core's demo.
+//! patch (fixed point and floating point), one tick of this core's demo, and one tick of
+//! the N = 5 patch through a sliding proxy.
 
 use super::fw_common::exit;
 use super::harness::Harness;
@@ -7,7 +8,8 @@ use core::hint::black_box;
 use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
 use mccs::{
-    Arith, DefaultArith, Edge, ForceTable64, Length, Solver, SolverConfig, Strain, Topology,
+    Arith, DefaultArith, Edge, ForceTable64, Length, ProxyConfig, Solver, SolverConfig, Strain,
+    Topology,
 };
 use mccs_firmware::demo;
 use mccs_firmware::entry as e;
@@ -206,5 +208,45 @@ fn tick_in<const N: usize, const E: usize>(
     }
     h.measure(4, || {
         black_box(e::tick(&mut s, black_box(probe)));
+    })
+}
+
+/// One tick of the standard N = 5 patch (2.5 mm, default configuration) through a proxy
+/// with friction (μ_s 0.6, μ_k 0.4), 0.5 mm deep and sliding along x at 10 mm/s (the
+/// contact slipping), after 200 ticks of it; averaged over 4.
+#[inline(never)]
+pub fn tick_proxy(h: &Harness, table: &ForceTable64) -> u32 {
+    let Ok(topo) = Topology::<10, 61>::standard_patch(5, 2.5) else {
+        exit(false)
+    };
+    let Ok(mut s) = Solver::new(topo, *table, &SolverConfig::default()) else {
+        exit(false)
+    };
+    let cfg = ProxyConfig {
+        grid: 5,
+        spacing: 2.5,
+        mu_s: 0.6,
+        mu_k: 0.4,
+        probe_radius: 0.0,
+    };
+    let Ok(mut proxy) = s.proxy(&cfg) else {
+        exit(false)
+    };
+    let (step, z) = (Length::from_num(0.01), Length::from_num(-0.5));
+    let mut x = Length::from_num(-1.0);
+    for _ in 0..200 {
+        x += step;
+        e::tick_proxy(&mut s, [x, Length::ZERO, z], &mut proxy);
+    }
+    if !proxy.slipping() {
+        exit(false)
+    }
+    h.measure(4, || {
+        x += step;
+        black_box(e::tick_proxy(
+            &mut s,
+            black_box([x, Length::ZERO, z]),
+            &mut proxy,
+        ));
     })
 }
