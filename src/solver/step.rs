@@ -68,9 +68,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         });
     }
 
-    /// Every spring's force into the nodes' accumulators.
-    #[inline(always)]
-    pub(super) fn spring_forces(&mut self) {
+    /// One substep: spring forces, then the improved Euler update of every free node.
+    fn substep(&mut self, drive: Drive) {
         A::spring_forces(
             &self.table,
             &self.c.arith,
@@ -78,20 +77,6 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             &mut self.warm,
             &mut self.nodes,
         );
-    }
-
-    /// The improved Euler update of every free node (which clears the accumulators).
-    #[inline(always)]
-    pub(super) fn integrate_free(&mut self) {
-        let count = self.topo.node_count().min(NODES);
-        if let Some(free) = self.nodes.get_mut(1..count) {
-            A::integrate(&self.c.arith, free);
-        }
-    }
-
-    /// One substep: spring forces, then the improved Euler update of every free node.
-    fn substep(&mut self, drive: Drive) {
-        self.spring_forces();
         let c = self.contact;
         self.reaction = self.nodes.get(c).map_or([0; 3], |n| n.f);
         match drive {
@@ -104,7 +89,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             }
             Drive::Hold { .. } => self.coupling_force = [0; 3],
         }
-        self.integrate_free();
+        let count = self.topo.node_count().min(NODES);
+        if let Some(free) = self.nodes.get_mut(1..count) {
+            A::integrate(&self.c.arith, free);
+        }
         if let Drive::Hold { disp, vel } = drive {
             let v = vel.map(|x| self.stored_velocity(x.clamp(-VEL_LIMIT, VEL_LIMIT - 1)));
             if let Some(n) = self.nodes.get_mut(c) {
