@@ -33,6 +33,7 @@ pub mod state;
 pub mod table;
 pub mod topology;
 pub mod units;
+pub mod window;
 
 #[cfg(feature = "defmt")]
 mod defmt;
@@ -49,3 +50,4 @@ pub use table::{
 };
 pub use topology::{Edge, End, Topology, TopologyError, GROUND};
 pub use units::{Force, Length, Stiffness, Strain, Velocity};
+pub use window::{Window, WindowConfig};

@@ -56,6 +56,9 @@ pub enum ProxyError {
     Friction,
     /// A probe radius outside 0 … spacing/2.
     ProbeRadius,
+    /// A tissue smaller than the patch, larger than 64 nodes a side or beyond ±100 mm, or
+    /// a window hysteresis outside 0.05 … 0.45 spacings.
+    Window,
 }
 
 impl ProxyError {
@@ -65,6 +68,7 @@ impl ProxyError {
             Self::Grid => "proxy: not this solver's standard patch, or a grid outside 3..=200 with a spacing of 1 … 100 mm within ±100 mm",
             Self::Friction => "proxy: mu_s and mu_k must be within [0, 2]",
             Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
+            Self::Window => "window: the tissue must be n..=64 nodes a side within ±100 mm, the hysteresis 0.05 … 0.45",
         }
     }
 }
@@ -156,6 +160,21 @@ impl Proxy {
     /// Whether the contact slips.
     pub fn slipping(&self) -> bool {
         self.at.is_some() && self.slipping
+    }
+
+    /// The rest grid's coordinates of patch-frame point `p` (Q16): where the probe is when
+    /// out of contact.
+    pub(crate) fn grid_of(&self, p: V3) -> [i32; 2] {
+        self.rest_grid(p[0], p[1])
+    }
+
+    /// The proxy's place after the patch moved by `d` nodes over the tissue.
+    pub(crate) fn shift_grid(&mut self, d: [i32; 2]) {
+        if let Some(g) = self.at.as_mut() {
+            for k in 0..2 {
+                g[k] = g[k].saturating_sub(d[k] << G_FRAC);
+            }
+        }
     }
 
     /// Out of contact.

@@ -185,6 +185,38 @@ mod robust {
         }
     }
 
+    /// The same on a 64 × 64 tissue, the window following: it stays on the tissue.
+    fn roam<A: Arith>(mu: (f64, f64), probes: &[(f64, f64, f64)]) {
+        let mut s = fixed::<A>();
+        let cfg = ProxyConfig {
+            grid: N,
+            spacing: SPACING,
+            mu_s: mu.0,
+            mu_k: mu.1,
+            probe_radius: 0.0,
+        };
+        let mut proxy = s.proxy(&cfg).unwrap();
+        let wc = mccs::WindowConfig {
+            tissue_w: 64,
+            tissue_h: 64,
+            hysteresis: 0.1,
+        };
+        let mut window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
+        let max = SolverConfig::default().coupling.max_force;
+        for &(x, y, z) in probes {
+            let f = s.step_roaming([x, y, z].map(Length::from_num), &mut proxy, &mut window);
+            let f = f.map(|c| c.to_num::<f64>());
+            let mag = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+            assert!(
+                mag <= max * (1.0 + 1e-4),
+                "{mag} N over the maximum at {x},{y},{z}"
+            );
+            assert!(f[2] >= 0.0, "pulled into the tissue: {f:?}");
+            let (i, j) = window.centre();
+            assert!((N / 2..64 - N / 2).contains(&i) && (N / 2..64 - N / 2).contains(&j));
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
         /// Any probe path, from anywhere within ±100 mm in jumps of any size: no panic
@@ -204,6 +236,138 @@ mod robust {
         ) {
             run::<Wide>(mu, radius, &probes);
             run::<Narrow>(mu, radius, &probes);
+            roam::<Wide>(mu, &probes);
+            roam::<Narrow>(mu, &probes);
+        }
+    }
+}
+
+mod roaming {
+    use super::*;
+    use mccs::WindowConfig;
+
+    /// From 1.5 mm above (−15, 0.4), press to 1 mm over 0.2 s, hold 0.3 s, slide 30 mm
+    /// along x at 10 mm/s, then 5 mm along y, lift.
+    fn path(t: usize) -> V {
+        let s = t as f64 / 1000.0;
+        let z = if s < 0.2 {
+            1.5 - 2.5 * s / 0.2
+        } else if s < 4.0 {
+            -1.0
+        } else {
+            -1.0 + (s - 4.0) * 10.0
+        };
+        let x = -15.0 + ((s - 0.5).max(0.0) * 10.0).min(30.0);
+        let y = 0.4 + ((s - 3.5).max(0.0) * 10.0).min(5.0);
+        [x, y, z]
+    }
+
+    fn compare<A: Arith>(mu: (f64, f64)) -> (f64, u32) {
+        let mut s = fixed::<A>();
+        let config = ProxyConfig {
+            grid: N,
+            spacing: SPACING,
+            mu_s: mu.0,
+            mu_k: mu.1,
+            probe_radius: 0.0,
+        };
+        let mut proxy = s.proxy(&config).unwrap();
+        let wc = WindowConfig {
+            tissue_w: 64,
+            tissue_h: 64,
+            hysteresis: 0.1,
+        };
+        let start = path(0);
+        let mut window = s.window(&wc, &proxy, start[0], start[1]).unwrap();
+        let cfg = RoamConfig {
+            tissue: Tissue::new(64, 64, SPACING, Shape::Flat).unwrap(),
+            n: N,
+            dynamics: TwinConfig::from_solver(&SolverConfig::default(), s.substeps()),
+            friction: Friction::new(mu.0, mu.1).unwrap(),
+            probe_radius: 0.0,
+            window_hysteresis: 0.1,
+        };
+        let law = Reference::new(&Params::TABLE2).unwrap();
+        let mut tw = RoamTwin::new(cfg, law, start[0], start[1]).unwrap();
+        assert_eq!(window.centre(), tw.centre());
+        let mut worst = 0.0f64;
+        for t in 0..4200 {
+            let p = path(t);
+            let got = s.step_roaming(p.map(Length::from_num), &mut proxy, &mut window);
+            let want = tw.step(p).force;
+            let got = got.map(|f| f.to_num::<f64>());
+            let mag = (want[0].powi(2) + want[1].powi(2) + want[2].powi(2)).sqrt();
+            let diff = (0..3)
+                .map(|k| (got[k] - want[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(
+                diff < 0.02 + 0.03 * mag,
+                "tick {t}: {got:?} against {want:?}"
+            );
+            assert_eq!(window.centre(), tw.centre(), "tick {t}: the windows differ");
+            if mag > 0.05 {
+                worst = worst.max(diff / mag);
+            }
+        }
+        assert_eq!(window.shifts(), tw.shifts);
+        (worst, window.shifts())
+    }
+
+    #[test]
+    fn the_fixed_window_follows_the_twin() {
+        // Frictionless the two agree within 2e-3 (5e-3 if the springs' warm-start values
+        // were not carried across a shift: the bound holds the window's maps to account).
+        for (name, mu, bound) in [
+            ("frictionless", (0.0, 0.0), 0.002),
+            ("friction", (0.6, 0.4), 0.01),
+        ] {
+            let (wide, shifts) = compare::<Wide>(mu);
+            let (narrow, _) = compare::<Narrow>(mu);
+            println!(
+                "ROAMFIXED case={name} wide_rel={wide:.2e} narrow_rel={narrow:.2e} shifts={shifts}"
+            );
+            assert!(shifts >= 12, "{name}: {shifts} shifts");
+            assert!(wide <= bound, "{name}: wide off by {wide:.3e}");
+            assert!(narrow <= 2.0 * bound, "{name}: narrow off by {narrow:.3e}");
+        }
+    }
+
+    #[test]
+    fn a_window_that_does_not_fit_is_refused() {
+        let s = fixed::<Wide>();
+        let proxy = s
+            .proxy(&ProxyConfig {
+                grid: N,
+                spacing: SPACING,
+                mu_s: 0.0,
+                mu_k: 0.0,
+                probe_radius: 0.0,
+            })
+            .unwrap();
+        let ok = WindowConfig {
+            tissue_w: 64,
+            tissue_h: 64,
+            hysteresis: 0.1,
+        };
+        assert!(s.window(&ok, &proxy, 0.0, 0.0).is_ok());
+        for bad in [
+            WindowConfig { tissue_w: 4, ..ok },
+            WindowConfig { tissue_h: 65, ..ok },
+            WindowConfig {
+                hysteresis: 0.5,
+                ..ok
+            },
+            WindowConfig {
+                hysteresis: f64::NAN,
+                ..ok
+            },
+        ] {
+            assert_eq!(
+                s.window(&bad, &proxy, 0.0, 0.0).err(),
+                Some(ProxyError::Window),
+                "{bad:?}"
+            );
         }
     }
 }

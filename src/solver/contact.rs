@@ -10,7 +10,7 @@ use crate::units::{from_f64, Force, Length, LEN_FRAC};
 
 /// The standard patch's surface as a proxy reads it: node `(a, b)` of the `n × n` grid,
 /// the outer ring at rest.
-struct View<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
+pub(super) struct View<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
     solver: &'a Solver<NODES, EDGES, S, A>,
     n: usize,
     /// Spacing, Q24 mm.
@@ -69,7 +69,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
-    fn view(&self, proxy: &Proxy) -> View<'_, NODES, EDGES, S, A> {
+    pub(super) fn view(&self, proxy: &Proxy) -> View<'_, NODES, EDGES, S, A> {
         let (n, spacing) = proxy.grid();
         View {
             solver: self,
@@ -87,6 +87,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
         proxy.update(&self.view(proxy), p);
+        self.proxy_substeps(p, probe_vel, proxy);
+        self.coupling_force
+            .map(|f| Force::from_bits(f.saturating_neg()))
+    }
+
+    /// The tick's substeps with the probe at `p` (Q24 mm, patch frame) moving at
+    /// `probe_vel` (Q16 mm/s), coupled to `proxy`.
+    pub(super) fn proxy_substeps(&mut self, p: V3, probe_vel: V3, proxy: &Proxy) {
         // The glued substep's two calls, written out again: shared through helpers they
         // changed the glued path's compiled code (the M3's N = 7 substep by 4 %).
         let count = self.topo.node_count().min(NODES);
@@ -103,8 +111,6 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 A::integrate(&self.c.arith, free);
             }
         }
-        self.coupling_force
-            .map(|f| Force::from_bits(f.saturating_neg()))
     }
 
     /// The proxy's coupling in one substep: its reaction onto the proxy's triangle (free

@@ -37,6 +37,7 @@ mod config;
 mod contact;
 mod error;
 mod param_set;
+mod roaming;
 pub mod stability;
 mod step;
 

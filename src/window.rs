@@ -1,0 +1,93 @@
+//! `Window`: the standard patch as a window onto a larger flat tissue that follows the
+//! contact (issue #19; the `f64` reference is `mccs_host::roam`, `docs/roaming.md`).
+//!
+//! The tissue is `W × H` nodes at the patch's spacing, centred on the origin (its top at
+//! `z = 0`); the patch simulates the `n × n` of them around its centre node, outer ring
+//! fixed at rest. When the contact point (out of contact: the probe) is more than
+//! `½ + hysteresis` spacings from the centre along an axis, the window moves one node
+//! that way and stays inside the tissue: the free nodes that stay free keep their state,
+//! the others start at rest, each spring takes the warm-start value of the spring it
+//! continues (a map per direction, built at start-up), and the proxy keeps its place on
+//! the tissue. A shift costs one pass over the nodes and one over the springs: bounded,
+//! no search.
+
+/// What a window is built from (start-up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowConfig {
+    /// Tissue nodes along `x` (the patch's `n` … 64).
+    pub tissue_w: usize,
+    /// Tissue nodes along `y` (the patch's `n` … 64).
+    pub tissue_h: usize,
+    /// How far past half a spacing the contact must go before the window moves,
+    /// spacings (0.05 … 0.45).
+    pub hysteresis: f64,
+}
+
+/// No warm-start value to take: the spring starts at rest.
+pub(crate) const NONE: u16 = u16::MAX;
+
+/// The window: where it is on the tissue, and the start-up maps its shifts use.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Window<const EDGES: usize> {
+    pub(crate) n: i32,
+    pub(crate) w: i32,
+    pub(crate) h: i32,
+    /// The window's first corner, tissue grid coordinates.
+    pub(crate) corner: [i32; 2],
+    /// `½ + hysteresis`, Q16 spacings.
+    pub(crate) limit: i32,
+    /// Spacing, Q24 mm.
+    pub(crate) spacing: i32,
+    /// Per direction (`+x`, `−x`, `+y`, `−y`): for each spring, the spring whose
+    /// warm-start value it takes at a shift ([`NONE`]: it starts at rest).
+    pub(crate) maps: [[u16; EDGES]; 4],
+    /// Shifts so far.
+    pub(crate) shifts: u32,
+}
+
+impl<const EDGES: usize> Window<EDGES> {
+    /// The window's centre node, tissue grid coordinates.
+    pub fn centre(&self) -> (usize, usize) {
+        (
+            (self.corner[0] + self.n / 2) as usize,
+            (self.corner[1] + self.n / 2) as usize,
+        )
+    }
+
+    /// Shifts so far.
+    pub fn shifts(&self) -> u32 {
+        self.shifts
+    }
+
+    /// The centre node's rest position in the tissue frame, Q24 mm: the patch frame's
+    /// origin.
+    pub(crate) fn origin(&self) -> [i32; 2] {
+        let c = self.centre();
+        // (i − (W − 1)/2) s = (2i − W + 1) s / 2.
+        let at = |i: usize, w: i32| (2 * i as i32 - w + 1).saturating_mul(self.spacing >> 1);
+        [at(c.0, self.w), at(c.1, self.h)]
+    }
+
+    /// The shift for a point `g` (window grid coordinates, Q16): −1, 0 or +1 per axis,
+    /// kept inside the tissue.
+    pub(crate) fn step_for(&self, g: [i32; 2]) -> [i32; 2] {
+        let centre = (self.n / 2) << 16;
+        let side = [self.w, self.h];
+        core::array::from_fn(|k| {
+            let d = g[k].saturating_sub(centre);
+            let s = if d > self.limit {
+                1
+            } else if d < -self.limit {
+                -1
+            } else {
+                0
+            };
+            let c = self.corner[k] + s;
+            if c < 0 || c > side[k] - self.n {
+                0
+            } else {
+                s
+            }
+        })
+    }
+}
