@@ -244,6 +244,11 @@ impl Proxy {
         [p[0], p[1], p[2].saturating_add(self.radius)]
     }
 
+    /// The proxy's centre on the current surface (Q24 mm), when in contact.
+    pub(crate) fn centre_at(&self, s: &impl Surface) -> Option<V3> {
+        self.at.map(|g| self.centre(s, g))
+    }
+
     /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame).
     pub(crate) fn update(&mut self, s: &impl Surface, probe: V3) {
         let goal_g = self.locate(s, probe[0], probe[1]);

@@ -59,6 +59,12 @@ impl<const EDGES: usize> Window<EDGES> {
         self.shifts
     }
 
+    /// The patch frame's origin (the centre node's rest position) in the tissue frame,
+    /// mm (`x`, `y`; the frames share `z`).
+    pub fn origin_mm(&self) -> [crate::units::Length; 2] {
+        self.origin().map(crate::units::Length::from_bits)
+    }
+
     /// The centre node's rest position in the tissue frame, Q24 mm: the patch frame's
     /// origin.
     pub(crate) fn origin(&self) -> [i32; 2] {

@@ -8,7 +8,10 @@ use crate::patch::{substeps, Mesh, Twin, TwinConfig, V};
 use crate::reference::Reference;
 use crate::roam::{Friction, RoamConfig, RoamError, RoamTwin, Tissue};
 use crate::trajectory::Trajectory;
-use mccs::{Arith, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
+use mccs::{
+    Arith, ForceTable64, Length, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
+    SolverError, Topology, WindowConfig,
+};
 
 /// Capacities of the fixed backend's solver: N = 12 has 101 node slots and 558 springs.
 pub const FIXED_NODES: usize = 101;
@@ -52,6 +55,8 @@ pub enum ReplayError {
     Topology(mccs::TopologyError),
     /// The roaming configuration.
     Roam(RoamError),
+    /// The core's proxy or window refused the configuration.
+    Proxy(ProxyError),
 }
 
 impl std::fmt::Display for ReplayError {
@@ -61,6 +66,7 @@ impl std::fmt::Display for ReplayError {
             Self::Table(e) => e.fmt(f),
             Self::Topology(e) => e.fmt(f),
             Self::Roam(e) => e.fmt(f),
+            Self::Proxy(e) => e.fmt(f),
         }
     }
 }
@@ -199,6 +205,80 @@ impl Replay {
         traj: &Trajectory,
         roaming: &Roaming,
         mut row: impl FnMut(RoamRow),
+    ) -> Result<(), ReplayError> {
+        match self.engine {
+            Engine::Reference => self.roam_twin(params, traj, roaming, &mut row),
+            Engine::Wide => self.roam_fixed(params, traj, roaming, mccs::Wide, &mut row),
+            Engine::Narrow => self.roam_fixed(params, traj, roaming, mccs::Narrow, &mut row),
+        }
+    }
+
+    /// The core's roaming ([`mccs::Solver::step_roaming`]): a flat tissue only.
+    fn roam_fixed<A: Arith>(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        roaming: &Roaming,
+        arith: A,
+        row: &mut dyn FnMut(RoamRow),
+    ) -> Result<(), ReplayError> {
+        if roaming.tissue.shape != crate::roam::Shape::Flat {
+            return Err(ReplayError::Proxy(ProxyError::Window));
+        }
+        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
+        let spacing = roaming.tissue.spacing;
+        let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, spacing)
+            .map_err(ReplayError::Topology)?;
+        let mut s =
+            Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)?;
+        let mut proxy = s
+            .proxy(&ProxyConfig {
+                grid: self.grid,
+                spacing,
+                mu_s: roaming.friction.mu_s,
+                mu_k: roaming.friction.mu_k,
+                probe_radius: roaming.probe_radius,
+            })
+            .map_err(ReplayError::Proxy)?;
+        let window_config = WindowConfig {
+            tissue_w: roaming.tissue.w,
+            tissue_h: roaming.tissue.h,
+            hysteresis: 0.1,
+        };
+        let mut ticks = traj.ticks(self.config.tick_hz).peekable();
+        let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
+        let mut window = s
+            .window(&window_config, &proxy, start[0], start[1])
+            .map_err(ReplayError::Proxy)?;
+        for (time, p) in ticks {
+            let force = s.step_roaming(p.map(Length::saturating_from_num), &mut proxy, &mut window);
+            let o = window.origin_mm().map(|c| c.to_num::<f64>());
+            let proxy_at = match s.proxy_point(&proxy) {
+                Some(q) => {
+                    let q = q.map(|c| c.to_num::<f64>());
+                    [q[0] + o[0], q[1] + o[1], q[2]]
+                }
+                None => p,
+            };
+            row(RoamRow {
+                time,
+                force: force.map(|c| c.to_num::<f64>()),
+                proxy: proxy_at,
+                contact: proxy.grid_position().is_some(),
+                slipping: proxy.slipping(),
+                window_shifts: window.shifts(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The `f64` reference's roaming.
+    fn roam_twin(
+        &self,
+        params: &Params,
+        traj: &Trajectory,
+        roaming: &Roaming,
+        row: &mut dyn FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
         let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
         let mesh = Mesh::standard(self.grid, roaming.tissue.spacing);

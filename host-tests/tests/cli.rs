@@ -783,8 +783,15 @@ fn replay_roaming_errors_name_the_argument() {
     ];
     for (extra, needles) in [
         (
-            &["--backend", "fixed", "--tissue", "64,64"][..],
-            &["--tissue", "reference"][..],
+            &[
+                "--backend",
+                "fixed",
+                "--tissue",
+                "64,64",
+                "--cap-radius",
+                "200",
+            ][..],
+            &["--cap-radius", "flat tissue only"][..],
         ),
         (&["--tissue", "2,64"], &["--tissue", "3..=64"]),
         (&["--tissue", "64"], &["--tissue", "W,H"]),
@@ -825,5 +832,63 @@ fn replay_roaming_errors_name_the_argument() {
     ] {
         let args: Vec<&str> = base.iter().chain(extra).copied().collect();
         assert_usage_error(&mccs(&args), needles);
+    }
+}
+
+#[test]
+fn replay_roams_in_the_core_as_in_the_reference() {
+    let run = |extra: &[&str]| -> Vec<Vec<f64>> {
+        let mut args = vec![
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/palpation.csv",
+            "--tissue",
+            "64,64",
+            "--friction",
+            "0.6,0.4",
+        ];
+        args.extend_from_slice(extra);
+        let out = mccs(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "stderr: {err}");
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let reference = run(&[]);
+    for extra in [
+        &["--backend", "fixed"][..],
+        &["--backend", "fixed", "--arith", "narrow"],
+    ] {
+        let fixed = run(extra);
+        assert_eq!(fixed.len(), reference.len());
+        for (f, r) in fixed.iter().zip(&reference) {
+            let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
+            let diff =
+                ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
+            assert!(
+                diff <= 0.02 + 0.02 * mag,
+                "{extra:?} t = {}: {f:?} against {r:?}",
+                r[0]
+            );
+            let proxy =
+                ((f[4] - r[4]).powi(2) + (f[5] - r[5]).powi(2) + (f[6] - r[6]).powi(2)).sqrt();
+            assert!(
+                proxy <= 0.01,
+                "{extra:?} t = {}: the proxy is {proxy} mm off",
+                r[0]
+            );
+            assert_eq!(
+                (f[7], f[8], f[9]),
+                (r[7], r[8], r[9]),
+                "{extra:?} t = {}: contact, slip, shifts",
+                r[0]
+            );
+        }
     }
 }

@@ -78,6 +78,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
+    /// The proxy's centre (mm, patch frame) on the current surface, when in contact.
+    pub fn proxy_point(&self, proxy: &Proxy) -> Option<[Length; 3]> {
+        proxy
+            .centre_at(&self.view(proxy))
+            .map(|p| p.map(Length::from_bits))
+    }
+
     /// One haptic tick with the probe at `probe` (mm, patch frame) touching the surface
     /// through `proxy` (from [`Solver::proxy`]): the proxy's contact and friction once,
     /// then the substeps with the coupling between probe and proxy. Returns the force the

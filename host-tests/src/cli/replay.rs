@@ -26,7 +26,7 @@ pub(super) struct Args {
     tuning: TuningArgs,
     /// Roam a tissue of W,H nodes (3 … 64 each, at --spacing; --grid is the window) with
     /// a proxy that slides on its surface; the trajectory is then in the tissue's frame
-    /// (origin at its centre, top at z = 0). The f64 reference only.
+    /// (origin at its centre, top at z = 0).
     #[arg(long, value_name = "W,H")]
     tissue: Option<String>,
     /// Static and kinetic friction MU_S,MU_K (0 … 2 each; with --tissue; default 0,0).
@@ -35,7 +35,8 @@ pub(super) struct Args {
     /// Probe radius, mm (0 … spacing/2; with --tissue; default 0).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     probe_radius: Option<f64>,
-    /// Shape the tissue as a spherical cap of this radius, mm (with --tissue).
+    /// Shape the tissue as a spherical cap of this radius, mm (with --tissue; --backend
+    /// reference only).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     cap_radius: Option<f64>,
 }
@@ -67,10 +68,10 @@ impl Args {
             }
             return Ok(None);
         };
-        if self.patch.backend != Backend::Reference {
+        if self.patch.backend != Backend::Reference && self.cap_radius.is_some() {
             return Err(arg_error(
-                "--tissue",
-                "roaming runs on --backend reference only: the fixed-point core does not roam yet (docs/roaming.md)",
+                "--cap-radius",
+                "the fixed-point core roams flat tissue only: use --backend reference for a cap (docs/roaming.md)",
             ));
         }
         let (w, h) = pair::<usize>(
@@ -208,6 +209,7 @@ fn roam(
         })
         .map_err(|e| match e {
             ReplayError::Solver(s) => config_error(s, &replay.config),
+            ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
             other => file_error(&a.params, other),
         })?;
     if let Some(e) = failed {
