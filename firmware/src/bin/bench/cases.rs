@@ -1,6 +1,6 @@
 //! The measured cases: one table evaluation, one spring, one substep of the standard
 //! patch (fixed point and floating point), one tick of this core's demo, and one tick of
-//! the N = 5 patch through a sliding proxy.
+//! its patch through a sliding proxy.
 
 use super::fw_common::exit;
 use super::harness::Harness;
@@ -211,19 +211,29 @@ fn tick_in<const N: usize, const E: usize>(
     })
 }
 
-/// One tick of the standard N = 5 patch (2.5 mm, default configuration) through a proxy
-/// with friction (μ_s 0.6, μ_k 0.4), 0.5 mm deep and sliding along x at 10 mm/s (the
-/// contact slipping), after 200 ticks of it; averaged over 4.
+/// One tick of this core's demo patch (its grid and configuration, 2.5 mm) through a
+/// proxy with friction (μ_s 0.6, μ_k 0.4), 0.5 mm deep and sliding along x at 10 mm/s
+/// (the contact slipping), after 200 ticks of it; averaged over 4.
 #[inline(never)]
 pub fn tick_proxy(h: &Harness, table: &ForceTable64) -> u32 {
-    let Ok(topo) = Topology::<10, 61>::standard_patch(5, 2.5) else {
+    match demo::spec_for(CORE).grid {
+        8 => tick_proxy_in::<37, 214>(h, table),
+        5 => tick_proxy_in::<10, 61>(h, table),
+        _ => tick_proxy_in::<5, 30>(h, table),
+    }
+}
+
+#[inline(never)]
+fn tick_proxy_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u32 {
+    let spec = demo::spec_for(CORE);
+    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, 2.5) else {
         exit(false)
     };
-    let Ok(mut s) = Solver::new(topo, *table, &SolverConfig::default()) else {
+    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
         exit(false)
     };
     let cfg = ProxyConfig {
-        grid: 5,
+        grid: spec.grid,
         spacing: 2.5,
         mu_s: 0.6,
         mu_k: 0.4,
