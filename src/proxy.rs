@@ -7,21 +7,22 @@
 //! coordinates `(u, v)` (Q16 spacings from the patch's corner), so it moves with the
 //! deformed nodes. Depth is measured along `z` (the rest normal of a flat patch).
 //!
-//! Per tick ([`Proxy::update`]): the goal is the deformed surface's point above or below
-//! the probe (found from the rest grid by a product by `1/s`, then two corrections by the
-//! deformed surface's offset: no search, no division), plus `r` up; the probe is in
+//! Per tick (`Proxy::update`, from `Solver::step_proxy`): the goal is the deformed
+//! surface's point above or below the probe (found from the rest grid by a product by
+//! `1/s`, then two corrections by the deformed surface's offset: no search, no
+//! division), plus `r` up; the probe is in
 //! contact while it is below the goal. Sticking, the proxy stays while its offset across
 //! `z` is within `μ_s` times its height above the probe; past it the contact slips and
 //! the proxy moves toward the goal onto `μ_k` times that height (three passes, since the
 //! surface's height under the proxy changes it); it sticks again below the hysteresis
-//! cone `tan(0.6 atan μ_k)`. Per substep ([`Proxy::force`]): the coupling
+//! cone `tan(0.6 atan μ_k)`. Per substep (`Proxy::force`): the coupling
 //! `k_c (proxy − probe)` plus its damping along `z`, held to the device maximum in
 //! magnitude, never pulling the surface up; its reaction goes onto the proxy's triangle
 //! with the proxy's weights.
 //!
 //! Formats: positions Q24 mm, velocities Q16 mm/s, forces Q20 N, grid coordinates and
 //! weights Q16, friction coefficients Q16. The only square roots are reciprocal ones by
-//! five Newton steps ([`rsqrt`]), for a slip and for a force over the device maximum.
+//! five Newton steps (`rsqrt`), for a slip and for a force over the device maximum.
 
 use crate::coupling::CouplingQ;
 use crate::q::{mul_wide, sat, V3};
