@@ -217,11 +217,16 @@ impl Proxy {
         Self::blend(w, c.map(|(a, b)| s.position(a, b)))
     }
 
-    /// Grid coordinates of patch-frame `(x, y)` on the rest grid (Q16).
+    /// A length (Q24 mm) in spacings (Q16): Q24 mm · Q30 /mm = Q54, `>> 38`.
+    fn spacings(&self, x: i32) -> i32 {
+        sat(mul_wide(x, self.inv_s) >> 38)
+    }
+
+    /// Grid coordinates of patch-frame `(x, y)` on the rest grid (Q16): the patch's
+    /// corner is `n/2` spacings away.
     fn rest_grid(&self, x: i32, y: i32) -> [i32; 2] {
-        // Q24 mm · Q30 /mm = Q54 → Q16: >> 38; the patch's corner is n/2 spacings away.
         let c = (self.n / 2) << G_FRAC;
-        [x, y].map(|p| sat((mul_wide(p, self.inv_s) >> 38) + c as i64))
+        [x, y].map(|p| self.spacings(p).saturating_add(c))
     }
 
     /// The deformed surface's point above or below patch-frame `(x, y)`: from the rest
@@ -231,9 +236,10 @@ impl Proxy {
         let mut g = self.rest_grid(x, y);
         for _ in 0..2 {
             let p = self.point(s, g);
-            let d = self.rest_grid(x.saturating_sub(p[0]), y.saturating_sub(p[1]));
-            let c = (self.n / 2) << G_FRAC;
-            g = [g[0].saturating_add(d[0] - c), g[1].saturating_add(d[1] - c)];
+            g = [
+                g[0].saturating_add(self.spacings(x.saturating_sub(p[0]))),
+                g[1].saturating_add(self.spacings(y.saturating_sub(p[1]))),
+            ];
         }
         let top = (self.n - 1) << G_FRAC;
         g.map(|x| x.max(0).min(top))
@@ -301,10 +307,9 @@ impl Proxy {
                 let off = proxy[k].saturating_sub(goal[k]);
                 goal[k].saturating_add(sat(mul_wide(off, lambda) >> G_FRAC))
             });
+            // Past the cone only when slipping (sticking, the state test above keeps
+            // `t2` within the static cone): the next pass re-measures the depth there.
             at = self.locate(s, next[0], next[1]);
-            if !self.slipping {
-                break;
-            }
         }
         self.at = Some(at);
     }
@@ -324,7 +329,11 @@ impl Proxy {
         };
         let (corners, w) = self.triangle(g);
         let p = Self::blend(w, corners.map(|(a, b)| s.position(a, b)));
-        let pv = Self::blend(w, corners.map(|(a, b)| s.velocity(a, b)));
+        // Only the surface's normal (z) velocity enters: the damping acts along z.
+        let vz = (0..3)
+            .map(|k| mul_wide(w[k], s.velocity(corners[k].0, corners[k].1)[2]))
+            .sum::<i64>();
+        let vz = sat(vz >> G_FRAC);
         let proxy = [p[0], p[1], p[2].saturating_add(self.radius)];
         // Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after >> 20.
         const SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
@@ -332,7 +341,7 @@ impl Proxy {
         let mut f: V3 = core::array::from_fn(|k| {
             sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> SH)
         });
-        let closing = pv[2].saturating_sub(probe_vel[2]);
+        let closing = vz.saturating_sub(probe_vel[2]);
         f[2] = f[2].saturating_add(sat(mul_wide(closing, coupling.damping) >> SH));
         if f[2] < 0 {
             return ([0; 3], corners, w);
@@ -352,9 +361,8 @@ impl Proxy {
 /// square of `r`'s format. Five Newton steps for `1/√M`, `M ∈ [¼, 1)` the normalised
 /// `x`, from a linear first guess (error below 25 %): better than 1e-9.
 fn scale_to(r: i32, x: i64) -> i32 {
-    let y = rsqrt(x);
     // r/√x = r · y · 2^(e/2 − 62), y Q30: in Q16, r · y >> (46 − e/2) (e is even).
-    let (y, e) = y;
+    let (y, e) = rsqrt(x);
     let sh = 46 - (e >> 1);
     sat((r.max(0) as i64 * y) >> sh).min(ONE_G)
 }
@@ -363,9 +371,9 @@ fn scale_to(r: i32, x: i64) -> i32 {
 fn rsqrt(x: i64) -> (i64, u32) {
     let x = x.max(1) as u64;
     let e = x.leading_zeros() & !1;
-    let m = x << e; // [2^62, 2^64): M = m / 2^64 ∈ [¼, 1).
-    let m30 = (m >> 34) as i64; // M in Q30.
-                                // First guess 2.5 − 1.5 M (Q30), then y ← y (3 − M y²)/2.
+    // m ∈ [2^62, 2^64): M = m / 2^64 ∈ [¼, 1), here in Q30.
+    let m30 = ((x << e) >> 34) as i64;
+    // First guess 2.5 − 1.5 M (Q30), then y ← y (3 − M y²)/2.
     let mut y = (5i64 << 29) - ((3 * m30) >> 1);
     for _ in 0..5 {
         let y2 = (y * y) >> 30;

@@ -69,8 +69,10 @@ impl<const EDGES: usize> Window<EDGES> {
     /// origin.
     pub(crate) fn origin(&self) -> [i32; 2] {
         let c = self.centre();
-        // (i − (W − 1)/2) s = (2i − W + 1) s / 2.
-        let at = |i: usize, w: i32| (2 * i as i32 - w + 1).saturating_mul(self.spacing >> 1);
+        // (i − (W − 1)/2) s = (2i − W + 1) s / 2, exact for an odd raw spacing too.
+        let at = |i: usize, w: i32| {
+            crate::q::sat(((2 * i as i32 - w + 1) as i64 * self.spacing as i64) >> 1)
+        };
         [at(c.0, self.w), at(c.1, self.h)]
     }
 

@@ -106,13 +106,9 @@ impl Replay {
         arith: A,
         row: &mut dyn FnMut(Row),
     ) -> Result<(), ReplayError> {
-        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
-        let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, self.spacing)
-            .map_err(ReplayError::Topology)?;
-        let nodes = topo.node_count() as u16;
-        let contact = topo.contact();
-        let mut s =
-            Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)?;
+        let mut s = self.solver(params, self.spacing, arith)?;
+        let nodes = s.topology().node_count() as u16;
+        let contact = s.topology().contact();
         let mm = |x: [Length; 3]| x.map(|c| c.to_num::<f64>());
         for (time, p) in traj.ticks(self.config.tick_hz) {
             let f = s.step(p.map(Length::saturating_from_num));
@@ -137,17 +133,8 @@ impl Replay {
         row: &mut dyn FnMut(Row),
     ) -> Result<(), ReplayError> {
         let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
-        let mesh = Mesh::standard(self.grid, self.spacing);
-        let mut tc = TwinConfig::from_solver(&self.config, 0);
-        let k_max = crate::cli::reference_max_stiffness(&law);
-        let n = substeps(&mesh, k_max, &tc).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
-        if n > self.config.max_substeps {
-            return Err(ReplayError::Solver(SolverError::TooManySubsteps {
-                needed: n,
-            }));
-        }
-        tc.substeps = n;
-        let mut twin = Twin::new(mesh, law, tc);
+        let tc = self.twin_dynamics(&law, self.spacing)?;
+        let mut twin = Twin::new(Mesh::standard(self.grid, self.spacing), law, tc);
         let c = twin.mesh.contact;
         for (time, p) in traj.ticks(self.config.tick_hz) {
             let force = twin.step(p);
@@ -163,6 +150,37 @@ impl Replay {
             });
         }
         Ok(())
+    }
+}
+
+impl Replay {
+    /// The fixed-point solver of the standard patch at `spacing`.
+    fn solver<A: Arith>(
+        &self,
+        params: &Params,
+        spacing: f64,
+        arith: A,
+    ) -> Result<Solver<FIXED_NODES, FIXED_EDGES, 64, A>, ReplayError> {
+        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
+        let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, spacing)
+            .map_err(ReplayError::Topology)?;
+        Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)
+    }
+
+    /// The twin's dynamics for the standard patch at `spacing`, at the substeps the twin's
+    /// rule gives it.
+    fn twin_dynamics(&self, law: &Reference, spacing: f64) -> Result<TwinConfig, ReplayError> {
+        let mesh = Mesh::standard(self.grid, spacing);
+        let mut tc = TwinConfig::from_solver(&self.config, 0);
+        let k_max = crate::cli::reference_max_stiffness(law);
+        let n = substeps(&mesh, k_max, &tc).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
+        if n > self.config.max_substeps {
+            return Err(ReplayError::Solver(SolverError::TooManySubsteps {
+                needed: n,
+            }));
+        }
+        tc.substeps = n;
+        Ok(tc)
     }
 }
 
@@ -225,12 +243,8 @@ impl Replay {
         if roaming.tissue.shape != crate::roam::Shape::Flat {
             return Err(ReplayError::Proxy(ProxyError::Window));
         }
-        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
         let spacing = roaming.tissue.spacing;
-        let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, spacing)
-            .map_err(ReplayError::Topology)?;
-        let mut s =
-            Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)?;
+        let mut s = self.solver(params, spacing, arith)?;
         let mut proxy = s
             .proxy(&ProxyConfig {
                 grid: self.grid,
@@ -281,21 +295,10 @@ impl Replay {
         row: &mut dyn FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
         let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
-        let mesh = Mesh::standard(self.grid, roaming.tissue.spacing);
-        let mut dynamics = TwinConfig::from_solver(&self.config, 0);
-        let k_max = crate::cli::reference_max_stiffness(&law);
-        let n =
-            substeps(&mesh, k_max, &dynamics).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
-        if n > self.config.max_substeps {
-            return Err(ReplayError::Solver(SolverError::TooManySubsteps {
-                needed: n,
-            }));
-        }
-        dynamics.substeps = n;
         let cfg = RoamConfig {
             tissue: roaming.tissue,
             n: self.grid,
-            dynamics,
+            dynamics: self.twin_dynamics(&law, roaming.tissue.spacing)?,
             friction: roaming.friction,
             probe_radius: roaming.probe_radius,
             window_hysteresis: 0.1,

@@ -723,19 +723,22 @@ fn help_usage_and_the_demo_check() {
     }
 }
 
+/// The palpation replayed on a 64 × 64 tissue with friction 0.6 / 0.4.
+const PALPATION: [&str; 9] = [
+    "replay",
+    "--params",
+    "params/table2.toml",
+    "--probe",
+    "params/palpation.csv",
+    "--tissue",
+    "64,64",
+    "--friction",
+    "0.6,0.4",
+];
+
 #[test]
 fn replay_roams_a_tissue_with_friction() {
-    let out = mccs(&[
-        "replay",
-        "--params",
-        "params/table2.toml",
-        "--probe",
-        "params/palpation.csv",
-        "--tissue",
-        "64,64",
-        "--friction",
-        "0.6,0.4",
-    ]);
+    let out = mccs(&PALPATION);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "stderr: {err}");
     let text = String::from_utf8(out.stdout).unwrap();
@@ -838,17 +841,7 @@ fn replay_roaming_errors_name_the_argument() {
 #[test]
 fn replay_roams_in_the_core_as_in_the_reference() {
     let run = |extra: &[&str]| -> Vec<Vec<f64>> {
-        let mut args = vec![
-            "replay",
-            "--params",
-            "params/table2.toml",
-            "--probe",
-            "params/palpation.csv",
-            "--tissue",
-            "64,64",
-            "--friction",
-            "0.6,0.4",
-        ];
+        let mut args = PALPATION.to_vec();
         args.extend_from_slice(extra);
         let out = mccs(&args);
         let err = String::from_utf8_lossy(&out.stderr);

@@ -20,6 +20,17 @@ fn fixed<A: Arith>() -> Fixed<A> {
     Solver::with_arith(topo, table, &SolverConfig::default(), A::default()).unwrap()
 }
 
+/// The proxy configuration of the test patch with friction `mu` and probe radius `radius`.
+fn proxy_config(mu: (f64, f64), radius: f64) -> ProxyConfig {
+    ProxyConfig {
+        grid: N,
+        spacing: SPACING,
+        mu_s: mu.0,
+        mu_k: mu.1,
+        probe_radius: radius,
+    }
+}
+
 fn twin(substeps: u32, mu: (f64, f64), radius: f64) -> RoamTwin {
     let cfg = RoamConfig {
         tissue: Tissue::new(N, N, SPACING, Shape::Flat).unwrap(),
@@ -52,13 +63,7 @@ fn path(t: usize) -> V {
 /// magnitude (where it is above 0.05 N), and whether the slip states agreed.
 fn compare<A: Arith>(mu: (f64, f64), radius: f64) -> (f64, usize) {
     let mut s = fixed::<A>();
-    let config = ProxyConfig {
-        grid: N,
-        spacing: SPACING,
-        mu_s: mu.0,
-        mu_k: mu.1,
-        probe_radius: radius,
-    };
+    let config = proxy_config(mu, radius);
     let mut proxy = s.proxy(&config).unwrap();
     let mut tw = twin(s.substeps(), mu, radius);
     let (mut worst, mut slip_disagree) = (0.0f64, 0);
@@ -117,13 +122,7 @@ fn the_fixed_proxy_follows_the_twin() {
 #[test]
 fn a_proxy_for_another_patch_is_refused() {
     let s = fixed::<Wide>();
-    let ok = ProxyConfig {
-        grid: N,
-        spacing: SPACING,
-        mu_s: 0.3,
-        mu_k: 0.3,
-        probe_radius: 0.0,
-    };
+    let ok = proxy_config((0.3, 0.3), 0.0);
     assert!(s.proxy(&ok).is_ok());
     for (bad, err) in [
         (ProxyConfig { grid: 6, ..ok }, ProxyError::Grid),
@@ -156,13 +155,7 @@ mod robust {
 
     fn run<A: Arith>(mu: (f64, f64), radius: f64, probes: &[(f64, f64, f64)]) {
         let mut s = fixed::<A>();
-        let cfg = ProxyConfig {
-            grid: N,
-            spacing: SPACING,
-            mu_s: mu.0,
-            mu_k: mu.1,
-            probe_radius: radius,
-        };
+        let cfg = proxy_config(mu, radius);
         let mut proxy = s.proxy(&cfg).unwrap();
         let max = SolverConfig::default().coupling.max_force;
         for &(x, y, z) in probes {
@@ -188,13 +181,7 @@ mod robust {
     /// The same on a 64 × 64 tissue, the window following: it stays on the tissue.
     fn roam<A: Arith>(mu: (f64, f64), probes: &[(f64, f64, f64)]) {
         let mut s = fixed::<A>();
-        let cfg = ProxyConfig {
-            grid: N,
-            spacing: SPACING,
-            mu_s: mu.0,
-            mu_k: mu.1,
-            probe_radius: 0.0,
-        };
+        let cfg = proxy_config(mu, 0.0);
         let mut proxy = s.proxy(&cfg).unwrap();
         let wc = mccs::WindowConfig {
             tissue_w: 64,
@@ -264,13 +251,7 @@ mod roaming {
 
     fn compare<A: Arith>(mu: (f64, f64)) -> (f64, u32) {
         let mut s = fixed::<A>();
-        let config = ProxyConfig {
-            grid: N,
-            spacing: SPACING,
-            mu_s: mu.0,
-            mu_k: mu.1,
-            probe_radius: 0.0,
-        };
+        let config = proxy_config(mu, 0.0);
         let mut proxy = s.proxy(&config).unwrap();
         let wc = WindowConfig {
             tissue_w: 64,
@@ -336,15 +317,7 @@ mod roaming {
     #[test]
     fn a_window_that_does_not_fit_is_refused() {
         let s = fixed::<Wide>();
-        let proxy = s
-            .proxy(&ProxyConfig {
-                grid: N,
-                spacing: SPACING,
-                mu_s: 0.0,
-                mu_k: 0.0,
-                probe_radius: 0.0,
-            })
-            .unwrap();
+        let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
         let ok = WindowConfig {
             tissue_w: 64,
             tissue_h: 64,

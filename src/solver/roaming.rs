@@ -157,7 +157,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
         }
-        let dir = DIRECTIONS.iter().position(|x| *x == d).unwrap_or(0);
+        let dir = match d {
+            [1, 0] => 0,
+            [-1, 0] => 1,
+            [0, 1] => 2,
+            _ => 3,
+        };
         let old = self.warm;
         for (e, w) in self.warm.iter_mut().enumerate() {
             let from = window.maps[dir].get(e).copied().unwrap_or(NONE);

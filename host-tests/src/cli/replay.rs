@@ -130,88 +130,76 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         config: cfg,
         engine: a.patch.engine(),
     };
-    let mut w = std::io::BufWriter::new(out);
-    if let Some(roaming) = roaming {
-        return roam(&replay, &p, &traj, &roaming, &mut w, &a);
+    let w = std::io::BufWriter::new(out);
+    let fail = |e| match e {
+        ReplayError::Solver(s) => config_error(s, &cfg),
+        ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
+        other => file_error(&a.params, other),
+    };
+    match roaming {
+        Some(roaming) => csv(
+            w,
+            "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts",
+            |row| {
+                replay.roam(&p, &traj, &roaming, |r: RoamRow| {
+                    row(format!(
+                        "{},{},{},{},{},{},{},{},{},{}",
+                        fmt_time(r.time),
+                        r.force[0],
+                        r.force[1],
+                        r.force[2],
+                        r.proxy[0],
+                        r.proxy[1],
+                        r.proxy[2],
+                        r.contact as u8,
+                        r.slipping as u8,
+                        r.window_shifts
+                    ))
+                })
+            },
+            fail,
+        ),
+        None => csv(
+            w,
+            "time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm",
+            |row| {
+                replay.run(&p, &traj, |r| {
+                    row(format!(
+                        "{},{},{},{},{},{},{},{}",
+                        fmt_time(r.time),
+                        r.force[0],
+                        r.force[1],
+                        r.force[2],
+                        r.contact[0],
+                        r.contact[1],
+                        r.contact[2],
+                        r.max_disp
+                    ))
+                })
+            },
+            fail,
+        ),
     }
-    writeln!(
-        w,
-        "time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm"
-    )
-    .map_err(io_error)?;
-    let mut failed = None;
-    replay
-        .run(&p, &traj, |r| {
-            if failed.is_some() {
-                return;
-            }
-            let line = format!(
-                "{},{},{},{},{},{},{},{}",
-                fmt_time(r.time),
-                r.force[0],
-                r.force[1],
-                r.force[2],
-                r.contact[0],
-                r.contact[1],
-                r.contact[2],
-                r.max_disp
-            );
-            if let Err(e) = writeln!(w, "{line}") {
-                failed = Some(e);
-            }
-        })
-        .map_err(|e| match e {
-            ReplayError::Solver(s) => config_error(s, &cfg),
-            other => file_error(&a.params, other),
-        })?;
-    if let Some(e) = failed {
-        return Err(io_error(e));
-    }
-    w.flush().map_err(io_error)
 }
 
-/// The roaming replay's CSV.
-fn roam(
-    replay: &Replay,
-    p: &mccs::Params,
-    traj: &trajectory::Trajectory,
-    roaming: &Roaming,
-    w: &mut impl Write,
-    a: &Args,
+/// Writes `header`, then each line `run` hands its row function; stops writing at the
+/// first failed write, which it reports after the run.
+fn csv(
+    mut w: impl Write,
+    header: &str,
+    run: impl FnOnce(&mut dyn FnMut(String)) -> Result<(), ReplayError>,
+    fail: impl FnOnce(ReplayError) -> CliError,
 ) -> Result<(), CliError> {
-    writeln!(
-        w,
-        "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts"
-    )
-    .map_err(io_error)?;
+    writeln!(w, "{header}").map_err(io_error)?;
     let mut failed = None;
-    replay
-        .roam(p, traj, roaming, |r: RoamRow| {
-            if failed.is_some() {
-                return;
-            }
-            let line = format!(
-                "{},{},{},{},{},{},{},{},{},{}",
-                fmt_time(r.time),
-                r.force[0],
-                r.force[1],
-                r.force[2],
-                r.proxy[0],
-                r.proxy[1],
-                r.proxy[2],
-                r.contact as u8,
-                r.slipping as u8,
-                r.window_shifts
-            );
+    run(&mut |line| {
+        if failed.is_none() {
             if let Err(e) = writeln!(w, "{line}") {
                 failed = Some(e);
             }
-        })
-        .map_err(|e| match e {
-            ReplayError::Solver(s) => config_error(s, &replay.config),
-            ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
-            other => file_error(&a.params, other),
-        })?;
+        }
+    })
+    .map_err(fail)?;
     if let Some(e) = failed {
         return Err(io_error(e));
     }
