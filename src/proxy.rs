@@ -25,7 +25,7 @@
 //! five Newton steps (`rsqrt`), for a slip and for a force over the device maximum.
 
 use crate::coupling::CouplingQ;
-use crate::q::{mul_wide, sat, V3};
+use crate::q::{self, mul_wide, sat, V3};
 use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
 
 /// Fraction bits of grid coordinates and weights.
@@ -132,7 +132,7 @@ impl Proxy {
         let mu_h = if c.mu_k > c.mu_s {
             0.0
         } else {
-            libm::tan(0.6 * libm::atan(c.mu_k))
+            tan_small(0.6 * libm::atan(c.mu_k))
         };
         Ok(Proxy {
             n: c.grid as i32,
@@ -204,11 +204,16 @@ impl Proxy {
         }
     }
 
-    /// `Σ w_k x_k` for the triangle's corners' values `x` (Q24 or Q16 per the values).
+    /// `Σ w_k x_k` for the triangle's corners' values `x` (Q24 or Q16 per the values), as
+    /// `x₀ + w₁ (x₁ − x₀) + w₂ (x₂ − x₀)` (the weights sum to one), each term by
+    /// [`part`]: no 64-bit product (on the M0 a pass of the friction loop costs three of
+    /// these). Within two units of the last place of the exact sum.
     fn blend(w: [i32; 3], x: [V3; 3]) -> V3 {
-        core::array::from_fn(
-            |d| sat((0..3).map(|k| mul_wide(w[k], x[k][d])).sum::<i64>() >> G_FRAC),
-        )
+        core::array::from_fn(|d| {
+            let t1 = part(x[1][d].saturating_sub(x[0][d]), w[1]);
+            let t2 = part(x[2][d].saturating_sub(x[0][d]), w[2]);
+            x[0][d].saturating_add(t1).saturating_add(t2)
+        })
     }
 
     /// The deformed surface's point at grid `g`.
@@ -217,9 +222,10 @@ impl Proxy {
         Self::blend(w, c.map(|(a, b)| s.position(a, b)))
     }
 
-    /// A length (Q24 mm) in spacings (Q16): Q24 mm · Q30 /mm = Q54, `>> 38`.
+    /// A length (Q24 mm) in spacings (Q16): Q24 mm · Q30 /mm = Q54, its high word `>> 6`
+    /// (the same floor as `>> 38`; within `i32`: `|x| · 1/s` ≤ 2³¹ · 2³⁰).
     fn spacings(&self, x: i32) -> i32 {
-        sat(mul_wide(x, self.inv_s) >> 38)
+        q::mulhi(x, self.inv_s) >> 6
     }
 
     /// Grid coordinates of patch-frame `(x, y)` on the rest grid (Q16): the patch's
@@ -357,28 +363,136 @@ impl Proxy {
     }
 }
 
+/// `⌊d · w / 2¹⁶⌋` for a weight `0 ≤ w ≤ 2¹⁶` (Q16) and any `d`, from one [`q::mul_s`]
+/// with a 16-bit operand: `w` itself up to 2¹⁵, else `d − d (2¹⁶ − w)/2¹⁶` (then within
+/// one unit of the floor).
+fn part(d: i32, w: i32) -> i32 {
+    if w <= 1 << 15 {
+        q::mul_s::<16>(d, w)
+    } else {
+        d.saturating_sub(q::mul_s::<16>(d, ONE_G - w))
+    }
+}
+
 /// `r / √x` in Q16 for `0 < r` and `r² < x` (a value below 1): `x` a square in the
 /// square of `r`'s format. Five Newton steps for `1/√M`, `M ∈ [¼, 1)` the normalised
-/// `x`, from a linear first guess (error below 25 %): better than 1e-9.
+/// `x`, from a linear first guess (error below 25 %), in 32-bit products: within 1e-8.
 fn scale_to(r: i32, x: i64) -> i32 {
     // r/√x = r · y · 2^(e/2 − 62), y Q30: in Q16, r · y >> (46 − e/2) (e is even).
     let (y, e) = rsqrt(x);
     let sh = 46 - (e >> 1);
-    sat((r.max(0) as i64 * y) >> sh).min(ONE_G)
+    sat(((r.max(0) as u32 as u64 * y as u64) >> sh) as i64).min(ONE_G)
 }
 
 /// `1/√x` for `x > 0` as `(y, e)`: `1/√x = y · 2^(e/2 − 62)`, `y` in Q30 within (1, 2].
-fn rsqrt(x: i64) -> (i64, u32) {
+/// Each product is a high word of 32 × 32 bits ([`q::mulhi_u`]: one `umull`, or four
+/// 16-bit products on the M0).
+fn rsqrt(x: i64) -> (u32, u32) {
     let x = x.max(1) as u64;
     let e = x.leading_zeros() & !1;
     // m ∈ [2^62, 2^64): M = m / 2^64 ∈ [¼, 1), here in Q30.
-    let m30 = ((x << e) >> 34) as i64;
-    // First guess 2.5 − 1.5 M (Q30), then y ← y (3 − M y²)/2.
-    let mut y = (5i64 << 29) - ((3 * m30) >> 1);
+    let m30 = ((x << e) >> 34) as u32;
+    // First guess 2.5 − 1.5 M (Q30, ≤ 2.125), then y ← y (3 − M y²)/2: y² in Q28 (≤ 4.6),
+    // M y² in Q26 then Q30 (≤ 1.55: its largest over the first guess), y (3 − M y²) in
+    // Q28, halved into Q30. After the first step y ≤ 1/√M ≤ 2 (the step's maximum).
+    let mut y = (5u32 << 29) - ((3 * m30) >> 1);
     for _ in 0..5 {
-        let y2 = (y * y) >> 30;
-        let my2 = (m30 * y2) >> 30;
-        y = (y * ((3i64 << 30) - my2)) >> 31;
+        let y2 = q::mulhi_u(y, y);
+        let my2 = q::mulhi_u(m30, y2) << 4;
+        y = q::mulhi_u(y, (3u32 << 30) - my2) << 1;
     }
     (y, e)
+}
+
+/// `tan x` for `0 ≤ x ≤ 0.7` (start-up: the hysteresis cone, `x = 0.6 atan μ_k ≤ 0.665`),
+/// as `sin x / cos x` from their Taylor series to `x¹⁵` and `x¹⁴`: the first omitted
+/// terms are below `0.7¹⁷/17! = 6e-18` and `0.7¹⁶/16! = 2e-16`, so the result is within
+/// 1e-15 relative of `tan` (tested against `std`). libm's `tan` costs 6 KiB of flash
+/// (its argument reduction), `tanf` 4.6 KiB; this costs a few hundred bytes.
+fn tan_small(x: f64) -> f64 {
+    let x2 = x * x;
+    let (mut sin, mut cos) = (0.0, 0.0);
+    // Horner from the highest term: sin = x Σ (−x²)^k/(2k+1)!, cos = Σ (−x²)^k/(2k)!.
+    for k in (0..8u32).rev() {
+        let (s_den, c_den) = ((2 * k + 2) * (2 * k + 3), (2 * k + 1) * (2 * k + 2));
+        sin = 1.0 - x2 * sin / s_den as f64;
+        cos = 1.0 - x2 * cos / c_den as f64;
+    }
+    x * sin / cos
+}
+
+#[cfg(test)]
+mod tests {
+    /// `part` against the exact product, over weights 0 … 2¹⁶ and values up to ±2³¹.
+    #[test]
+    fn part_matches_the_exact_product() {
+        let ds = [
+            i32::MIN,
+            i32::MIN + 1,
+            -1 << 30,
+            -123_456_789,
+            -65_537,
+            -1,
+            0,
+            1,
+            65_535,
+            987_654_321,
+            i32::MAX,
+        ];
+        for w in (0..=65_536)
+            .step_by(7)
+            .chain([32_767, 32_768, 32_769, 65_535, 65_536])
+        {
+            for d in ds {
+                let exact = (d as i64 * w as i64) >> 16;
+                let got = super::part(d, w) as i64;
+                assert!((got - exact).abs() <= 1, "{d} × {w}: {got} vs {exact}");
+                // The M0's split product is exact for the operand `part` gives it.
+                let b = if w <= 1 << 15 { w } else { 65_536 - w };
+                let split = crate::q::mul_s_split::<16>(d, b) as i64;
+                assert_eq!(split, (d as i64 * b as i64) >> 16, "{d} × {b}");
+            }
+        }
+    }
+
+    /// `rsqrt` against `f64` over its whole domain (1 … 2⁶³, log-spaced, and each power of
+    /// two's neighbours), within 1e-7 relative; `scale_to` within one Q16 step.
+    #[test]
+    fn rsqrt_matches_f64() {
+        let mut worst = 0.0f64;
+        let mut xs: Vec<i64> = (0..63)
+            .flat_map(|k| [(1i64 << k) - 1, 1i64 << k, (1i64 << k) + 1])
+            .collect();
+        xs.extend((0..20_000).map(|i| 2f64.powf(i as f64 * 63.0 / 20_000.0) as i64));
+        xs.push(i64::MAX);
+        for x in xs.into_iter().filter(|&x| x > 0) {
+            let (y, e) = super::rsqrt(x);
+            let got = y as f64 * 2f64.powf(e as f64 / 2.0 - 62.0);
+            let rel = (got * (x as f64).sqrt() - 1.0).abs();
+            worst = worst.max(rel);
+        }
+        assert!(worst < 1e-7, "worst relative error {worst:e}");
+        for (r, x) in [
+            (3_000i32, 10_000_000i64),
+            (1 << 20, 1i64 << 41),
+            (77, 6_000),
+        ] {
+            let want = r as f64 / (x as f64).sqrt() * 65536.0;
+            let got = super::scale_to(r, x) as f64;
+            assert!((got - want).abs() <= 1.0, "{r} {x}: {got} vs {want}");
+        }
+    }
+
+    /// `tan_small` against `std` over its whole domain.
+    #[test]
+    fn tan_small_matches_std() {
+        let mut worst = 0.0f64;
+        for i in 1..=70_000 {
+            let x = i as f64 * 1e-5;
+            let rel = (super::tan_small(x) - x.tan()).abs() / x.tan();
+            worst = worst.max(rel);
+        }
+        assert!(worst < 1e-15, "worst relative error {worst:e}");
+        assert_eq!(super::tan_small(0.0), 0.0);
+    }
 }

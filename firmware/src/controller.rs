@@ -1,6 +1,11 @@
 //! `Controller`: one haptic tick end to end — device in, solver, device out — with the
 //! safe state and the run statistics the firmware reports.
 //!
+//! Contact, a type parameter (only the one used is compiled in): [`Glued`] (the probe
+//! holds the patch's contact node through a spring on all three axes, the indentation
+//! test's contact; probe in the patch frame) or [`Roaming`] (a proxy with friction on a
+//! tissue the patch follows as a window; probe in the tissue frame).
+//!
 //! Safe state: any device error (failing to read or to write) latches a [`Fault`] and
 //! puts the device in its safe state at once ([`HapticDevice::safe_state`]: zero duty
 //! first, then the drive cut); from then on every tick re-asserts the safe state and
@@ -8,7 +13,52 @@
 //! for another topology or tick rate is refused and counted; the solver keeps its set.
 
 use crate::device::HapticDevice;
-use mccs::{Arith, DefaultArith, Force, ParamSet, Solver};
+use mccs::{Arith, DefaultArith, Force, Length, ParamSet, Proxy, Solver, Window};
+
+/// How the probe touches the tissue: one tick of the solver with the probe read.
+pub trait Contact<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
+    /// One tick of `solver` with the probe at `probe` (mm); the force to render (N).
+    fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3];
+    /// Window shifts so far (0 for a contact without a window).
+    fn window_shifts(&self) -> u32 {
+        0
+    }
+}
+
+/// The probe glued to the patch's contact node through a spring on all three axes
+/// ([`Solver::step`], the indentation test's contact); the probe in the patch frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Glued;
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<NODES, EDGES, S, A>
+    for Glued
+{
+    fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3] {
+        solver.step(probe)
+    }
+}
+
+/// The probe touching a flat tissue through a proxy with friction, the patch following
+/// the contact as a window ([`Solver::step_roaming`]); the probe in the tissue frame.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Roaming<const EDGES: usize> {
+    /// The proxy (from `Solver::proxy`).
+    pub proxy: Proxy,
+    /// The window (from `Solver::window`).
+    pub window: Window<EDGES>,
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<NODES, EDGES, S, A>
+    for Roaming<EDGES>
+{
+    fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3] {
+        solver.step_roaming(probe, &mut self.proxy, &mut self.window)
+    }
+
+    fn window_shifts(&self) -> u32 {
+        self.window.shifts()
+    }
+}
 
 /// Why the controller is in its safe state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,6 +100,8 @@ pub struct Telemetry {
     pub overruns: u32,
     /// The safe state, if entered.
     pub fault: Option<Fault>,
+    /// Window shifts so far (roaming contact; 0 when glued).
+    pub window_shifts: u32,
     /// Parameter sets applied so far.
     pub swaps: u32,
     /// Parameter sets refused (prepared for another topology or tick rate).
@@ -68,6 +120,7 @@ impl Telemetry {
             steady_force: Force::ZERO,
             overruns: 0,
             fault: None,
+            window_shifts: 0,
             swaps: 0,
             rejected_swaps: 0,
             safe_state_errors: 0,
@@ -89,21 +142,45 @@ pub struct Controller<
     const EDGES: usize,
     const S: usize,
     A: Arith = DefaultArith,
+    C = Glued,
 > {
     solver: Solver<NODES, EDGES, S, A>,
+    contact: C,
     device: D,
     steady_tick: u32,
     telemetry: Telemetry,
 }
 
 impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
-    Controller<D, NODES, EDGES, S, A>
+    Controller<D, NODES, EDGES, S, A, Glued>
 {
-    /// A controller; the force along `z` at tick `steady_tick` (0-based) is recorded as
-    /// the steady force.
+    /// A controller with the probe glued to the patch ([`Glued`]); the force along `z` at
+    /// tick `steady_tick` (0-based) is recorded as the steady force.
     pub fn new(solver: Solver<NODES, EDGES, S, A>, device: D, steady_tick: u32) -> Self {
+        Self::with_contact(solver, Glued, device, steady_tick)
+    }
+}
+
+impl<
+        D: HapticDevice,
+        const NODES: usize,
+        const EDGES: usize,
+        const S: usize,
+        A: Arith,
+        C: Contact<NODES, EDGES, S, A>,
+    > Controller<D, NODES, EDGES, S, A, C>
+{
+    /// A controller with the probe touching the tissue through `contact`; the force along
+    /// `z` at tick `steady_tick` (0-based) is recorded as the steady force.
+    pub fn with_contact(
+        solver: Solver<NODES, EDGES, S, A>,
+        contact: C,
+        device: D,
+        steady_tick: u32,
+    ) -> Self {
         Self {
             solver,
+            contact,
             device,
             steady_tick,
             telemetry: Telemetry::new(),
@@ -126,7 +203,8 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A:
         } else {
             match self.device.read_position() {
                 Ok(probe) => {
-                    let force = self.solver.step(probe);
+                    let force = self.contact.step(&mut self.solver, probe);
+                    self.telemetry.window_shifts = self.contact.window_shifts();
                     if self.device.write_force(force).is_ok() {
                         force
                     } else {
@@ -176,6 +254,11 @@ impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A:
     /// The solver.
     pub fn solver(&self) -> &Solver<NODES, EDGES, S, A> {
         &self.solver
+    }
+
+    /// The contact.
+    pub fn contact(&self) -> &C {
+        &self.contact
     }
 
     /// The device.

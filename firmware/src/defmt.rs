@@ -23,6 +23,7 @@ impl Format for DemoError {
             Self::Solver(e) => write!(f, "{}", e),
             Self::Table(e) => write!(f, "{}", e),
             Self::Path(e) => write!(f, "{}", e),
+            Self::Contact(e) => write!(f, "{}", e),
         }
     }
 }

@@ -1,18 +1,19 @@
 //! The demo run, shared by the firmware (`firmware/src/bin/haptic.rs`) and the host (`mccs demo`)
-//! so that both run exactly the same thing: the Table 2 spring on a standard 2.5 mm patch,
-//! the probe replaying [`demo_path`] (2 s: approach, press to 1.2 mm, hold, 2 mm stroke,
-//! release), and 1.25 s in a switch to a stiffer tissue ([`swapped_params`]: the cone's
-//! shear modulus × 1.25), built by the main loop and handed over through a
-//! [`Mailbox`](crate::mailbox::Mailbox). Each core runs the [`DemoSpec`] that fits its
-//! instruction budget.
+//! so that both run exactly the same thing: a palpation ([`palpation_path`], 4 s: press,
+//! slide 30 mm, press harder, slide back, lift) through a proxy with friction on a flat
+//! 64 × 64 Table 2 tissue at 2.5 mm, which the core's standard patch follows as a window
+//! ([`Roaming`]); 1.25 s in, mid-slide, a switch to a stiffer tissue
+//! ([`swapped_params`]: the cone's shear modulus × 1.25), built by the main loop and
+//! handed over through a [`Mailbox`](crate::mailbox::Mailbox). Each core runs the
+//! [`DemoSpec`] that fits its instruction budget.
 
-use crate::controller::Controller;
+use crate::controller::{Controller, Roaming};
 use crate::device::SimulatedDevice;
-use crate::probe_path::{demo_path, PathError};
+use crate::probe_path::{palpation_path, PathError, ProbePath};
 use crate::target::Core;
 use mccs::{
-    Arith, ForceTable64, Narrow, ParamSet, Params, Solver, SolverConfig, SolverError, TableError,
-    Topology, TopologyError, Wide,
+    Arith, ForceTable64, Narrow, ParamSet, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
+    SolverError, TableError, Topology, TopologyError, Wide, WindowConfig,
 };
 
 /// A demo configuration: what each core runs within its instruction budget.
@@ -89,14 +90,14 @@ pub const fn spec_for(core: Core) -> DemoSpec {
 }
 
 impl DemoSpec {
-    /// Ticks in the run (2 s).
+    /// Ticks in the run (4 s).
     pub const fn ticks(&self) -> u32 {
-        2 * self.tick_hz
+        4 * self.tick_hz
     }
 
-    /// The tick whose `z` force is the steady force: the end of the hold (t = 1.0 s).
+    /// The tick whose `z` force is the steady force: the end of the first hold (t = 0.5 s).
     pub const fn steady_tick(&self) -> u32 {
-        self.tick_hz - 1
+        self.tick_hz / 2 - 1
     }
 
     /// The first tick on the swapped parameters (mid-stroke, t = 1.25 s).
@@ -124,8 +125,8 @@ impl DemoSpec {
     /// frames at once.
     pub fn controller<const N: usize, const E: usize, A: Arith>(
         &self,
-        table: ForceTable64,
-    ) -> Result<Controller<DemoDevice, N, E, 64, A>, DemoError> {
+        table: &ForceTable64,
+    ) -> Result<DemoControllerIn<N, E, A>, DemoError> {
         let mut slot = None;
         self.controller_into(table, &mut slot)?;
         slot.ok_or(DemoError::Path(PathError::Count))
@@ -135,15 +136,46 @@ impl DemoSpec {
     #[inline(never)]
     pub fn controller_into<const N: usize, const E: usize, A: Arith>(
         &self,
-        table: ForceTable64,
-        slot: &mut Option<Controller<DemoDevice, N, E, 64, A>>,
+        table: &ForceTable64,
+        slot: &mut Option<DemoControllerIn<N, E, A>>,
     ) -> Result<(), DemoError> {
         let topo = Topology::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
-        let device = SimulatedDevice::new(demo_path(self.tick_hz).map_err(DemoError::Path)?);
-        let solver = Solver::with_arith(topo, table, &self.config(), A::default())
+        let path = palpation_path(self.tick_hz).map_err(DemoError::Path)?;
+        let solver = Solver::with_arith(topo, *table, &self.config(), A::default())
             .map_err(DemoError::Solver)?;
-        *slot = Some(Controller::new(solver, device, self.steady_tick()));
+        let start = path.at(0).map(|c| c.to_num::<f64>());
+        let contact = self.roaming(&solver, start[0], start[1])?;
+        place(slot, solver, contact, path, self.steady_tick());
         Ok(())
+    }
+
+    /// The demo's contact for `solver`, the window centred at `(x, y)` (mm, tissue frame).
+    /// Out of line, like the other start-up builders.
+    #[inline(never)]
+    pub fn roaming<const N: usize, const E: usize, A: Arith>(
+        &self,
+        solver: &Solver<N, E, 64, A>,
+        x: f64,
+        y: f64,
+    ) -> Result<Roaming<E>, DemoError> {
+        let proxy = solver
+            .proxy(&self.proxy_config())
+            .map_err(DemoError::Contact)?;
+        let window = solver
+            .window(&WINDOW, &proxy, x, y)
+            .map_err(DemoError::Contact)?;
+        Ok(Roaming { proxy, window })
+    }
+
+    /// The proxy: the demo's friction and a point probe on this spec's patch.
+    pub fn proxy_config(&self) -> ProxyConfig {
+        ProxyConfig {
+            grid: self.grid,
+            spacing: SPACING,
+            mu_s: FRICTION.0,
+            mu_k: FRICTION.1,
+            probe_radius: 0.0,
+        }
     }
 
     /// The swapped parameter set for this spec's patch (software floating point: for the
@@ -159,15 +191,48 @@ impl DemoSpec {
     }
 }
 
-/// Grid spacing of the demo patch, mm.
+/// Builds the controller into `slot`. Out of line: the parts arrive by reference, and
+/// the controller's temporary is on this frame alone (the M0's start-up stack).
+#[inline(never)]
+fn place<const N: usize, const E: usize, A: Arith>(
+    slot: &mut Option<DemoControllerIn<N, E, A>>,
+    solver: Solver<N, E, 64, A>,
+    contact: Roaming<E>,
+    path: ProbePath<9>,
+    steady_tick: u32,
+) {
+    let device = SimulatedDevice::new(path);
+    *slot = Some(Controller::with_contact(
+        solver,
+        contact,
+        device,
+        steady_tick,
+    ));
+}
+
+/// Grid spacing of the demo patch and tissue, mm.
 pub const SPACING: f64 = 2.5;
 
+/// The demo's tissue (64 × 64 nodes, 157.5 mm a side) and window hysteresis (0.1
+/// spacing past the half).
+pub const WINDOW: WindowConfig = WindowConfig {
+    tissue_w: 64,
+    tissue_h: 64,
+    hysteresis: 0.1,
+};
+
+/// The demo's friction `(μ_s, μ_k)`.
+pub const FRICTION: (f64, f64) = (0.6, 0.4);
+
 /// The demo's device.
-pub type DemoDevice = SimulatedDevice<7>;
-/// A demo controller in this core's arithmetic with capacity for `NODES` node slots
-/// (the ground included) and `EDGES` springs.
+pub type DemoDevice = SimulatedDevice<9>;
+/// A demo controller in arithmetic `A` with capacity for `NODES` node slots (the ground
+/// included) and `EDGES` springs.
+pub type DemoControllerIn<const NODES: usize, const EDGES: usize, A> =
+    Controller<DemoDevice, NODES, EDGES, 64, A, Roaming<EDGES>>;
+/// A demo controller in this core's arithmetic.
 pub type DemoControllerOf<const NODES: usize, const EDGES: usize> =
-    Controller<DemoDevice, NODES, EDGES, 64>;
+    DemoControllerIn<NODES, EDGES, mccs::DefaultArith>;
 /// A demo controller with capacity for N = 8 (36 free nodes + ground, 214 springs): the
 /// M4F demo.
 pub type DemoController = DemoControllerOf<37, 214>;
@@ -193,6 +258,8 @@ pub enum DemoError {
     Table(TableError),
     /// The probe path.
     Path(PathError),
+    /// The proxy or the window.
+    Contact(ProxyError),
 }
 
 impl core::fmt::Display for DemoError {
@@ -202,6 +269,7 @@ impl core::fmt::Display for DemoError {
             Self::Solver(e) => e.fmt(f),
             Self::Table(e) => e.fmt(f),
             Self::Path(e) => e.fmt(f),
+            Self::Contact(e) => e.fmt(f),
         }
     }
 }
@@ -217,6 +285,8 @@ pub struct Summary {
     pub max_force: f32,
     /// Force along z at the steady tick, N.
     pub steady_force: f32,
+    /// Window shifts.
+    pub window_shifts: u32,
 }
 
 /// Runs the whole demo on the host (no overruns: nothing is timed), with the swap handed
@@ -232,7 +302,7 @@ pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
 
 fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
     static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
-    let mut ctl: Controller<DemoDevice, 37, 214, 64, A> = spec.controller(TABLE2)?;
+    let mut ctl: DemoControllerIn<37, 214, A> = spec.controller(&TABLE2)?;
     let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
     for tick in 0..spec.ticks() {
         let s = if tick >= spec.swap_tick() {
@@ -248,5 +318,6 @@ fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
         overruns: t.overruns,
         max_force: t.max_force.to_num(),
         steady_force: t.steady_force.to_num(),
+        window_shifts: t.window_shifts,
     })
 }

@@ -6,6 +6,7 @@ use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
 use mccs::{
     Arith, DefaultArith, Edge, Force, ForceTable64, Length, Proxy, Solver, Stiffness, Strain,
+    Window,
 };
 
 /// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
@@ -57,4 +58,15 @@ pub fn tick_proxy<const N: usize, const E: usize>(
     proxy: &mut Proxy,
 ) -> [Force; 3] {
     solver.step_proxy(probe, proxy)
+}
+
+/// One tick of a solver roaming a tissue through a proxy, never inlined.
+#[inline(never)]
+pub fn tick_roaming<const N: usize, const E: usize>(
+    solver: &mut Solver<N, E, 64>,
+    probe: [Length; 3],
+    proxy: &mut Proxy,
+    window: &mut Window<E>,
+) -> [Force; 3] {
+    solver.step_roaming(probe, proxy, window)
 }

@@ -33,7 +33,7 @@ pub mod target;
 #[cfg(feature = "defmt")]
 mod defmt;
 
-pub use controller::{Controller, Fault, Telemetry};
+pub use controller::{Contact, Controller, Fault, Glued, Roaming, Telemetry};
 pub use device::{HapticDevice, SimulatedDevice};
 pub use mailbox::{Mailbox, Shared};
-pub use probe_path::{demo_path, PathError, ProbePath, Waypoint};
+pub use probe_path::{indentation_path, palpation_path, PathError, ProbePath, Waypoint};

@@ -124,22 +124,54 @@ impl<const K: usize> ProbePath<K> {
     }
 }
 
-/// The demo trajectory: 2 s of approach, press, hold, stroke and release over the
-/// contact node, at `tick_hz` (waypoint times scale with it). Depth 1.2 mm below the
-/// surface, stroke 2 mm along `x`.
-pub fn demo_path(tick_hz: u32) -> Result<ProbePath<7>, PathError> {
-    // (time in s, position in mm)
-    const LEGS: [(f64, [f64; 3]); 7] = [
-        (0.0, [0.0, 0.0, 1.0]),
-        (0.3, [0.0, 0.0, 0.0]),
-        (0.7, [0.0, 0.0, -1.2]),
-        (1.0, [0.0, 0.0, -1.2]),
-        (1.5, [2.0, 0.0, -1.2]),
-        (1.8, [2.0, 0.0, 1.0]),
-        (2.0, [2.0, 0.0, 1.0]),
-    ];
-    ProbePath::new(&LEGS.map(|(s, position)| Waypoint {
+/// Builds a path from `(time in s, position in mm)` legs at `tick_hz`.
+fn path_of<const K: usize>(
+    legs: [(f64, [f64; 3]); K],
+    tick_hz: u32,
+) -> Result<ProbePath<K>, PathError> {
+    ProbePath::new(&legs.map(|(s, position)| Waypoint {
         tick: (s * tick_hz as f64) as u32,
         position,
     }))
+}
+
+/// The demo's palpation (tissue frame, mm; the tissue's top at `z = 0`), 4 s at
+/// `tick_hz` (waypoint times scale with it): press 1 mm deep at `x = −15` (0.3 s), hold
+/// (0.2 s), slide 30 mm along `x` (1.2 s), press to 1.5 mm (0.2 s), hold (0.2 s), slide
+/// back (1.2 s), lift (0.3 s), rest (0.4 s). `y = 0.4` keeps the stroke off the grid's
+/// node lines.
+pub fn palpation_path(tick_hz: u32) -> Result<ProbePath<9>, PathError> {
+    const Y: f64 = 0.4;
+    path_of(
+        [
+            (0.0, [-15.0, Y, 1.0]),
+            (0.3, [-15.0, Y, -1.0]),
+            (0.5, [-15.0, Y, -1.0]),
+            (1.7, [15.0, Y, -1.0]),
+            (1.9, [15.0, Y, -1.5]),
+            (2.1, [15.0, Y, -1.5]),
+            (3.3, [-15.0, Y, -1.5]),
+            (3.6, [-15.0, Y, 1.0]),
+            (4.0, [-15.0, Y, 1.0]),
+        ],
+        tick_hz,
+    )
+}
+
+/// An indentation over the glued contact node (patch frame, mm), 2 s at `tick_hz`:
+/// approach, press to 1.2 mm below the surface, hold, a 2 mm stroke along `x` (which
+/// drags the glued node), release.
+pub fn indentation_path(tick_hz: u32) -> Result<ProbePath<7>, PathError> {
+    path_of(
+        [
+            (0.0, [0.0, 0.0, 1.0]),
+            (0.3, [0.0, 0.0, 0.0]),
+            (0.7, [0.0, 0.0, -1.2]),
+            (1.0, [0.0, 0.0, -1.2]),
+            (1.5, [2.0, 0.0, -1.2]),
+            (1.8, [2.0, 0.0, 1.0]),
+            (2.0, [2.0, 0.0, 1.0]),
+        ],
+        tick_hz,
+    )
 }

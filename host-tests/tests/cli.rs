@@ -683,7 +683,7 @@ fn help_usage_and_the_demo_check() {
     let host = String::from_utf8(mccs(&["demo", "--core", "m3"]).stdout).unwrap();
     let summary = host.trim();
     let start = "INFO  mccs haptic demo: core=m3 tick=1000 Hz, …";
-    let cases: [(&str, String, Option<i32>); 6] = [
+    let cases: [(&str, String, Option<i32>); 7] = [
         (
             "good.log",
             format!("{start}\nINFO  tick=100 …\n{summary}\n"),
@@ -707,7 +707,15 @@ fn help_usage_and_the_demo_check() {
         ),
         (
             "digits.log",
-            format!("{start}\n{}\n", summary.replace("ticks=2000", "ticks=1999")),
+            format!("{start}\n{}\n", summary.replace("ticks=4000", "ticks=3999")),
+            Some(1),
+        ),
+        (
+            "shifts.log",
+            format!(
+                "{start}\n{}\n",
+                summary.replace("window_shifts=", "window_shifts=9")
+            ),
             Some(1),
         ),
     ];

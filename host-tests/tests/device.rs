@@ -10,13 +10,16 @@ use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as Pin
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
 use embedded_hal_mock::eh1::spi::{Mock as SpiMock, Transaction as SpiTx};
 use embedded_hal_mock::eh1::MockError;
-use mccs::{Force, ForceTable64, Length, Params, Solver, SolverConfig, SolverError, Topology};
+use mccs::{
+    Force, ForceTable64, Length, Params, ProxyConfig, Solver, SolverConfig, SolverError, Topology,
+    WindowConfig,
+};
 use mccs_firmware::drivers::as5047p::{
     self, decode, read_command, As5047p, EncoderConfig, Frame, ANGLECOM, DIAAGC, DIAAGC_LF, ERRFL,
 };
 use mccs_firmware::drivers::pwm_motor::{MotorConfig, MotorConfigError, PwmMotor};
 use mccs_firmware::one_dof::OneDofDevice;
-use mccs_firmware::{Controller, Fault, HapticDevice};
+use mccs_firmware::{Controller, Fault, HapticDevice, Roaming};
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -495,12 +498,33 @@ fn solver() -> Solver<10, 61, 64> {
     .unwrap()
 }
 
+/// The roaming contact (issue #19) for [`solver`]: friction 0.6 / 0.4, the window on a
+/// 64 × 64 tissue centred under the 1-DOF probe.
+fn roaming(s: &Solver<10, 61, 64>) -> Roaming<61> {
+    let proxy = s
+        .proxy(&ProxyConfig {
+            grid: 5,
+            spacing: 2.5,
+            mu_s: 0.6,
+            mu_k: 0.4,
+            probe_radius: 0.0,
+        })
+        .unwrap();
+    let wc = WindowConfig {
+        tissue_w: 64,
+        tissue_h: 64,
+        hysteresis: 0.1,
+    };
+    let window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
+    Roaming { proxy, window }
+}
+
 /// A 1-DOF device on fakes, the probe pressing in and out (so that the direction
-/// turns), with faults at `spi`, `pin` and `pwm` calls; 400 ticks of a controller.
-/// Returns the tick of the first failure, the tick the fault latched, and whether the
-/// actuator was driven (duty above zero with the driver enabled) at the end of every
-/// tick.
-fn run(spi: Fail, pin: Fail, pwm: Fail) -> (Option<usize>, Option<usize>, Vec<u16>) {
+/// turns), with faults at `spi`, `pin` and `pwm` calls; 400 ticks of a controller, its
+/// probe glued or (`roam`) roaming. Returns the tick of the first failure, the tick the
+/// fault latched, and whether the actuator was driven (duty above zero with the driver
+/// enabled) at the end of every tick.
+fn run_as(spi: Fail, pin: Fail, pwm: Fail, roam: bool) -> (Option<usize>, Option<usize>, Vec<u16>) {
     let log = Rc::new(RefCell::new(Log::default()));
     // 0.3 mm of travel per 100 counts; down to −3 mm and back, every 100 ticks.
     let sensor = Sensor::new(|n| {
@@ -514,21 +538,37 @@ fn run(spi: Fail, pin: Fail, pwm: Fail) -> (Option<usize>, Option<usize>, Vec<u1
     });
     sensor.0.borrow_mut().fail = Box::new(move |n| spi.at(n));
     let device = rig(&log, sensor, pwm, pin);
-    let mut ctl = Controller::new(solver(), device, 0);
+    // One tick, returning the telemetry after it: the controller glued or roaming.
+    let mut tick: Box<dyn FnMut() -> mccs_firmware::Telemetry> = if roam {
+        let s = solver();
+        let c = roaming(&s);
+        let mut ctl = Controller::with_contact(s, c, device, 0);
+        Box::new(move || {
+            ctl.tick(None);
+            ctl.telemetry()
+        })
+    } else {
+        let mut ctl = Controller::new(solver(), device, 0);
+        Box::new(move || {
+            ctl.tick(None);
+            ctl.telemetry()
+        })
+    };
     let mut duties = Vec::new();
     let (mut first_failure, mut latched) = (None, None);
+    let mut before = mccs_firmware::Telemetry::new();
     for t in 0..400 {
-        let before = (ctl.telemetry().safe_state_errors, ctl.telemetry().fault);
         let seen = log.borrow().duties.len();
-        ctl.tick(None);
+        let now = tick();
         let failed_now = spi.at(t)
             || log.borrow().duties.len() < seen + 1
-            || ctl.telemetry().fault != before.1
-            || ctl.telemetry().safe_state_errors != before.0;
+            || now.fault != before.fault
+            || now.safe_state_errors != before.safe_state_errors;
+        before = now;
         if failed_now && first_failure.is_none() {
             first_failure = Some(t);
         }
-        if ctl.telemetry().fault.is_some() && latched.is_none() {
+        if now.fault.is_some() && latched.is_none() {
             latched = Some(t);
             assert!(!log.borrow().enabled || pin != Fail::Never || pwm != Fail::Never);
         }
@@ -542,30 +582,36 @@ fn run(spi: Fail, pin: Fail, pwm: Fail) -> (Option<usize>, Option<usize>, Vec<u1
 /// once and failing forever: the actuator is off (zero duty, or the driver disabled
 /// where the PWM refuses every write) at the end of the tick the fault is found in, and
 /// at the end of every tick after (the safe state re-asserted every tick).
+/// The same with the probe glued and roaming (issue #19's contact: the fault path does
+/// not depend on it).
 #[test]
 fn a_fault_at_any_call_site_ends_at_the_actuator() {
-    let (_, latched, duties) = run(Fail::Never, Fail::Never, Fail::Never);
-    assert_eq!(latched, None);
-    assert!(
-        duties.iter().filter(|&&d| d > 0).count() > 100,
-        "it renders"
-    );
-    for schedule in [Fail::Once(150), Fail::From(150)] {
-        for site in ["spi", "direction", "pwm"] {
-            let (spi, pin, pwm) = match site {
-                "spi" => (schedule, Fail::Never, Fail::Never),
-                // The pin is written when the direction changes: the force on this
-                // 1-DOF probe always pushes up, so its one call is the first contact.
-                "direction" => (Fail::Never, shift(schedule, 0), Fail::Never),
-                _ => (Fail::Never, Fail::Never, shift(schedule, 150)),
-            };
-            let (_, latched, duties) = run(spi, pin, pwm);
-            let t = latched.unwrap_or_else(|| panic!("{site} {schedule:?}: no fault latched"));
-            assert!(
-                duties[t..].iter().all(|&d| d == 0),
-                "{site} {schedule:?}: duty after the fault at tick {t}: {:?}",
-                &duties[t..(t + 10).min(duties.len())]
-            );
+    for roam in [false, true] {
+        let (_, latched, duties) = run_as(Fail::Never, Fail::Never, Fail::Never, roam);
+        assert_eq!(latched, None);
+        assert!(
+            duties.iter().filter(|&&d| d > 0).count() > 100,
+            "roam {roam}: it renders"
+        );
+        for schedule in [Fail::Once(150), Fail::From(150)] {
+            for site in ["spi", "direction", "pwm"] {
+                let (spi, pin, pwm) = match site {
+                    "spi" => (schedule, Fail::Never, Fail::Never),
+                    // The pin is written when the direction changes: the force on this
+                    // 1-DOF probe always pushes up, so its one call is the first contact.
+                    "direction" => (Fail::Never, shift(schedule, 0), Fail::Never),
+                    _ => (Fail::Never, Fail::Never, shift(schedule, 150)),
+                };
+                let (_, latched, duties) = run_as(spi, pin, pwm, roam);
+                let t = latched.unwrap_or_else(|| {
+                    panic!("roam {roam}: {site} {schedule:?}: no fault latched")
+                });
+                assert!(
+                    duties[t..].iter().all(|&d| d == 0),
+                    "roam {roam}: {site} {schedule:?}: duty after the fault at tick {t}: {:?}",
+                    &duties[t..(t + 10).min(duties.len())]
+                );
+            }
         }
     }
 }

@@ -4,7 +4,7 @@
 use mccs::{
     Arith, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, SolverError, Topology, Wide,
 };
-use mccs_firmware::demo_path;
+use mccs_firmware::indentation_path;
 use mccs_host::patch::{substeps, Mesh, Twin, TwinConfig, V};
 use mccs_host::reference::Reference;
 use nalgebra::{DMatrix, DVector};
@@ -211,7 +211,7 @@ fn narrow_dynamics_with_little_no_or_most_spring_damping() {
 fn dynamics<A: Arith>(name: &str, cfg: SolverConfig) {
     let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
     let mut t = twin(5, 2.5, &cfg, f.substeps());
-    let path = demo_path(1000).unwrap();
+    let path = indentation_path(1000).unwrap();
     let (mut peak, mut sum_sq, mut max_err, mut count) = (0.0f64, 0.0, 0.0f64, 0.0);
     for tick in 0..2000 {
         let p = path.at(tick);
@@ -227,7 +227,7 @@ fn dynamics<A: Arith>(name: &str, cfg: SolverConfig) {
     }
     let rms = (sum_sq / count).sqrt();
     println!(
-        "{name}: demo path, N=5: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
+        "{name}: indentation path, N=5: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
         rms / peak,
         max_err / peak
     );

@@ -1,6 +1,6 @@
-//! The haptic firmware: the MCCS patch solver in a 1 kHz SysTick interrupt, driving a
-//! simulated device that replays the demo probe path (see `mccs_firmware::demo`), logging with
-//! defmt. Runs in QEMU on `netduinoplus2` (Cortex-M4F, the default), `lm3s6965evb`
+//! The haptic firmware: the MCCS patch solver in a 1 kHz SysTick interrupt, roaming a
+//! tissue under a simulated device that replays the demo's palpation (see
+//! `mccs_firmware::demo`), logging with defmt. Runs in QEMU on `netduinoplus2` (Cortex-M4F, the default), `lm3s6965evb`
 //! (Cortex-M3) and `microbit` (Cortex-M0); see docs/firmware.md.
 //!
 //! - The tick interrupt owns the controller (solver + device). The main loop reads the
@@ -90,10 +90,12 @@ mod firmware {
         }
         let swap_substeps = post_swap();
         defmt::info!(
-            "mccs haptic demo: core={=str} tick={=u32} Hz, N={=usize} patch, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
+            "mccs haptic demo: core={=str} tick={=u32} Hz, N={=usize} window on a {=usize} x {=usize} tissue, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
             SPEC.core,
             SPEC.tick_hz,
             SPEC.grid,
+            demo::WINDOW.tissue_w,
+            demo::WINDOW.tissue_h,
             info.springs,
             info.substeps,
             swap_substeps,
@@ -114,11 +116,12 @@ mod firmware {
             if t.ticks >= next_trace && t.ticks > 0 {
                 next_trace = t.ticks + TRACE_EVERY;
                 defmt::info!(
-                    "tick={=u32} force_n=({=f32}, {=f32}, {=f32})",
+                    "tick={=u32} force_n=({=f32}, {=f32}, {=f32}) window_shifts={=u32}",
                     t.ticks,
                     t.force[0].to_num::<f32>(),
                     t.force[1].to_num::<f32>(),
-                    t.force[2].to_num::<f32>()
+                    t.force[2].to_num::<f32>(),
+                    t.window_shifts
                 );
             }
             if let Some(fault) = t.fault {
@@ -136,11 +139,12 @@ mod firmware {
                     SPEC.budget()
                 );
                 defmt::println!(
-                    "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32}",
+                    "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32}",
                     t.ticks,
                     t.overruns,
                     t.max_force.to_num::<f32>(),
-                    t.steady_force.to_num::<f32>()
+                    t.steady_force.to_num::<f32>(),
+                    t.window_shifts
                 );
                 exit(t.fault.is_none());
             }
@@ -154,6 +158,13 @@ mod firmware {
             init(CTL);
             return;
         };
+        run_tick(ctl);
+    }
+
+    /// One tick, timed. Out of line: its frame (the swapped set's copy among it) is not
+    /// under `init`'s on the first run (the M0's 16 KiB of RAM).
+    #[inline(never)]
+    fn run_tick(ctl: &mut Ctl) {
         let ticks = ctl.telemetry().ticks;
         if ticks >= SPEC.ticks() {
             return;
@@ -191,7 +202,7 @@ mod firmware {
     /// space is free again before the ticks start (the M0 has 16 KiB of RAM).
     #[inline(never)]
     fn init(slot: &mut Option<Ctl>) {
-        if SPEC.controller_into(TABLE2, slot).is_err() {
+        if SPEC.controller_into(&TABLE2, slot).is_err() {
             *slot = None;
         }
         if let Some(ctl) = slot {

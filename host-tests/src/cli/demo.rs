@@ -13,7 +13,7 @@ pub(super) struct Args {
     core: String,
     /// A decoded firmware log (scripts/firmware.sh's output) to check against the host's
     /// run: exit 0 when it is this core's demo log and its SUMMARY line has the host's
-    /// ticks and forces (to the printed digit) and overruns=0; exit 1 when it does not;
+    /// ticks, forces (to the printed digit) and window shifts, and overruns=0; exit 1 when it does not;
     /// exit 2 when the file cannot be read or is not this core's demo log.
     #[arg(long)]
     check: Option<PathBuf>,
@@ -23,8 +23,8 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let spec = demo::spec(&a.core).ok_or_else(|| arg_error("--core", "must be m4f, m3 or m0"))?;
     let host = demo::run_on_host(&spec).map_err(|e| CliError::new(format!("demo: {e}")))?;
     let line = format!(
-        "SUMMARY ticks={} overruns={} max_force_n={} steady_force_n={}",
-        host.ticks, host.overruns, host.max_force, host.steady_force
+        "SUMMARY ticks={} overruns={} max_force_n={} steady_force_n={} window_shifts={}",
+        host.ticks, host.overruns, host.max_force, host.steady_force, host.window_shifts
     );
     match a.check {
         None => writeln!(out, "{line}").map_err(io_error),
@@ -43,10 +43,12 @@ pub struct FirmwareSummary {
     pub max_force: f32,
     /// Steady force, N.
     pub steady_force: f32,
+    /// Window shifts.
+    pub window_shifts: u32,
 }
 
-/// Parses a `SUMMARY ticks=… overruns=… max_force_n=… steady_force_n=…` line: exactly
-/// these four fields, in this order.
+/// Parses a `SUMMARY ticks=… overruns=… max_force_n=… steady_force_n=… window_shifts=…`
+/// line: exactly these five fields, in this order.
 pub fn parse_summary(line: &str) -> Option<FirmwareSummary> {
     let mut fields = line.trim().strip_prefix("SUMMARY ")?.split_whitespace();
     let mut next = |name: &str| -> Option<String> {
@@ -58,6 +60,7 @@ pub fn parse_summary(line: &str) -> Option<FirmwareSummary> {
         overruns: next("overruns")?.parse().ok()?,
         max_force: next("max_force_n")?.parse().ok()?,
         steady_force: next("steady_force_n")?.parse().ok()?,
+        window_shifts: next("window_shifts")?.parse().ok()?,
     };
     fields.next().is_none().then_some(s)
 }
@@ -105,14 +108,15 @@ fn check_demo_log(
     let ok = fw.overruns == 0
         && fw.ticks == host.ticks
         && fw.steady_force == host.steady_force
-        && fw.max_force == host.max_force;
+        && fw.max_force == host.max_force
+        && fw.window_shifts == host.window_shifts;
     writeln!(out, "host:     {host_line}").map_err(io_error)?;
     writeln!(out, "firmware: {last}").map_err(io_error)?;
     if ok {
         writeln!(out, "demo check: ok").map_err(io_error)
     } else {
         Err(CliError::check_failed(format!(
-            "{name}: SUMMARY differs from the host's run (needs overruns=0, the same ticks and forces to the printed digit)"
+            "{name}: SUMMARY differs from the host's run (needs overruns=0, the same ticks, forces to the printed digit and window shifts)"
         )))
     }
 }

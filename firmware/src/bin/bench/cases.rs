@@ -1,6 +1,7 @@
 //! The measured cases: one table evaluation, one spring, one substep of the standard
-//! patch (fixed point and floating point), one tick of this core's demo, and one tick of
-//! its patch through a sliding proxy.
+//! patch (fixed point and floating point), one tick of this core's demo, one tick of its
+//! patch through a sliding proxy, and the ticks of the demo's roaming (with and without a
+//! window shift).
 
 use super::fw_common::exit;
 use super::harness::Harness;
@@ -259,4 +260,84 @@ fn tick_proxy_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable
             &mut proxy,
         ));
     })
+}
+
+/// The demo's roaming ticks (`DemoSpec::roaming`: its patch as a window on the 64 × 64
+/// tissue, friction 0.6 / 0.4): a press to 1 mm at `x = −5` (200 ticks), then a slide
+/// along `x` at 10 mm/s for 1000 ticks (4 window shifts), each tick measured alone.
+#[derive(Clone, Copy)]
+pub struct RoamingTicks {
+    /// The longest tick of the slide without a shift.
+    pub steady: u32,
+    /// The longest tick with a shift.
+    pub shift: u32,
+    /// The most a shift tick took over the tick before it: the shift's own cost.
+    pub shift_extra: u32,
+}
+
+/// [`RoamingTicks`] for this core's demo patch; `empty` is the harness's own count.
+#[inline(never)]
+pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    match demo::spec_for(CORE).grid {
+        8 => roaming_in::<37, 214>(h, table, empty),
+        5 => roaming_in::<10, 61>(h, table, empty),
+        _ => roaming_in::<5, 30>(h, table, empty),
+    }
+}
+
+#[inline(never)]
+fn roaming_in<const N: usize, const E: usize>(
+    h: &Harness,
+    table: &ForceTable64,
+    empty: u32,
+) -> RoamingTicks {
+    let spec = demo::spec_for(CORE);
+    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) else {
+        exit(false)
+    };
+    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
+        exit(false)
+    };
+    let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
+    let Ok(mut c) = spec.roaming(&s, -5.0, 0.4) else {
+        exit(false)
+    };
+    let depth = Length::from_num(-1);
+    for k in 0..200 {
+        let z = depth / 200 * k;
+        e::tick_roaming(&mut s, [x0, y, z], &mut c.proxy, &mut c.window);
+    }
+    let step = Length::from_num(0.01);
+    let mut x = x0;
+    let mut out = RoamingTicks {
+        steady: 0,
+        shift: 0,
+        shift_extra: 0,
+    };
+    let mut last = 0;
+    for _ in 0..1000 {
+        x += step;
+        let before = c.window.shifts();
+        let n = h
+            .measure(1, || {
+                black_box(e::tick_roaming(
+                    &mut s,
+                    black_box([x, y, depth]),
+                    &mut c.proxy,
+                    &mut c.window,
+                ));
+            })
+            .saturating_sub(empty);
+        if c.window.shifts() != before {
+            out.shift = out.shift.max(n);
+            out.shift_extra = out.shift_extra.max(n.saturating_sub(last));
+        } else {
+            out.steady = out.steady.max(n);
+        }
+        last = n;
+    }
+    if c.window.shifts() < 3 || !c.proxy.slipping() {
+        exit(false)
+    }
+    out
 }

@@ -101,6 +101,12 @@ mod firmware {
         figs.report("tick", cases::tick(&h, &table, probe) - empty);
         // One tick of the demo's patch through a sliding proxy (issue #19).
         figs.report("tick_proxy", cases::tick_proxy(&h, &table) - empty);
+        // The demo's roaming: the longest tick without and with a window shift, and a
+        // shift's own cost (the most a shift tick took over the tick before).
+        let roam = cases::roaming(&h, &table, empty);
+        figs.report("tick_roaming", roam.steady);
+        figs.report("tick_roaming_shift", roam.shift);
+        figs.report("window_shift", roam.shift_extra);
         let mem = [
             ("solver_n4", core::mem::size_of::<Solver<5, 30, 64>>()),
             ("solver_n5", core::mem::size_of::<Solver<10, 61, 64>>()),
