@@ -10,7 +10,7 @@ LOG_DIR=target/logs/demo
 mkdir -p "$LOG_DIR"
 run_stage build-decoder cargo build -p defmt-log
 run_stage build-firmware cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
-say "...  running the firmware in QEMU (Cortex-M4F, 2 s of simulated ticks)"
+say "...  running the firmware in QEMU (Cortex-M4F, 4 s of simulated ticks: a palpation)"
 start=$SECONDS
 bash scripts/firmware.sh m4f
 say "ok   demo ($((SECONDS - start)) s)"
