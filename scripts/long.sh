@@ -15,8 +15,8 @@ mkdir -p target/logs/long
 log=target/logs/long/properties.log
 echo "long.sh: the short-trajectory properties at $cases cases per arithmetic (log: $log)" >&2
 start=$(date +%s)
-PROPTEST_CASES=$cases cargo test --release -p mccs-host --test solver_properties \
-    -- --show-output short_trajectories > "$log" 2>&1 &
+PROPTEST_CASES=$cases cargo test --release -p mccs-host --test host \
+    -- --show-output solver_properties::short_trajectories > "$log" 2>&1 &
 pid=$!
 while kill -0 "$pid" 2>/dev/null; do
   sleep 10
@@ -25,12 +25,12 @@ done
 wait "$pid" || { echo "long.sh: the properties failed; see $log" >&2; exit 1; }
 settle=$(( cases / 100 > 60 ? cases / 100 : 60 ))
 echo "long.sh: the settling properties at $settle cases per arithmetic" >&2
-PROPTEST_CASES=$settle cargo test --release -p mccs-host --test solver_properties \
-    -- --show-output after_lift_off >> "$log" 2>&1 || { echo "long.sh: the settling properties failed; see $log" >&2; exit 1; }
+PROPTEST_CASES=$settle cargo test --release -p mccs-host --test host \
+    -- --show-output solver_properties::after_lift_off >> "$log" 2>&1 || { echo "long.sh: the settling properties failed; see $log" >&2; exit 1; }
 grep -E "^PROPERTY " "$log"
 echo "long.sh: the force-table bound over 10^5 random springs (a few minutes)" >&2
-TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test table_bound \
-    -- --show-output every_table > target/logs/long/table_bound.log 2>&1 \
+TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test host \
+    -- --show-output table_bound::every_table > target/logs/long/table_bound.log 2>&1 \
   || { echo "long.sh: the table bound failed; see target/logs/long/table_bound.log" >&2; exit 1; }
 grep -E "^TABLEBOUND " target/logs/long/table_bound.log
 echo "long.sh: properties done in $(( $(date +%s) - start )) s; fuzzing $fuzz_seconds s per target" >&2

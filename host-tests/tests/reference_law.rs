@@ -1,7 +1,7 @@
 //! The f64 reference law against an independent coil-by-coil oracle, its invariants,
 //! its two inverses against each other, and random springs (proptest).
 
-mod common;
+use crate::common;
 
 use common::any_spring;
 use mccs::{Cone, ParamError, ParamKey, Params};

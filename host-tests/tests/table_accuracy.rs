@@ -3,7 +3,7 @@
 //! `cargo test -p mccs-host --test table_accuracy -- --nocapture` prints the figures the
 //! docs/accuracy.md reports (max and RMS error per knot count, linear vs Hermite, bytes).
 
-mod common;
+use crate::common;
 
 use mccs::arith::{narrow::table_force, ArithTable};
 use mccs::{ForceTable, Narrow, Params, Strain};

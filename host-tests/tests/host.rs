@@ -1,0 +1,48 @@
+//! The host tests, one binary (each `tests/<name>.rs` a module): one link and one
+//! build of the generic core for all of them instead of one per file. Run one file's
+//! tests with `cargo test -p mccs-host --test host <name>::`.
+
+mod common;
+
+#[path = "architecture.rs"]
+mod architecture;
+#[path = "arith.rs"]
+mod arith;
+#[path = "cli.rs"]
+mod cli;
+#[path = "demo.rs"]
+mod demo;
+#[path = "device.rs"]
+mod device;
+#[path = "docs.rs"]
+mod docs;
+#[path = "fit.rs"]
+mod fit;
+#[path = "float_patch.rs"]
+mod float_patch;
+#[path = "patch.rs"]
+mod patch;
+#[path = "proxy.rs"]
+mod proxy;
+#[path = "reference_law.rs"]
+mod reference_law;
+#[path = "replay.rs"]
+mod replay;
+#[path = "roam.rs"]
+mod roam;
+#[path = "solver_properties.rs"]
+mod solver_properties;
+#[path = "spring_sweep.rs"]
+mod spring_sweep;
+#[path = "stability.rs"]
+mod stability;
+#[path = "swap.rs"]
+mod swap;
+#[path = "table_accuracy.rs"]
+mod table_accuracy;
+#[path = "table_bound.rs"]
+mod table_bound;
+#[path = "table_edges.rs"]
+mod table_edges;
+#[path = "table_source.rs"]
+mod table_source;
