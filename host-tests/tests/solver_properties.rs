@@ -21,10 +21,10 @@
 use mccs::arith::Arith;
 use mccs::units::{DIR_FRAC, INV_LEN_FRAC};
 use mccs::{
-    Bound, Coupling, Force, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, Topology,
-    Velocity, Wide,
+    Bound, Coupling, Force, ForceTable64, Length, Narrow, Params, ProxyConfig, Solver,
+    SolverConfig, Topology, Velocity, Wide, WindowConfig,
 };
-use mccs_firmware::{Controller, HapticDevice};
+use mccs_firmware::{Contact, Controller, HapticDevice, Roaming};
 use mccs_host::reference::Reference;
 use proptest::prelude::*;
 use std::sync::OnceLock;
@@ -160,10 +160,15 @@ impl HapticDevice for Device {
     }
 }
 
+/// A roaming contact for a short run: friction `(μ_s, μ_k)` and the probe's radius as a
+/// fraction of half a spacing.
+type Roam = ((f64, f64), f64);
+
 fn short_run<A: Arith>(
     case: &Case,
     path: Vec<(u32, [f64; 3])>,
     fail: Option<(u32, bool)>,
+    roam: Option<Roam>,
     seen: &std::sync::Mutex<Seen>,
 ) -> Result<(), TestCaseError> {
     let s = solver::<A>(case);
@@ -172,14 +177,48 @@ fn short_run<A: Arith>(
         "the stability bound refuses this configuration"
     );
     let s = s.unwrap();
-    let max = Force::from_num(case.config.coupling.max_force) + Force::DELTA;
     let dev = Device {
         path,
         tick: 0,
         fail,
         written: Vec::new(),
     };
-    let mut ctl = Controller::new(s, dev, 0);
+    match roam {
+        None => drive(case, Controller::new(s, dev, 0), false, seen),
+        Some(((mu_s, mu_k), r)) => {
+            let proxy = s
+                .proxy(&ProxyConfig {
+                    grid: case.grid,
+                    spacing: case.spacing,
+                    mu_s,
+                    mu_k,
+                    probe_radius: r * case.spacing / 2.0,
+                })
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let wc = WindowConfig {
+                tissue_w: 16,
+                tissue_h: 16,
+                hysteresis: 0.1,
+            };
+            let window = s
+                .window(&wc, &proxy, 0.0, 0.0)
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let ctl = Controller::with_contact(s, Roaming { proxy, window }, dev, 0);
+            drive(case, ctl, true, seen)
+        }
+    }
+}
+
+/// 200 ticks of `ctl`: the force within the device maximum (and, roaming, never pulling
+/// the probe into the tissue); after a device fault, zero on every tick and only zeros
+/// written from the safe state on.
+fn drive<A: Arith, C: Contact<10, 61, 64, A>>(
+    case: &Case,
+    mut ctl: Controller<Device, 10, 61, 64, A, C>,
+    roaming: bool,
+    seen: &std::sync::Mutex<Seen>,
+) -> Result<(), TestCaseError> {
+    let max = Force::from_num(case.config.coupling.max_force) + Force::DELTA;
     let mut faulted_at = None;
     let mut peak = Force::ZERO;
     for t in 0..200u32 {
@@ -188,6 +227,9 @@ fn short_run<A: Arith>(
             f.iter().all(|c| c.abs() <= max),
             "tick {t}: {f:?} beyond {max}"
         );
+        if roaming {
+            prop_assert!(f[2] >= Force::ZERO, "tick {t}: {f:?} pulls the probe in");
+        }
         peak = f.iter().fold(peak, |m, c| m.max(c.abs()));
         if ctl.telemetry().fault.is_some() {
             faulted_at.get_or_insert(ctl.device().written.len());
@@ -204,6 +246,7 @@ fn short_run<A: Arith>(
     }
     let mut s = seen.lock().unwrap();
     s.cases += 1;
+    s.roaming += roaming as u64;
     s.ticks += 200;
     s.faults += faulted_at.is_some() as u64;
     s.force_of_max = s
@@ -251,6 +294,8 @@ fn run_cases<S: Strategy>(
 #[derive(Default)]
 struct Seen {
     cases: u64,
+    /// Cases with the roaming contact (the others glued).
+    roaming: u64,
     ticks: u64,
     faults: u64,
     /// The largest |force| over the device maximum.
@@ -266,13 +311,14 @@ fn short<A: Arith>(name: &str) {
             any_case(3..=4),
             any_path(200),
             prop::option::weighted(0.3, (1u32..200, any::<bool>())),
+            prop::option::weighted(0.3, ((0.0f64..2.0, 0.0f64..2.0), 0.0f64..1.0)),
         ),
-        |(case, path, fail)| short_run::<A>(&case, path, fail, &seen),
+        |(case, path, fail, roam)| short_run::<A>(&case, path, fail, roam, &seen),
     );
     let s = seen.into_inner().unwrap();
     println!(
-        "PROPERTY case=short arith={name} cases={} ticks={} device_faults={} max_force_of_limit={:.4}",
-        s.cases, s.ticks, s.faults, s.force_of_max
+        "PROPERTY case=short arith={name} cases={} roaming={} ticks={} device_faults={} max_force_of_limit={:.4}",
+        s.cases, s.roaming, s.ticks, s.faults, s.force_of_max
     );
 }
 
