@@ -31,19 +31,24 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
     for View<'_, NODES, EDGES, S, A>
 {
     fn position(&self, a: usize, b: usize) -> V3 {
-        let c = (self.n / 2) as i32;
-        let ring = [
-            (a as i32 - c).saturating_mul(self.spacing),
-            (b as i32 - c).saturating_mul(self.spacing),
-            0,
-        ];
+        // A ring node's rest position: within the patch's ±100 mm (`Proxy::new` checks
+        // `(n/2) s` ≤ 100 mm), so the product fits `i32` (no saturating product: on the
+        // M0 that is a 64-bit one, six per surface point).
+        let ring = || {
+            let c = (self.n / 2) as i32;
+            [
+                (a as i32 - c).wrapping_mul(self.spacing),
+                (b as i32 - c).wrapping_mul(self.spacing),
+                0,
+            ]
+        };
         match self.node(a, b) {
             Some(i) => {
-                let rest = self.solver.topo.rest_q24(i).unwrap_or(ring);
+                let rest = self.solver.topo.rest_q24(i).unwrap_or_else(ring);
                 let u = self.solver.node_disp(i);
                 core::array::from_fn(|k| rest[k].saturating_add(u[k]))
             }
-            None => ring,
+            None => ring(),
         }
     }
 

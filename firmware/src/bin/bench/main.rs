@@ -107,6 +107,12 @@ mod firmware {
         figs.report("tick_roaming", roam.steady);
         figs.report("tick_roaming_shift", roam.shift);
         figs.report("window_shift", roam.shift_extra);
+        // The longest shift-free tick plus the largest shift: a bound on a shift falling on
+        // the most expensive tick, which the slide need not meet.
+        figs.report(
+            "tick_roaming_bound",
+            roam.steady.saturating_add(roam.shift_extra),
+        );
         let mem = [
             ("solver_n4", core::mem::size_of::<Solver<5, 30, 64>>()),
             ("solver_n5", core::mem::size_of::<Solver<10, 61, 64>>()),
