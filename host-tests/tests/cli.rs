@@ -683,7 +683,8 @@ fn help_usage_and_the_demo_check() {
     let host = String::from_utf8(mccs(&["demo", "--core", "m3"]).stdout).unwrap();
     let summary = host.trim();
     let start = "INFO  mccs haptic demo: core=m3 tick=1000 Hz, …";
-    let cases: [(&str, String, Option<i32>); 7] = [
+    let old_summary = summary.split(" window_shifts=").next().unwrap().to_owned();
+    let cases: [(&str, String, Option<i32>); 8] = [
         (
             "good.log",
             format!("{start}\nINFO  tick=100 …\n{summary}\n"),
@@ -709,6 +710,11 @@ fn help_usage_and_the_demo_check() {
             "digits.log",
             format!("{start}\n{}\n", summary.replace("ticks=4000", "ticks=3999")),
             Some(1),
+        ),
+        (
+            "old-firmware.log",
+            format!("{start}\n{old_summary}\n"),
+            Some(2),
         ),
         (
             "shifts.log",

@@ -99,6 +99,11 @@ fn check_demo_log(
                 "{name}: no SUMMARY line: the firmware did not finish"
             )))
         }
+        (1, None) if last.starts_with("SUMMARY") => {
+            return Err(CliError::new(format!(
+                "{name}: its SUMMARY line is not `SUMMARY ticks=… overruns=… max_force_n=… steady_force_n=… window_shifts=…` (a firmware older than this mccs? rebuild it)"
+            )))
+        }
         _ => {
             return Err(CliError::new(format!(
                 "{name}: the log must end with its one SUMMARY line"
