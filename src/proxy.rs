@@ -204,16 +204,20 @@ impl Proxy {
         }
     }
 
-    /// `Σ w_k x_k` for the triangle's corners' values `x` (Q24 or Q16 per the values), as
-    /// `x₀ + w₁ (x₁ − x₀) + w₂ (x₂ − x₀)` (the weights sum to one), each term by
-    /// [`part`]: no 64-bit product (on the M0 a pass of the friction loop costs three of
-    /// these). Within two units of the last place of the exact sum.
+    /// `Σ w_k x_k` for the triangle's corners' values `x` (Q24 or Q16 per the values), per
+    /// axis by [`Self::blend1`].
     fn blend(w: [i32; 3], x: [V3; 3]) -> V3 {
-        core::array::from_fn(|d| {
-            let t1 = part(x[1][d].saturating_sub(x[0][d]), w[1]);
-            let t2 = part(x[2][d].saturating_sub(x[0][d]), w[2]);
-            x[0][d].saturating_add(t1).saturating_add(t2)
-        })
+        core::array::from_fn(|d| Self::blend1(w, [x[0][d], x[1][d], x[2][d]]))
+    }
+
+    /// `Σ w_k x_k` for one value per corner, as `x₀ + w₁ (x₁ − x₀) + w₂ (x₂ − x₀)` (the
+    /// weights sum to one), each term by [`q::mul_weight`]: no 64-bit product (on the M0
+    /// a pass of the friction loop blends three surface points). Within two units of the
+    /// last place of the exact sum.
+    fn blend1(w: [i32; 3], x: [i32; 3]) -> i32 {
+        let t1 = q::mul_weight(x[1].saturating_sub(x[0]), w[1]);
+        let t2 = q::mul_weight(x[2].saturating_sub(x[0]), w[2]);
+        x[0].saturating_add(t1).saturating_add(t2)
     }
 
     /// The deformed surface's point at grid `g`.
@@ -311,7 +315,7 @@ impl Proxy {
             let lambda = scale_to(radius, t2);
             let next = [0, 1].map(|k| {
                 let off = proxy[k].saturating_sub(goal[k]);
-                goal[k].saturating_add(sat(mul_wide(off, lambda) >> G_FRAC))
+                goal[k].saturating_add(q::mul_weight(off, lambda))
             });
             // Past the cone only when slipping (sticking, the state test above keeps
             // `t2` within the static cone): the next pass re-measures the depth there.
@@ -336,10 +340,7 @@ impl Proxy {
         let (corners, w) = self.triangle(g);
         let p = Self::blend(w, corners.map(|(a, b)| s.position(a, b)));
         // Only the surface's normal (z) velocity enters: the damping acts along z.
-        let vz = (0..3)
-            .map(|k| mul_wide(w[k], s.velocity(corners[k].0, corners[k].1)[2]))
-            .sum::<i64>();
-        let vz = sat(vz >> G_FRAC);
+        let vz = Self::blend1(w, corners.map(|(a, b)| s.velocity(a, b)[2]));
         let proxy = [p[0], p[1], p[2].saturating_add(self.radius)];
         // Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after >> 20.
         const SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
@@ -366,17 +367,6 @@ impl Proxy {
             });
         }
         (f, corners, w)
-    }
-}
-
-/// `⌊d · w / 2¹⁶⌋` for a weight `0 ≤ w ≤ 2¹⁶` (Q16) and any `d`, from one [`q::mul_s`]
-/// with a 16-bit operand: `w` itself up to 2¹⁵, else `d − d (2¹⁶ − w)/2¹⁶` (then within
-/// one unit of the floor).
-fn part(d: i32, w: i32) -> i32 {
-    if w <= 1 << 15 {
-        q::mul_s::<16>(d, w)
-    } else {
-        d.saturating_sub(q::mul_s::<16>(d, ONE_G - w))
     }
 }
 
@@ -434,38 +424,6 @@ fn tan_small(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    /// `part` against the exact product, over weights 0 … 2¹⁶ and values up to ±2³¹.
-    #[test]
-    fn part_matches_the_exact_product() {
-        let ds = [
-            i32::MIN,
-            i32::MIN + 1,
-            -1 << 30,
-            -123_456_789,
-            -65_537,
-            -1,
-            0,
-            1,
-            65_535,
-            987_654_321,
-            i32::MAX,
-        ];
-        for w in (0..=65_536)
-            .step_by(7)
-            .chain([32_767, 32_768, 32_769, 65_535, 65_536])
-        {
-            for d in ds {
-                let exact = (d as i64 * w as i64) >> 16;
-                let got = super::part(d, w) as i64;
-                assert!((got - exact).abs() <= 1, "{d} × {w}: {got} vs {exact}");
-                // The M0's split product is exact for the operand `part` gives it.
-                let b = if w <= 1 << 15 { w } else { 65_536 - w };
-                let split = crate::q::mul_s_split::<16>(d, b) as i64;
-                assert_eq!(split, (d as i64 * b as i64) >> 16, "{d} × {b}");
-            }
-        }
-    }
-
     /// `rsqrt` against `f64` over its whole domain (1 … 2⁶³, log-spaced, and each power of
     /// two's neighbours), within 1e-7 relative; `scale_to` never above the exact ratio.
     #[test]

@@ -159,6 +159,18 @@ pub fn mul_t_split(a: i32, t: u32) -> i32 {
         .wrapping_add((a0.wrapping_mul(t) >> 16) as i32)
 }
 
+/// `⌊d · w / 2¹⁶⌋` (within one unit) for a Q16 weight `0 ≤ w ≤ 2¹⁶` and any `d`: one
+/// [`mul_s`] with a 16-bit operand, `w` itself up to 2¹⁵, else `d − d (2¹⁶ − w)/2¹⁶`. No
+/// 64-bit product (a library call on the M0): the proxy's blends, slip and reaction.
+#[inline(always)]
+pub fn mul_weight(d: i32, w: i32) -> i32 {
+    if w <= 1 << 15 {
+        mul_s::<16>(d, w)
+    } else {
+        d.saturating_sub(mul_s::<16>(d, (1 << 16) - w))
+    }
+}
+
 /// `⌊a · b / 2^SH⌋` for a 16-bit `b` (`|b| ≤ 2¹⁵`, `SH` ≤ 16): a product with one
 /// narrow operand. One long multiply and a shift on the M3/M4; on the Cortex-M0
 /// [`mul_s_split`], two 32-bit multiplies with the same bits. The caller's ranges must
@@ -234,4 +246,39 @@ pub fn opaque(mut x: i32) -> i32 {
         x = core::hint::black_box(x);
     }
     x
+}
+
+#[cfg(test)]
+mod tests {
+    /// `mul_weight` against the exact product, over weights 0 … 2¹⁶ and values up to ±2³¹.
+    #[test]
+    fn mul_weight_matches_the_exact_product() {
+        let ds = [
+            i32::MIN,
+            i32::MIN + 1,
+            -1 << 30,
+            -123_456_789,
+            -65_537,
+            -1,
+            0,
+            1,
+            65_535,
+            987_654_321,
+            i32::MAX,
+        ];
+        for w in (0..=65_536)
+            .step_by(7)
+            .chain([32_767, 32_768, 32_769, 65_535, 65_536])
+        {
+            for d in ds {
+                let exact = (d as i64 * w as i64) >> 16;
+                let got = super::mul_weight(d, w) as i64;
+                assert!((got - exact).abs() <= 1, "{d} × {w}: {got} vs {exact}");
+                // The M0's split product is exact for the operand `mul_weight` gives it.
+                let b = if w <= 1 << 15 { w } else { 65_536 - w };
+                let split = super::mul_s_split::<16>(d, b) as i64;
+                assert_eq!(split, (d as i64 * b as i64) >> 16, "{d} × {b}");
+            }
+        }
+    }
 }

@@ -208,7 +208,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         let pos =
             |i: usize, j: usize, z: f64| [(i as f64 - c) * spacing, (j as f64 - c) * spacing, z];
         let fixed = |i: usize, j: usize| i == 0 || j == 0 || i == n - 1 || j == n - 1;
-        // Free surface node (i, j) gets index 1 + (i − 1)(n − 2) + (j − 1).
+        // Free surface node (i, j) gets index 1 + (i − 1)(n − 2) + (j − 1) (`surface_node`).
         for i in 1..n - 1 {
             for j in 1..n - 1 {
                 t.add_free_node(pos(i, j, 0.0))?;
@@ -218,7 +218,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
             if fixed(i, j) {
                 End::Fixed(pos(i, j, 0.0))
             } else {
-                End::Free((1 + (i - 1) * (n - 2) + (j - 1)) as u16)
+                End::Free(surface_node(n, i as i32, j as i32).unwrap_or(0) as u16)
             }
         };
         let both_fixed = |p: (usize, usize), q: (usize, usize)| fixed(p.0, p.1) && fixed(q.0, q.1);
@@ -247,7 +247,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
                 t.add_edge(surface(i, j), End::Fixed(pos(i, j, -spacing)))?;
             }
         }
-        let contact = 1 + (n / 2 - 1) * (n - 2) + (n / 2 - 1);
+        let contact = surface_node(n, (n / 2) as i32, (n / 2) as i32).unwrap_or(0);
         t.set_contact(contact as u16)?;
         Ok(t)
     }
@@ -302,6 +302,16 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     pub fn rest_length(e: &Edge) -> f64 {
         (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64
     }
+}
+
+/// The node index of the standard patch's surface node `(a, b)` (grid coordinates,
+/// `0 … n − 1`): `1 + (a − 1)(n − 2) + (b − 1)` for a free node, `None` on the fixed
+/// outer ring or off the grid. One source for the layout `standard_patch` builds and the
+/// proxy and the window read.
+#[inline(always)]
+pub(crate) fn surface_node(n: usize, a: i32, b: i32) -> Option<usize> {
+    let inner = n as i32 - 2;
+    (a >= 1 && b >= 1 && a <= inner && b <= inner).then(|| (1 + (a - 1) * inner + (b - 1)) as usize)
 }
 
 fn from_q24(x: i32) -> f64 {

@@ -65,6 +65,17 @@ fn path(t: usize) -> V {
     [0.3 + slide, 0.2 + side, z]
 }
 
+/// How far the core's force `got` is from the twin's `want`, and `|want|` (N).
+fn off_by(got: [mccs::Force; 3], want: V) -> (f64, f64) {
+    let got = got.map(|f| f.to_num::<f64>());
+    let mag = (want[0].powi(2) + want[1].powi(2) + want[2].powi(2)).sqrt();
+    let diff = (0..3)
+        .map(|k| (got[k] - want[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    (diff, mag)
+}
+
 /// Runs the path in both; returns the largest force difference over the twin's force
 /// magnitude (where it is above 0.05 N), and whether the slip states agreed.
 fn compare<A: Arith>(mu: (f64, f64), radius: f64) -> (f64, usize) {
@@ -77,12 +88,7 @@ fn compare<A: Arith>(mu: (f64, f64), radius: f64) -> (f64, usize) {
         let p = path(t);
         let got = s.step_proxy(p.map(Length::from_num), &mut proxy);
         let want = tw.step(p).force;
-        let got = got.map(|f| f.to_num::<f64>());
-        let mag = (want[0].powi(2) + want[1].powi(2) + want[2].powi(2)).sqrt();
-        let diff = (0..3)
-            .map(|k| (got[k] - want[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let (diff, mag) = off_by(got, want);
         assert!(
             diff < 0.02 + 0.02 * mag,
             "tick {t}: {got:?} against {want:?}"
@@ -276,12 +282,7 @@ mod roaming {
             let p = path(t);
             let got = s.step_roaming(p.map(Length::from_num), &mut proxy, &mut window);
             let want = tw.step(p).force;
-            let got = got.map(|f| f.to_num::<f64>());
-            let mag = (want[0].powi(2) + want[1].powi(2) + want[2].powi(2)).sqrt();
-            let diff = (0..3)
-                .map(|k| (got[k] - want[k]).powi(2))
-                .sum::<f64>()
-                .sqrt();
+            let (diff, mag) = off_by(got, want);
             assert!(
                 diff < 0.02 + 0.03 * mag,
                 "tick {t}: {got:?} against {want:?}"

@@ -5,7 +5,8 @@ use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
-use crate::q::{mul_wide, sat, V3};
+use crate::q::{self, V3};
+use crate::topology::surface_node;
 use crate::units::{from_f64, Force, Length, LEN_FRAC};
 
 /// The standard patch's surface as a proxy reads it: node `(a, b)` of the `n × n` grid,
@@ -22,8 +23,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
 {
     /// The node of surface point `(a, b)`, `None` on the ring.
     fn node(&self, a: usize, b: usize) -> Option<usize> {
-        let n = self.n;
-        (a >= 1 && b >= 1 && a + 1 < n && b + 1 < n).then(|| 1 + (a - 1) * (n - 2) + (b - 1))
+        surface_node(self.n, a as i32, b as i32)
     }
 }
 
@@ -100,8 +100,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.probe_prev = p;
         proxy.update(&self.view(proxy), p);
         self.proxy_substeps(p, probe_vel, proxy);
-        self.coupling_force
-            .map(|f| Force::from_bits(f.saturating_neg()))
+        self.device_force()
     }
 
     /// The tick's substeps with the probe at `p` (Q24 mm, patch frame) moving at
@@ -134,8 +133,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         for (node, w) in nodes.into_iter().zip(w) {
             if let Some(n) = node.and_then(|i| self.nodes.get_mut(i)) {
                 for k in 0..3 {
-                    let share = sat(mul_wide(w, f[k]) >> 16);
-                    n.f[k] = n.f[k].saturating_sub(share);
+                    n.f[k] = n.f[k].saturating_sub(q::mul_weight(f[k], w));
                 }
             }
         }

@@ -6,7 +6,7 @@ use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Proxy, ProxyError};
 use crate::q::V3;
-use crate::topology::{Edge, GROUND};
+use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
 use crate::window::{Window, WindowConfig, NONE};
 
@@ -126,34 +126,27 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
         self.probe_prev = p;
         self.proxy_substeps(p, probe_vel, proxy);
-        self.coupling_force
-            .map(|f| Force::from_bits(f.saturating_neg()))
+        self.device_force()
     }
 
     /// Moves the window one node along `d` (one axis): node states, warm-start values,
     /// the proxy's place.
     fn shift(&mut self, window: &mut Window<EDGES>, d: [i32; 2], proxy: &mut Proxy) {
         let n = window.n;
-        let inner = |a: i32, b: i32| a >= 1 && b >= 1 && a <= n - 2 && b <= n - 2;
-        let index = |a: i32, b: i32| (1 + (a - 1) * (n - 2) + (b - 1)) as usize;
+        let node = |a: i32, b: i32| surface_node(n as usize, a, b);
         // In the direction of the shift, so that every source is read before it is
         // overwritten.
         let order = |s: i32, k: i32| if s > 0 { k } else { n - 1 - k };
         for ka in 0..n {
             for kb in 0..n {
                 let (a, b) = (order(d[0], ka), order(d[1], kb));
-                if !inner(a, b) {
+                let Some(i) = node(a, b) else {
                     continue;
-                }
-                let (sa, sb) = (a + d[0], b + d[1]);
-                let (u, v): (V3, V3) = if inner(sa, sb) {
-                    self.nodes
-                        .get(index(sa, sb))
-                        .map_or(([0; 3], [0; 3]), |x| (x.u, x.v))
-                } else {
-                    ([0; 3], [0; 3])
                 };
-                if let Some(x) = self.nodes.get_mut(index(a, b)) {
+                let (u, v): (V3, V3) = node(a + d[0], b + d[1])
+                    .and_then(|j| self.nodes.get(j))
+                    .map_or(([0; 3], [0; 3]), |x| (x.u, x.v));
+                if let Some(x) = self.nodes.get_mut(i) {
                     x.u = u;
                     x.v = v;
                 }

@@ -38,6 +38,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         for _ in 0..self.substeps {
             self.substep(drive);
         }
+        self.device_force()
+    }
+
+    /// The force the device must render: minus the coupling's force on the tissue (N).
+    #[inline(always)]
+    pub(super) fn device_force(&self) -> [Force; 3] {
         self.coupling_force
             .map(|f| Force::from_bits(f.saturating_neg()))
     }
