@@ -23,6 +23,7 @@
 extern crate self as mccs;
 
 pub mod arith;
+mod cap;
 pub mod coupling;
 pub mod law;
 pub mod params;

@@ -272,6 +272,18 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         self.rest.get(i).copied()
     }
 
+    /// The springs, to rewrite their rest geometry (a window moving over a cap).
+    pub(crate) fn edges_mut(&mut self) -> &mut [Edge] {
+        &mut self.edges
+    }
+
+    /// Sets free node `i`'s rest height (Q24 mm; a window moving over a cap).
+    pub(crate) fn set_rest_z(&mut self, i: usize, z: i32) {
+        if let Some(p) = self.rest.get_mut(i) {
+            p[2] = z;
+        }
+    }
+
     /// Rest position of node `i` (mm), `None` if it does not exist.
     pub fn rest(&self, i: u16) -> Option<[f64; 3]> {
         self.rest.get(i as usize).map(|p| p.map(from_q24))

@@ -1,15 +1,18 @@
-//! `Window`: the standard patch as a window onto a larger flat tissue that follows the
-//! contact (issue #19; the `f64` reference is `mccs_host::roam`, `docs/roaming.md`).
+//! `Window`: the standard patch as a window onto a larger tissue that follows the contact
+//! (issue #19; the `f64` reference is `mccs_host::roam`, `docs/roaming.md`).
 //!
 //! The tissue is `W × H` nodes at the patch's spacing, centred on the origin (its top at
-//! `z = 0`); the patch simulates the `n × n` of them around its centre node, outer ring
+//! `z = 0`), flat or a spherical cap ([`crate::cap`]); the patch simulates the `n × n` of them around its centre node, outer ring
 //! fixed at rest. When the contact point (out of contact: the probe) is more than
 //! `½ + hysteresis` spacings from the centre along an axis, the window moves one node
 //! that way and stays inside the tissue: the free nodes that stay free keep their state,
 //! the others start at rest, each spring takes the warm-start value of the spring it
 //! continues (a map per direction, built at start-up), and the proxy keeps its place on
 //! the tissue. A shift costs one pass over the nodes and one over the springs: bounded,
-//! no search.
+//! no search. On a cap the springs' rest geometry changes with the window: a shift also
+//! moves the window's rest heights, computes the `n` entering ones, takes each spring's
+//! geometry from the spring it continues and computes the entering springs' (about
+//! `5 (n − 2)`, one reciprocal square root each).
 
 /// What a window is built from (start-up).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -21,10 +24,15 @@ pub struct WindowConfig {
     /// How far past half a spacing the contact must go before the window moves,
     /// spacings (0.05 … 0.45).
     pub hysteresis: f64,
+    /// A spherical cap of this radius, mm (4/3 of the tissue's half-diagonal … 2000 mm;
+    /// its base within ±100 mm); `None`: flat.
+    pub cap_radius: Option<f64>,
 }
 
 /// No warm-start value to take: the spring starts at rest.
 pub(crate) const NONE: u16 = u16::MAX;
+/// In a map entry: the spring continued runs the other way (its direction is negated).
+pub(crate) const FLIP: u16 = 1 << 15;
 
 /// The window: where it is on the tissue, and the start-up maps its shifts use.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -39,10 +47,33 @@ pub struct Window<const EDGES: usize> {
     /// Spacing, Q24 mm.
     pub(crate) spacing: i32,
     /// Per direction (`+x`, `−x`, `+y`, `−y`): for each spring, the spring whose
-    /// warm-start value it takes at a shift ([`NONE`]: it starts at rest).
+    /// warm-start value (and on a cap, rest geometry) it takes at a shift ([`NONE`]: it
+    /// starts at rest; with [`FLIP`]: that spring runs the other way).
     pub(crate) maps: [[u16; EDGES]; 4],
     /// Shifts so far.
     pub(crate) shifts: u32,
+    /// The tissue's cap (`None`: flat).
+    pub(crate) cap: Option<crate::cap::Cap>,
+    /// `1/s`, Q30 per mm.
+    pub(crate) inv_s: i32,
+    /// On a cap: the rest heights of the window's `n × n` surface nodes (Q24 mm, node
+    /// `(a, b)` at `a n + b`), in the first `n²` slots (the standard patch has
+    /// `5n² − 14n + 6 ≥ n²` springs).
+    pub(crate) heights: [i32; EDGES],
+    /// On a cap: where each spring's two ends are on the window's grid ([`pack_ends`]).
+    pub(crate) ends: [u32; EDGES],
+}
+
+/// Two ends `(a, b, layer)` (grid coordinates 0 … 127, layer 1: the base) in one word.
+pub(crate) fn pack_ends(k: [[i32; 3]; 2]) -> u32 {
+    let one = |e: [i32; 3]| (e[0] as u32 & 0x7F) | (e[1] as u32 & 0x7F) << 7 | (e[2] as u32 & 1) << 14;
+    one(k[0]) | one(k[1]) << 15
+}
+
+/// The ends [`pack_ends`] packed.
+pub(crate) fn unpack_ends(x: u32) -> [[i32; 3]; 2] {
+    let one = |e: u32| [(e & 0x7F) as i32, (e >> 7 & 0x7F) as i32, (e >> 14 & 1) as i32];
+    [one(x), one(x >> 15)]
 }
 
 impl<const EDGES: usize> Window<EDGES> {
@@ -63,6 +94,17 @@ impl<const EDGES: usize> Window<EDGES> {
     /// mm (`x`, `y`; the frames share `z`).
     pub fn origin_mm(&self) -> [crate::units::Length; 2] {
         self.origin().map(crate::units::Length::from_bits)
+    }
+
+    /// Whether the tissue is a cap.
+    pub fn is_cap(&self) -> bool {
+        self.cap.is_some()
+    }
+
+    /// The cap as the proxy sees it this tick (`None`: flat).
+    pub(crate) fn cap_frame(&self) -> Option<crate::proxy::CapFrame> {
+        let origin = self.origin();
+        self.cap.map(|cap| crate::proxy::CapFrame { cap, origin })
     }
 
     /// The centre node's rest position in the tissue frame, Q24 mm: the patch frame's

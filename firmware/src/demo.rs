@@ -141,10 +141,10 @@ impl DemoSpec {
     ) -> Result<(), DemoError> {
         let topo = Topology::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
         let path = palpation_path(self.tick_hz).map_err(DemoError::Path)?;
-        let solver = Solver::with_arith(topo, *table, &self.config(), A::default())
+        let mut solver = Solver::with_arith(topo, *table, &self.config(), A::default())
             .map_err(DemoError::Solver)?;
         let start = path.at(0).map(|c| c.to_num::<f64>());
-        let contact = self.roaming(&solver, start[0], start[1])?;
+        let contact = self.roaming(&mut solver, start[0], start[1])?;
         place(slot, solver, contact, path, self.steady_tick());
         Ok(())
     }
@@ -154,7 +154,7 @@ impl DemoSpec {
     #[inline(never)]
     pub fn roaming<const N: usize, const E: usize, A: Arith>(
         &self,
-        solver: &Solver<N, E, 64, A>,
+        solver: &mut Solver<N, E, 64, A>,
         x: f64,
         y: f64,
     ) -> Result<Roaming<E>, DemoError> {
@@ -219,6 +219,7 @@ pub const WINDOW: WindowConfig = WindowConfig {
     tissue_w: 64,
     tissue_h: 64,
     hysteresis: 0.1,
+    cap_radius: None,
 };
 
 /// The demo's friction `(μ_s, μ_k)`.

@@ -231,7 +231,7 @@ impl Replay {
         }
     }
 
-    /// The core's roaming ([`mccs::Solver::step_roaming`]): a flat tissue only.
+    /// The core's roaming ([`mccs::Solver::step_roaming`]).
     fn roam_fixed<A: Arith>(
         &self,
         params: &Params,
@@ -240,9 +240,6 @@ impl Replay {
         arith: A,
         row: &mut dyn FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
-        if roaming.tissue.shape != crate::roam::Shape::Flat {
-            return Err(ReplayError::Proxy(ProxyError::Window));
-        }
         let spacing = roaming.tissue.spacing;
         let mut s = self.solver(params, spacing, arith)?;
         let mut proxy = s
@@ -258,6 +255,10 @@ impl Replay {
             tissue_w: roaming.tissue.w,
             tissue_h: roaming.tissue.h,
             hysteresis: 0.1,
+            cap_radius: match roaming.tissue.shape {
+                crate::roam::Shape::Flat => None,
+                crate::roam::Shape::Cap { radius } => Some(radius),
+            },
         };
         let mut ticks = traj.ticks(self.config.tick_hz).peekable();
         let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
@@ -267,7 +268,7 @@ impl Replay {
         for (time, p) in ticks {
             let force = s.step_roaming(p.map(Length::saturating_from_num), &mut proxy, &mut window);
             let o = window.origin_mm().map(|c| c.to_num::<f64>());
-            let proxy_at = match s.proxy_point(&proxy) {
+            let proxy_at = match s.proxy_point_in(&proxy, &window) {
                 Some(q) => {
                     let q = q.map(|c| c.to_num::<f64>());
                     [q[0] + o[0], q[1] + o[1], q[2]]

@@ -500,7 +500,7 @@ fn solver() -> Solver<10, 61, 64> {
 
 /// The roaming contact (issue #19) for [`solver`]: friction 0.6 / 0.4, the window on a
 /// 64 × 64 tissue centred under the 1-DOF probe.
-fn roaming(s: &Solver<10, 61, 64>) -> Roaming<61> {
+fn roaming(s: &mut Solver<10, 61, 64>) -> Roaming<61> {
     let proxy = s
         .proxy(&ProxyConfig {
             grid: 5,
@@ -514,6 +514,7 @@ fn roaming(s: &Solver<10, 61, 64>) -> Roaming<61> {
         tissue_w: 64,
         tissue_h: 64,
         hysteresis: 0.1,
+        cap_radius: None,
     };
     let window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
     Roaming { proxy, window }
@@ -540,8 +541,8 @@ fn run_as(spi: Fail, pin: Fail, pwm: Fail, roam: bool) -> (Option<usize>, Option
     let device = rig(&log, sensor, pwm, pin);
     // One tick, returning the telemetry after it: the controller glued or roaming.
     let mut tick: Box<dyn FnMut() -> mccs_firmware::Telemetry> = if roam {
-        let s = solver();
-        let c = roaming(&s);
+        let mut s = solver();
+        let c = roaming(&mut s);
         let mut ctl = Controller::with_contact(s, c, device, 0);
         Box::new(move || {
             ctl.tick(None);

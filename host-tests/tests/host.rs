@@ -8,6 +8,8 @@ mod common;
 mod architecture;
 #[path = "arith.rs"]
 mod arith;
+#[path = "cap.rs"]
+mod cap;
 #[path = "cli.rs"]
 mod cli;
 #[path = "demo.rs"]

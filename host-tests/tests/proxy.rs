@@ -196,6 +196,7 @@ mod robust {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
+            cap_radius: None,
         };
         let mut window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
         let max = device_max();
@@ -263,6 +264,7 @@ mod roaming {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
+            cap_radius: None,
         };
         let start = path(0);
         let mut window = s.window(&wc, &proxy, start[0], start[1]).unwrap();
@@ -317,12 +319,13 @@ mod roaming {
 
     #[test]
     fn a_window_that_does_not_fit_is_refused() {
-        let s = fixed::<Wide>();
+        let mut s = fixed::<Wide>();
         let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
         let ok = WindowConfig {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
+            cap_radius: None,
         };
         assert!(s.window(&ok, &proxy, 0.0, 0.0).is_ok());
         for bad in [

@@ -176,7 +176,7 @@ fn short_run<A: Arith>(
         s.is_some(),
         "the stability bound refuses this configuration"
     );
-    let s = s.unwrap();
+    let mut s = s.unwrap();
     let dev = Device {
         path,
         tick: 0,
@@ -199,6 +199,7 @@ fn short_run<A: Arith>(
                 tissue_w: 16,
                 tissue_h: 16,
                 hysteresis: 0.1,
+                cap_radius: None,
             };
             let window = s
                 .window(&wc, &proxy, 0.0, 0.0)

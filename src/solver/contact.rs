@@ -4,7 +4,7 @@
 use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
-use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
+use crate::proxy::{CapFrame, Proxy, ProxyConfig, ProxyError, Surface};
 use crate::q::{self, V3};
 use crate::topology::surface_node;
 use crate::units::{from_f64, Force, Length, LEN_FRAC};
@@ -25,22 +25,56 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
     fn node(&self, a: usize, b: usize) -> Option<usize> {
         surface_node(self.n, a as i32, b as i32)
     }
+
+    /// A ring node's rest `x` and `y` (Q24 mm, patch frame): within the patch's ±100 mm
+    /// (`Proxy::new` checks `(n/2) s` ≤ 100 mm), so the products fit `i32` (no
+    /// saturating product: on the M0 that is a 64-bit one, six per surface point).
+    #[inline(always)]
+    fn ring_xy(&self, a: usize, b: usize) -> [i32; 2] {
+        let c = (self.n / 2) as i32;
+        [
+            (a as i32 - c).wrapping_mul(self.spacing),
+            (b as i32 - c).wrapping_mul(self.spacing),
+        ]
+    }
+}
+
+/// A window's surface over a cap as the proxy reads it: the ring's rest heights from the
+/// window's (the free nodes' rest positions are the topology's, moved with the window).
+pub(super) struct CapView<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
+    view: View<'a, NODES, EDGES, S, A>,
+    heights: &'a [i32; EDGES],
+}
+
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
+    for CapView<'_, NODES, EDGES, S, A>
+{
+    fn position(&self, a: usize, b: usize) -> V3 {
+        match self.view.node(a, b) {
+            Some(_) => self.view.position(a, b),
+            None => {
+                let [x, y] = self.view.ring_xy(a, b);
+                [x, y, self.rest_z(a, b)]
+            }
+        }
+    }
+
+    fn velocity(&self, a: usize, b: usize) -> V3 {
+        self.view.velocity(a, b)
+    }
+
+    fn rest_z(&self, a: usize, b: usize) -> i32 {
+        self.heights.get(a * self.view.n + b).copied().unwrap_or(0)
+    }
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
     for View<'_, NODES, EDGES, S, A>
 {
     fn position(&self, a: usize, b: usize) -> V3 {
-        // A ring node's rest position: within the patch's ±100 mm (`Proxy::new` checks
-        // `(n/2) s` ≤ 100 mm), so the product fits `i32` (no saturating product: on the
-        // M0 that is a 64-bit one, six per surface point).
         let ring = || {
-            let c = (self.n / 2) as i32;
-            [
-                (a as i32 - c).wrapping_mul(self.spacing),
-                (b as i32 - c).wrapping_mul(self.spacing),
-                0,
-            ]
+            let [x, y] = self.ring_xy(a, b);
+            [x, y, 0]
         };
         match self.node(a, b) {
             Some(i) => {
@@ -83,11 +117,38 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
+    /// A window's surface over a cap.
+    pub(super) fn cap_view<'a>(
+        &'a self,
+        proxy: &Proxy,
+        window: &'a crate::window::Window<EDGES>,
+    ) -> CapView<'a, NODES, EDGES, S, A> {
+        CapView {
+            view: self.view(proxy),
+            heights: &window.heights,
+        }
+    }
+
     /// The proxy's centre (mm, patch frame) on the current surface, when in contact.
     pub fn proxy_point(&self, proxy: &Proxy) -> Option<[Length; 3]> {
         proxy
             .centre_at(&self.view(proxy))
             .map(|p| p.map(Length::from_bits))
+    }
+
+    /// The proxy's centre (mm, patch frame) on a window's current surface (flat or a
+    /// cap), when in contact.
+    pub fn proxy_point_in(
+        &self,
+        proxy: &Proxy,
+        window: &crate::window::Window<EDGES>,
+    ) -> Option<[Length; 3]> {
+        match window.cap_frame() {
+            None => self.proxy_point(proxy),
+            Some(f) => proxy
+                .centre_cap_at(&self.cap_view(proxy, window), &f)
+                .map(|p| p.map(Length::from_bits)),
+        }
     }
 
     /// One haptic tick with the probe at `probe` (mm, patch frame) touching the surface
@@ -124,11 +185,46 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
+    /// [`Self::proxy_substeps`] on a cap.
+    pub(super) fn proxy_substeps_cap(
+        &mut self,
+        p: V3,
+        probe_vel: V3,
+        proxy: &Proxy,
+        window: &crate::window::Window<EDGES>,
+        frame: &CapFrame,
+    ) {
+        let count = self.topo.node_count().min(NODES);
+        for _ in 0..self.substeps {
+            A::spring_forces(
+                &self.table,
+                &self.c.arith,
+                &self.topo,
+                &mut self.warm,
+                &mut self.nodes,
+            );
+            let view = self.cap_view(proxy, window);
+            let (f, corners, w) = proxy.force_cap(&view, frame, &self.c.coupling, p, probe_vel);
+            self.react(proxy, f, corners, w);
+            if let Some(free) = self.nodes.get_mut(1..count) {
+                A::integrate(&self.c.arith, free);
+            }
+        }
+    }
+
     /// The proxy's coupling in one substep: its reaction onto the proxy's triangle (free
     /// nodes only), and the force on the tissue kept as the coupling force.
     fn proxy_reaction(&mut self, proxy: &Proxy, probe: V3, probe_vel: V3) {
         let view = self.view(proxy);
         let (f, corners, w) = proxy.force(&view, &self.c.coupling, probe, probe_vel);
+        self.react(proxy, f, corners, w);
+    }
+
+    /// The force `f` (Q20 N) of the proxy on the tissue through its triangle `corners`
+    /// with weights `w`: minus it onto the free corners, kept as the coupling force.
+    #[inline(always)]
+    fn react(&mut self, proxy: &Proxy, f: V3, corners: [(usize, usize); 3], w: [i32; 3]) {
+        let view = self.view(proxy);
         let nodes = corners.map(|(a, b)| view.node(a, b));
         for (node, w) in nodes.into_iter().zip(w) {
             if let Some(n) = node.and_then(|i| self.nodes.get_mut(i)) {

@@ -1,14 +1,15 @@
-//! The solver as a window onto a larger flat tissue ([`Window`]), driven through a
-//! [`Proxy`]: the window's start-up maps, its shifts, and the tick.
+//! The solver as a window onto a larger tissue ([`Window`]), flat or a cap, driven
+//! through a [`Proxy`]: the window's start-up maps, its shifts, and the tick.
 
 use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
+use crate::cap::Cap;
 use crate::proxy::{Proxy, ProxyError};
-use crate::q::V3;
+use crate::q::{self, mul_wide, sat, V3};
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
-use crate::window::{Window, WindowConfig, NONE};
+use crate::window::{pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
 
 /// Where a spring's end is on the patch's grid: `(a, b, layer)` (layer 1: the base).
 type Key = [i32; 3];
@@ -17,11 +18,14 @@ type Key = [i32; 3];
 const DIRECTIONS: [[i32; 2]; 4] = [[1, 0], [-1, 0], [0, 1], [0, -1]];
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
-    /// A window of this solver's patch onto a flat tissue of `config`'s size, centred on
-    /// the tissue node nearest `(x, y)` (mm, tissue frame: origin at its centre), for a
-    /// proxy from [`Solver::proxy`] (start-up: the maps take `4 E²` comparisons).
+    /// A window of this solver's patch onto a tissue of `config`'s size and shape,
+    /// centred on the tissue node nearest `(x, y)` (mm, tissue frame: origin at its
+    /// centre), for a proxy from [`Solver::proxy`] (start-up: the maps take `4 E²`
+    /// comparisons). On a cap the patch takes the window's rest geometry (its
+    /// substeps and [`crate::ParamSet`] fingerprint stay the flat patch's: the cap's
+    /// springs are no shorter, so no stiffer).
     pub fn window(
-        &self,
+        &mut self,
         config: &WindowConfig,
         proxy: &Proxy,
         x: f64,
@@ -37,6 +41,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         if !(0.05..=0.45).contains(&config.hysteresis) {
             return Err(ProxyError::Window);
         }
+        let cap = match config.cap_radius {
+            None => None,
+            Some(r) => Some(Self::cap_for(r, w, h, s)?),
+        };
         let corner = |p: f64, side: usize| {
             let u = libm::round(p / s + (side - 1) as f64 / 2.0) - (n / 2) as f64;
             u.clamp(0.0, (side - n) as f64) as i32
@@ -55,15 +63,20 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
                 let moved = keys[e].map(|k| [k[0] + d[0], k[1] + d[1], k[2]]);
                 (0..count)
-                    .find(|&o| {
+                    .find_map(|o| {
                         let k = keys[o];
-                        (k[0] == moved[0] && k[1] == moved[1])
-                            || (k[0] == moved[1] && k[1] == moved[0])
+                        if k[0] == moved[0] && k[1] == moved[1] {
+                            Some(o as u16)
+                        } else if k[0] == moved[1] && k[1] == moved[0] {
+                            Some(o as u16 | FLIP)
+                        } else {
+                            None
+                        }
                     })
-                    .map_or(NONE, |o| o as u16)
+                    .unwrap_or(NONE)
             })
         });
-        Ok(Window {
+        let mut window = Window {
             n: n as i32,
             w: w as i32,
             h: h as i32,
@@ -72,17 +85,84 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             spacing,
             maps,
             shifts: 0,
-        })
+            cap,
+            inv_s: from_f64(1.0 / s, 30),
+            heights: [0; EDGES],
+            ends: core::array::from_fn(|e| pack_ends(keys[e])),
+        };
+        if let Some(cap) = cap {
+            if n * n > EDGES {
+                return Err(ProxyError::Window);
+            }
+            for a in 0..n as i32 {
+                for b in 0..n as i32 {
+                    let z = cap.height(window.corner[0] + a, window.corner[1] + b);
+                    if let Some(slot) = window.heights.get_mut((a * n as i32 + b) as usize) {
+                        *slot = z;
+                    }
+                }
+            }
+            self.set_cap_geometry(&window, None, 0);
+        }
+        Ok(window)
     }
 
-    /// Where an edge's two ends are on the grid (start-up).
+    /// The cap of radius `r` mm over a `w × h` tissue at spacing `s` mm, if the core can
+    /// run it: its base above −100 mm and its longest spring (at the tissue's corner)
+    /// within the arithmetic's (start-up).
+    fn cap_for(r: f64, w: usize, h: usize, s: f64) -> Result<Cap, ProxyError> {
+        let cap = Cap::new(r, w, h, s).ok_or(ProxyError::Cap)?;
+        let (hx, hy) = ((w - 1) as f64 * s / 2.0, (h - 1) as f64 * s / 2.0);
+        let z = |x: f64, y: f64| libm::sqrt(r * r - x * x - y * y) - r;
+        // The steepest cell is the corner's: its diagonal is the longest spring.
+        let dz = z(hx, hy) - z(hx - s, hy - s);
+        let longest = libm::sqrt(2.0 * s * s + dz * dz);
+        if z(hx, hy) - s < -100.0 || longest > A::MAX_REST_LENGTH_MM {
+            return Err(ProxyError::Cap);
+        }
+        Ok(cap)
+    }
+
+    /// On a cap: the free nodes' rest heights from the window's, and each spring's rest
+    /// geometry: taken from `old` through the map of direction `dir` where it continues a
+    /// spring, else computed from the heights (all of them without `old`).
+    fn set_cap_geometry(&mut self, window: &Window<EDGES>, old: Option<&[(V3, i32); EDGES]>, dir: usize) {
+        let n = window.n;
+        for a in 1..n - 1 {
+            for b in 1..n - 1 {
+                if let (Some(i), Some(&z)) = (
+                    surface_node(n as usize, a, b),
+                    window.heights.get((a * n + b) as usize),
+                ) {
+                    self.topo.set_rest_z(i, z);
+                }
+            }
+        }
+        for (e, edge) in self.topo.edges_mut().iter_mut().enumerate() {
+            let from = match old {
+                Some(_) => window.maps[dir].get(e).copied().unwrap_or(NONE),
+                None => NONE,
+            };
+            let taken = old.and_then(|o| o.get((from & !FLIP) as usize));
+            let (dir_v, inv_len) = match taken {
+                Some(&(d, inv)) if from & FLIP != 0 => (d.map(i32::saturating_neg), inv),
+                Some(&g) => g,
+                None => edge_geometry(window, window.ends.get(e).copied().unwrap_or(0)),
+            };
+            edge.dir = dir_v;
+            edge.inv_len = inv_len;
+        }
+    }
+
+    /// Where an edge's two ends are on the grid (start-up): the base end of a vertical
+    /// spring is the one fixed end straight below its free end (on a cap too, where a
+    /// surface node may lie deeper than `s/2`).
     fn keys(&self, e: &Edge, n: usize, s: f64) -> [Key; 2] {
         let c = (n / 2) as f64;
-        let key = |p: [f64; 3]| -> Key {
+        let key = |p: [f64; 3]| -> [i32; 2] {
             [
                 libm::round(p[0] / s + c) as i32,
                 libm::round(p[1] / s + c) as i32,
-                (p[2] < -s / 2.0) as i32,
             ]
         };
         let a = self.topo.rest(e.a).unwrap_or([0.0; 3]);
@@ -92,7 +172,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         } else {
             self.topo.rest(e.b).unwrap_or([0.0; 3])
         };
-        [key(a), key(b)]
+        let (ka, kb) = (key(a), key(b));
+        let base = e.b == GROUND && ka == kb;
+        [[ka[0], ka[1], 0], [kb[0], kb[1], base as i32]]
     }
 
     /// One haptic tick on the tissue with the probe at `probe` (mm, tissue frame)
@@ -111,7 +193,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         };
         let mut p = in_window(window);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
-        proxy.update(&self.view(proxy), p);
+        let frame = window.cap_frame();
+        match &frame {
+            None => proxy.update(&self.view(proxy), p),
+            Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, p),
+        }
         let g = proxy.grid_position().unwrap_or_else(|| proxy.grid_of(p));
         let d = window.step_for(g);
         // One axis at a time (each index constant: no bounds check on the tick path).
@@ -125,7 +211,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             p = in_window(window);
         }
         self.probe_prev = p;
-        self.proxy_substeps(p, probe_vel, proxy);
+        match window.cap_frame() {
+            None => self.proxy_substeps(p, probe_vel, proxy),
+            Some(f) => self.proxy_substeps_cap(p, probe_vel, proxy, window, &f),
+        }
         self.device_force()
     }
 
@@ -158,6 +247,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             [0, 1] => 2,
             _ => 3,
         };
+        if window.cap.is_some() {
+            self.shift_cap(window, d, dir);
+        }
         let old = self.warm;
         for (e, w) in self.warm.iter_mut().enumerate() {
             let from = window.maps[dir].get(e).copied().unwrap_or(NONE);
@@ -166,5 +258,75 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         proxy.shift_grid(d);
         window.corner = [window.corner[0] + d[0], window.corner[1] + d[1]];
         window.shifts = window.shifts.saturating_add(1);
+    }
+
+    /// A shift's part on a cap: the rest heights move with the window (the `n` entering
+    /// ones computed), then the springs' rest geometry (see [`Self::set_cap_geometry`]).
+    #[inline(never)]
+    fn shift_cap(&mut self, window: &mut Window<EDGES>, d: [i32; 2], dir: usize) {
+        let n = window.n;
+        let Some(cap) = window.cap else {
+            return;
+        };
+        let order = |s: i32, k: i32| if s > 0 { k } else { n - 1 - k };
+        for ka in 0..n {
+            for kb in 0..n {
+                let (a, b) = (order(d[0], ka), order(d[1], kb));
+                let (sa, sb) = (a + d[0], b + d[1]);
+                let z = if (0..n).contains(&sa) && (0..n).contains(&sb) {
+                    window.heights.get((sa * n + sb) as usize).copied().unwrap_or(0)
+                } else {
+                    cap.height(window.corner[0] + sa, window.corner[1] + sb)
+                };
+                if let Some(slot) = window.heights.get_mut((a * n + b) as usize) {
+                    *slot = z;
+                }
+            }
+        }
+        let mut old = [([0; 3], 0); EDGES];
+        for (o, e) in old.iter_mut().zip(self.topo.edges()) {
+            *o = (e.dir, e.inv_len);
+        }
+        self.set_cap_geometry(window, Some(&old), dir);
+    }
+}
+
+/// A spring's rest geometry `(dir, 1/l0)` (Q23, Q31 per mm) on a cap from its packed
+/// ends and the window's rest heights, in spacings so that every square fits `i64`: the
+/// horizontal offsets are whole spacings, the vertical one `Δz/s` by a product by `1/s`;
+/// `s/l0` by one reciprocal square root (within 2e-8).
+fn edge_geometry<const EDGES: usize>(window: &Window<EDGES>, ends: u32) -> (V3, i32) {
+    let [a, b] = unpack_ends(ends);
+    let z = |k: [i32; 3]| {
+        let h = window.heights.get((k[0] * window.n + k[1]) as usize).copied().unwrap_or(0);
+        h.saturating_sub(k[2].wrapping_mul(window.spacing))
+    };
+    // Offsets in spacings, Q28 (|Δz| ≤ 128 mm over s ≥ 1 mm: the squares sum within i64).
+    // Every product is rounded to nearest, symmetrically: a spring computed from its
+    // other end is its exact negation (a continued spring may run the other way), and
+    // a unit direction's length stays within rounding of one (no strain at rest).
+    let dz = z(b).saturating_sub(z(a));
+    let ds: [i64; 3] = [
+        ((b[0] - a[0]) as i64) << 28,
+        ((b[1] - a[1]) as i64) << 28,
+        round_shr(dz as i64 * window.inv_s as i64, 26),
+    ];
+    let (y, e) = q::rsqrt(ds[0] * ds[0] + ds[1] * ds[1] + ds[2] * ds[2]);
+    // s/l0 = y 2^(e/2 − 34) (the sum is Q56), in Q30: y >> (4 − e/2); l0 ≥ s: e ≤ 6.
+    let sl = round_shr(y as i64, 4u32.saturating_sub(e >> 1).max(1)) as i32;
+    // 1/l0 = (s/l0)(1/s): Q30 · Q30 = Q60, Q31 after >> 29; 1 mm is held at i32::MAX.
+    let inv_len = sat(round_shr(mul_wide(sl, window.inv_s), 29));
+    // dir = (Δ/s)(s/l0): Q28 · Q30 = Q58, Q23 after >> 35.
+    let dir = ds.map(|c| sat(round_shr(c * sl as i64, 35)));
+    (dir, inv_len)
+}
+
+/// `x / 2^sh` rounded to nearest, halves away from zero (`sh` ≥ 1): odd in `x`.
+fn round_shr(x: i64, sh: u32) -> i64 {
+    let m = (x.unsigned_abs() + (1 << (sh - 1))) >> sh;
+    if x < 0 {
+        -(m as i64)
+    } else {
+        m as i64
     }
 }

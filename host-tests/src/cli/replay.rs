@@ -3,7 +3,7 @@
 
 use super::patch_args::{config_error, PatchArgs, TuningArgs};
 use super::table::solver_table;
-use super::{arg_error, file_error, io_error, Backend, CliError};
+use super::{arg_error, file_error, io_error, CliError};
 use crate::paramfile;
 use crate::replay::{Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
@@ -35,8 +35,8 @@ pub(super) struct Args {
     /// Probe radius, mm (0 … spacing/2; with --tissue; default 0).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     probe_radius: Option<f64>,
-    /// Shape the tissue as a spherical cap of this radius, mm (with --tissue; --backend
-    /// reference only).
+    /// Shape the tissue as a spherical cap of this radius, mm (with --tissue; 4/3 of the
+    /// tissue's half-diagonal … 2000).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     cap_radius: Option<f64>,
 }
@@ -68,12 +68,6 @@ impl Args {
             }
             return Ok(None);
         };
-        if self.patch.backend != Backend::Reference && self.cap_radius.is_some() {
-            return Err(arg_error(
-                "--cap-radius",
-                "the fixed-point core roams flat tissue only: use --backend reference for a cap (docs/roaming.md)",
-            ));
-        }
         let (w, h) = pair::<usize>(
             "--tissue",
             tissue,

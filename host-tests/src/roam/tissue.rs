@@ -10,6 +10,8 @@ pub const MAX_SIDE: usize = 64;
 /// Largest distance of a tissue node from the tissue's centre, mm, per axis: the core's
 /// length format holds ±128 mm, and its topology takes nodes within ±100 mm.
 pub const MAX_EXTENT_MM: f64 = 100.0;
+/// Largest cap radius, mm (the core's `R` in Q20).
+pub const MAX_CAP_RADIUS_MM: f64 = 2000.0;
 
 /// The rest surface's shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,7 +20,7 @@ pub enum Shape {
     Flat,
     /// A spherical cap of radius `R` mm whose top is at the tissue's centre at `z = 0`:
     /// `z = √(R² − x² − y²) − R`. `R` must exceed the tissue's half-diagonal by a third,
-    /// so that the slope stays below about 1.2 everywhere.
+    /// so that the slope stays below about 1.2 everywhere, and be at most 2000 mm.
     Cap {
         /// Radius, mm.
         radius: f64,
@@ -59,7 +61,8 @@ impl Tissue {
         }
         if let Shape::Cap { radius } = shape {
             let half_diagonal = (hx * hx + hy * hy).sqrt();
-            if !radius.is_finite() || radius < 4.0 / 3.0 * half_diagonal {
+            if !radius.is_finite() || radius < 4.0 / 3.0 * half_diagonal || radius > MAX_CAP_RADIUS_MM
+            {
                 return Err(RoamError::CapRadius);
             }
         }

@@ -299,7 +299,7 @@ fn roaming_in<const N: usize, const E: usize>(
         exit(false)
     };
     let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
-    let Ok(mut c) = spec.roaming(&s, -5.0, 0.4) else {
+    let Ok(mut c) = spec.roaming(&mut s, -5.0, 0.4) else {
         exit(false)
     };
     let depth = Length::from_num(-1);

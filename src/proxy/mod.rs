@@ -24,6 +24,10 @@
 //! weights Q16, friction coefficients Q16. The only square roots are reciprocal ones by
 //! five Newton steps (`rsqrt`), for a slip and for a force over the device maximum.
 
+mod cap;
+
+pub(crate) use cap::CapFrame;
+
 use crate::coupling::CouplingQ;
 use crate::q::{self, mul_wide, sat, V3};
 use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
@@ -60,6 +64,9 @@ pub enum ProxyError {
     /// A tissue smaller than the patch, larger than 64 nodes a side or beyond ±100 mm, or
     /// a window hysteresis outside 0.05 … 0.45 spacings.
     Window,
+    /// A cap radius outside 4/3 of the tissue's half-diagonal … 2000 mm, or a cap whose
+    /// base reaches below −100 mm or whose longest spring is too long for the arithmetic.
+    Cap,
 }
 
 impl ProxyError {
@@ -70,6 +77,7 @@ impl ProxyError {
             Self::Friction => "proxy: mu_s and mu_k must be within [0, 2]",
             Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
             Self::Window => "window: the tissue must be n..=64 nodes a side within ±100 mm, the hysteresis 0.05 … 0.45",
+            Self::Cap => "cap: the radius must be 4/3 of the tissue's half-diagonal … 2000 mm, its base above -100 mm, its springs within the arithmetic's longest",
         }
     }
 }
@@ -108,6 +116,10 @@ pub(crate) trait Surface {
     fn position(&self, a: usize, b: usize) -> V3;
     /// Velocity of surface node `(a, b)` (Q16 mm/s).
     fn velocity(&self, a: usize, b: usize) -> V3;
+    /// Rest height of surface node `(a, b)` (Q24 mm; a flat patch's is 0).
+    fn rest_z(&self, _a: usize, _b: usize) -> i32 {
+        0
+    }
 }
 
 impl Proxy {
@@ -294,20 +306,7 @@ impl Proxy {
                 proxy[1].saturating_sub(goal[1]) >> 4,
             ];
             let t2 = mul_wide(t[0], t[0]) + mul_wide(t[1], t[1]);
-            let cone = |mu: i32| {
-                let r = sat(mul_wide(depth >> 4, mu) >> G_FRAC);
-                (r, mul_wide(r, r))
-            };
-            if pass == 0 {
-                self.slipping = if self.mu_k > self.mu_s {
-                    true
-                } else if self.slipping {
-                    t2 >= cone(self.mu_h).1
-                } else {
-                    t2 > cone(self.mu_s).1
-                };
-            }
-            let (radius, radius2) = cone(if self.slipping { self.mu_k } else { self.mu_s });
+            let (radius, radius2) = self.cone(pass, t2, depth);
             if t2 <= radius2 {
                 break;
             }
@@ -322,6 +321,27 @@ impl Proxy {
             at = self.locate(s, next[0], next[1]);
         }
         self.at = Some(at);
+    }
+
+    /// The friction cone's radius at `depth` (Q24 mm; the radius Q20 and its square) for
+    /// the stick–slip state, which the first `pass` of a tick sets from the square `t2`
+    /// (Q20²) of the proxy's offset across the normal.
+    #[inline(always)]
+    fn cone(&mut self, pass: u32, t2: i64, depth: i32) -> (i32, i64) {
+        let cone = |mu: i32| {
+            let r = sat(mul_wide(depth >> 4, mu) >> G_FRAC);
+            (r, mul_wide(r, r))
+        };
+        if pass == 0 {
+            self.slipping = if self.mu_k > self.mu_s {
+                true
+            } else if self.slipping {
+                t2 >= cone(self.mu_h).1
+            } else {
+                t2 > cone(self.mu_s).1
+            };
+        }
+        cone(if self.slipping { self.mu_k } else { self.mu_s })
     }
 
     /// The device's force (Q20 N) in one substep, with the probe at `probe` moving at
@@ -353,56 +373,40 @@ impl Proxy {
         if f[2] < 0 {
             return ([0; 3], corners, w);
         }
-        // Held to the device maximum in magnitude, never above it: the squares in Q12
-        // from each component's magnitude rounded up (an estimate never below |f|), the
-        // scale from below (`scale_to`), the scaled components truncated toward zero.
-        let up = |x: i32| ((x.unsigned_abs() >> 8) + 1) as i32;
-        let f2: i64 = f.iter().map(|&x| mul_wide(up(x), up(x))).sum();
-        let max = coupling.max_force;
-        if f2 > mul_wide(max >> 8, max >> 8) {
-            let lambda = scale_to(max >> 8, f2);
-            f = f.map(|x| {
-                let m = mul_wide(x.saturating_abs(), lambda) >> G_FRAC;
-                sat(if x < 0 { -m } else { m })
-            });
-        }
-        (f, corners, w)
+        (held(f, coupling.max_force), corners, w)
     }
+}
+
+/// `f` (Q20 N) held to `max` in magnitude, never above it: the squares in Q12 from each
+/// component's magnitude rounded up (an estimate never below |f|), the scale from below
+/// (`scale_to`), the scaled components truncated toward zero.
+#[inline(always)]
+fn held(f: V3, max: i32) -> V3 {
+    let up = |x: i32| ((x.unsigned_abs() >> 8) + 1) as i32;
+    let f2: i64 = f.iter().map(|&x| mul_wide(up(x), up(x))).sum();
+    if f2 <= mul_wide(max >> 8, max >> 8) {
+        return f;
+    }
+    let lambda = scale_to(max >> 8, f2);
+    f.map(|x| {
+        let m = mul_wide(x.saturating_abs(), lambda) >> G_FRAC;
+        sat(if x < 0 { -m } else { m })
+    })
 }
 
 /// `r / √x` in Q16 for `0 < r` and `r² < x` (a value below 1): `x` a square in the
 /// square of `r`'s format. Five Newton steps for `1/√M`, `M ∈ [¼, 1)` the normalised
-/// `x`, from a linear first guess (error below 25 %), in 32-bit products: within 1e-7;
+/// `x`, from a linear first guess (error below 25 %), in 32-bit products: within 2e-8;
 /// the result is then floored and lowered by one unit (1.5e-5 of one), so that it is
 /// never above the exact value and a force scaled by it stays within its limit.
 fn scale_to(r: i32, x: i64) -> i32 {
     // r/√x = r · y · 2^(e/2 − 62), y Q30: in Q16, r · y >> (46 − e/2) (e is even).
-    let (y, e) = rsqrt(x);
+    let (y, e) = q::rsqrt(x);
     let sh = 46 - (e >> 1);
     sat(((r.max(0) as u32 as u64 * y as u64) >> sh) as i64)
         .min(ONE_G)
         .saturating_sub(1)
         .max(0)
-}
-
-/// `1/√x` for `x > 0` as `(y, e)`: `1/√x = y · 2^(e/2 − 62)`, `y` in Q30 within (1, 2].
-/// Each product is a high word of 32 × 32 bits ([`q::mulhi_u`]: one `umull`, or four
-/// 16-bit products on the M0).
-fn rsqrt(x: i64) -> (u32, u32) {
-    let x = x.max(1) as u64;
-    let e = x.leading_zeros() & !1;
-    // m ∈ [2^62, 2^64): M = m / 2^64 ∈ [¼, 1), here in Q30.
-    let m30 = ((x << e) >> 34) as u32;
-    // First guess 2.5 − 1.5 M (Q30, ≤ 2.125), then y ← y (3 − M y²)/2: y² in Q28 (≤ 4.6),
-    // M y² in Q26 then Q30 (≤ 1.55: its largest over the first guess), y (3 − M y²) in
-    // Q28, halved into Q30. After the first step y ≤ 1/√M ≤ 2 (the step's maximum).
-    let mut y = (5u32 << 29) - ((3 * m30) >> 1);
-    for _ in 0..5 {
-        let y2 = q::mulhi_u(y, y);
-        let my2 = q::mulhi_u(m30, y2) << 4;
-        y = q::mulhi_u(y, (3u32 << 30) - my2) << 1;
-    }
-    (y, e)
 }
 
 /// `tan x` for `0 ≤ x ≤ 0.7` (start-up: the hysteresis cone, `x = 0.6 atan μ_k ≤ 0.665`),
@@ -425,7 +429,7 @@ fn tan_small(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     /// `rsqrt` against `f64` over its whole domain (1 … 2⁶³, log-spaced, and each power of
-    /// two's neighbours), within 1e-7 relative; `scale_to` never above the exact ratio.
+    /// two's neighbours), within 2e-8 relative (9.3e-9 measured); `scale_to` never above the exact ratio.
     #[test]
     fn rsqrt_matches_f64() {
         let mut worst = 0.0f64;
@@ -435,11 +439,11 @@ mod tests {
         xs.extend((0..20_000).map(|i| 2f64.powf(i as f64 * 63.0 / 20_000.0) as i64));
         xs.push(i64::MAX);
         for x in xs.into_iter().filter(|&x| x > 0) {
-            let (y, e) = super::rsqrt(x);
+            let (y, e) = crate::q::rsqrt(x);
             let got = y as f64 * 2f64.powf(e as f64 / 2.0 - 62.0);
             worst = worst.max((got * (x as f64).sqrt() - 1.0).abs());
         }
-        assert!(worst < 1e-7, "worst relative error {worst:e}");
+        assert!(worst < 2e-8, "worst relative error {worst:e}");
         // scale_to: within two Q16 units of r/√x, and never above it, over ratios from
         // 1e-4 to 1 and squares of every size.
         let mut k = 1u64;
