@@ -56,7 +56,8 @@ impl Cap {
             r: from_f64(radius, 20),
             inv_r: from_f64(1.0 / radius, 31 + inv_sh as u32),
             inv_sh: inv_sh as u32,
-            k: libm::round(spacing * spacing / (4.0 * radius * radius) * libm::ldexp(1.0, 62)) as u64,
+            k: libm::round(spacing * spacing / (4.0 * radius * radius) * libm::ldexp(1.0, 62))
+                as u64,
             w: w as i32,
             h: h as i32,
         })
@@ -136,7 +137,10 @@ mod tests {
                         let got = cap.height(i as i32, j as i32) as f64 / 2f64.powi(24);
                         let err = (got - want).abs();
                         worst = worst.max(err / r);
-                        assert!(err <= 2e-8 * r + 2.0 / 2f64.powi(24), "{w}x{h} s {s} R {r} ({i},{j}): {got} vs {want}");
+                        assert!(
+                            err <= 2e-8 * r + 2.0 / 2f64.powi(24),
+                            "{w}x{h} s {s} R {r} ({i},{j}): {got} vs {want}"
+                        );
                     }
                 }
             }
@@ -152,7 +156,7 @@ mod tests {
         let q24 = |x: f64| from_f64(x, 24);
         let unq = |x: i32| x as f64 / 2f64.powi(29);
         for (x, y) in [(0.0, 0.0), (78.75, -78.75), (-30.0, 55.5), (1.25, 0.0)] {
-            let z = (r * r - x * x - y * y as f64).sqrt() - r;
+            let z = (r * r - x * x - y * y).sqrt() - r;
             let n = cap.normal([q24(x), q24(y), q24(z)]).map(unq);
             let want = [x / r, y / r, (z + r) / r];
             for k in 0..3 {

@@ -66,13 +66,20 @@ pub struct Window<const EDGES: usize> {
 
 /// Two ends `(a, b, layer)` (grid coordinates 0 … 127, layer 1: the base) in one word.
 pub(crate) fn pack_ends(k: [[i32; 3]; 2]) -> u32 {
-    let one = |e: [i32; 3]| (e[0] as u32 & 0x7F) | (e[1] as u32 & 0x7F) << 7 | (e[2] as u32 & 1) << 14;
+    let one =
+        |e: [i32; 3]| (e[0] as u32 & 0x7F) | (e[1] as u32 & 0x7F) << 7 | (e[2] as u32 & 1) << 14;
     one(k[0]) | one(k[1]) << 15
 }
 
 /// The ends [`pack_ends`] packed.
 pub(crate) fn unpack_ends(x: u32) -> [[i32; 3]; 2] {
-    let one = |e: u32| [(e & 0x7F) as i32, (e >> 7 & 0x7F) as i32, (e >> 14 & 1) as i32];
+    let one = |e: u32| {
+        [
+            (e & 0x7F) as i32,
+            (e >> 7 & 0x7F) as i32,
+            (e >> 14 & 1) as i32,
+        ]
+    };
     [one(x), one(x >> 15)]
 }
 
@@ -99,12 +106,6 @@ impl<const EDGES: usize> Window<EDGES> {
     /// Whether the tissue is a cap.
     pub fn is_cap(&self) -> bool {
         self.cap.is_some()
-    }
-
-    /// The cap as the proxy sees it this tick (`None`: flat).
-    pub(crate) fn cap_frame(&self) -> Option<crate::proxy::CapFrame> {
-        let origin = self.origin();
-        self.cap.map(|cap| crate::proxy::CapFrame { cap, origin })
     }
 
     /// The centre node's rest position in the tissue frame, Q24 mm: the patch frame's

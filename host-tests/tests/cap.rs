@@ -92,8 +92,13 @@ fn compare<A: Arith>(mu: (f64, f64), radius: f64, x0: f64, y0: f64) -> (f64, f64
         probe_radius: radius,
         window_hysteresis: 0.1,
     };
-    let mut tw = RoamTwin::new(cfg, Reference::new(&Params::TABLE2).unwrap(), start[0], start[1])
-        .unwrap();
+    let mut tw = RoamTwin::new(
+        cfg,
+        Reference::new(&Params::TABLE2).unwrap(),
+        start[0],
+        start[1],
+    )
+    .unwrap();
     assert_eq!(window.centre(), tw.centre());
     let (mut sum2, mut worst, mut peak, mut apart) = (0.0f64, 0.0f64, 0.0f64, 0);
     let ticks = 5000;
@@ -109,7 +114,11 @@ fn compare<A: Arith>(mu: (f64, f64), radius: f64, x0: f64, y0: f64) -> (f64, f64
         if window.centre() != tw.centre() {
             apart += 1;
         }
-        assert_eq!(proxy.grid_position().is_some(), tw.contact().is_some(), "tick {t}: contact");
+        assert_eq!(
+            proxy.grid_position().is_some(),
+            tw.contact().is_some(),
+            "tick {t}: contact"
+        );
     }
     assert_eq!(window.shifts(), tw.shifts);
     let rms = (sum2 / ticks as f64).sqrt();
@@ -140,9 +149,15 @@ fn the_core_roams_a_cap_with_the_twin() {
             "CAPTWIN case={name} wide_rms_rel={rms_w:.2e} wide_max_rel={max_w:.2e} narrow_rms_rel={rms_n:.2e} narrow_max_rel={max_n:.2e} shifts={shifts} ticks_apart={apart}"
         );
         assert!(shifts >= 20, "{name}: {shifts} shifts");
-        assert!(apart <= 2, "{name}: the windows were apart on {apart} ticks");
+        assert!(
+            apart <= 2,
+            "{name}: the windows were apart on {apart} ticks"
+        );
         for (what, rms, max) in [("wide", rms_w, max_w), ("narrow", rms_n, max_n)] {
-            assert!(rms <= 0.005 && max <= 0.02, "{name} {what}: RMS {rms:.2e}, max {max:.2e}");
+            assert!(
+                rms <= 0.005 && max <= 0.02,
+                "{name} {what}: RMS {rms:.2e}, max {max:.2e}"
+            );
         }
     }
 }
@@ -155,7 +170,9 @@ fn the_core_roams_a_cap_with_the_twin() {
 fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
     let mut s = fixed::<Wide>();
     let mut proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-    let mut window = s.window(&window_config(Some(RADIUS)), &proxy, -40.0, -30.0).unwrap();
+    let mut window = s
+        .window(&window_config(Some(RADIUS)), &proxy, -40.0, -30.0)
+        .unwrap();
     // The probe far above the cap, moving over it: the window follows the probe.
     let mut checked = 0;
     for t in 0..=1200 {
@@ -173,13 +190,26 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
             .window(&window_config(Some(RADIUS)), &fresh_proxy, at(ci), at(cj))
             .unwrap();
         assert_eq!(w2.centre(), (ci, cj));
-        for (e, (got, want)) in s.topology().edges().iter().zip(fresh.topology().edges()).enumerate() {
+        for (e, (got, want)) in s
+            .topology()
+            .edges()
+            .iter()
+            .zip(fresh.topology().edges())
+            .enumerate()
+        {
             let close = (0..3).all(|k| (got.dir[k] - want.dir[k]).abs() <= 1)
                 && (got.inv_len - want.inv_len).abs() <= 1;
-            assert!(close, "tick {t} window {ci},{cj} edge {e}: {got:?} vs {want:?}");
+            assert!(
+                close,
+                "tick {t} window {ci},{cj} edge {e}: {got:?} vs {want:?}"
+            );
         }
         for i in 1..s.topology().node_count() as u16 {
-            assert_eq!(s.topology().rest(i), fresh.topology().rest(i), "tick {t} node {i}");
+            assert_eq!(
+                s.topology().rest(i),
+                fresh.topology().rest(i),
+                "tick {t} node {i}"
+            );
         }
         checked += 1;
     }
@@ -223,7 +253,9 @@ fn the_cap_at_rest_stays_at_rest() {
 fn caps_the_core_cannot_run_are_refused() {
     let mut s = fixed::<Wide>();
     let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-    assert!(s.window(&window_config(Some(148.5)), &proxy, 0.0, 0.0).is_ok());
+    assert!(s
+        .window(&window_config(Some(148.5)), &proxy, 0.0, 0.0)
+        .is_ok());
     for bad in [148.0, 2000.5, f64::NAN, -150.0] {
         let got = s.window(&window_config(Some(bad)), &proxy, 0.0, 0.0).err();
         assert_eq!(got, Some(ProxyError::Cap), "radius {bad}");
@@ -263,4 +295,3 @@ fn caps_the_core_cannot_run_are_refused() {
         Some(ProxyError::Cap)
     );
 }
-

@@ -806,9 +806,9 @@ fn replay_roaming_errors_name_the_argument() {
                 "--tissue",
                 "64,64",
                 "--cap-radius",
-                "200",
+                "2500",
             ][..],
-            &["--cap-radius", "flat tissue only"][..],
+            &["--cap-radius", "2000 mm"][..],
         ),
         (&["--tissue", "2,64"], &["--tissue", "3..=64"]),
         (&["--tissue", "64"], &["--tissue", "W,H"]),
@@ -867,35 +867,40 @@ fn replay_roams_in_the_core_as_in_the_reference() {
             .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
             .collect()
     };
-    let reference = run(&[]);
-    for extra in [
-        &["--backend", "fixed"][..],
-        &["--backend", "fixed", "--arith", "narrow"],
-    ] {
-        let fixed = run(extra);
-        assert_eq!(fixed.len(), reference.len());
-        for (f, r) in fixed.iter().zip(&reference) {
-            let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
-            let diff =
-                ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
-            assert!(
-                diff <= 0.02 + 0.02 * mag,
-                "{extra:?} t = {}: {f:?} against {r:?}",
-                r[0]
-            );
-            let proxy =
-                ((f[4] - r[4]).powi(2) + (f[5] - r[5]).powi(2) + (f[6] - r[6]).powi(2)).sqrt();
-            assert!(
-                proxy <= 0.01,
-                "{extra:?} t = {}: the proxy is {proxy} mm off",
-                r[0]
-            );
-            assert_eq!(
-                (f[7], f[8], f[9]),
-                (r[7], r[8], r[9]),
-                "{extra:?} t = {}: contact, slip, shifts",
-                r[0]
-            );
+    // Flat, and over a cap (R = 200 mm: the path's 1 mm below the top is 0.44 … 1 mm
+    // deep).
+    for shape in [&[][..], &["--cap-radius", "200"][..]] {
+        let reference = run(shape);
+        for extra in [
+            &["--backend", "fixed"][..],
+            &["--backend", "fixed", "--arith", "narrow"],
+        ] {
+            let extra = [extra, shape].concat();
+            let fixed = run(&extra);
+            assert_eq!(fixed.len(), reference.len());
+            for (f, r) in fixed.iter().zip(&reference) {
+                let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
+                let diff =
+                    ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
+                assert!(
+                    diff <= 0.02 + 0.02 * mag,
+                    "{extra:?} t = {}: {f:?} against {r:?}",
+                    r[0]
+                );
+                let proxy =
+                    ((f[4] - r[4]).powi(2) + (f[5] - r[5]).powi(2) + (f[6] - r[6]).powi(2)).sqrt();
+                assert!(
+                    proxy <= 0.01,
+                    "{extra:?} t = {}: the proxy is {proxy} mm off",
+                    r[0]
+                );
+                assert_eq!(
+                    (f[7], f[8], f[9]),
+                    (r[7], r[8], r[9]),
+                    "{extra:?} t = {}: contact, slip, shifts",
+                    r[0]
+                );
+            }
         }
     }
 }

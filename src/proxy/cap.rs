@@ -64,7 +64,8 @@ impl Proxy {
         let at = |u: i32, o: i32| {
             sat(mul_wide(u.max(0).min(top) - centre, self.spacing) >> G_FRAC).saturating_add(o)
         };
-        f.cap.normal([at(g[0], f.origin[0]), at(g[1], f.origin[1]), z])
+        f.cap
+            .normal([at(g[0], f.origin[0]), at(g[1], f.origin[1]), z])
     }
 
     /// The proxy's centre for grid `g` on a cap (the surface point plus `r` along the
@@ -82,9 +83,11 @@ impl Proxy {
     /// The grid position of the deformed surface's point on the cap's radial line
     /// through `p` (patch frame, Q24 mm).
     fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> [i32; 2] {
-        let n = f
-            .cap
-            .radial([p[0].saturating_add(f.origin[0]), p[1].saturating_add(f.origin[1]), p[2]]);
+        let n = f.cap.radial([
+            p[0].saturating_add(f.origin[0]),
+            p[1].saturating_add(f.origin[1]),
+            p[2],
+        ]);
         // Where the line meets the rest cap: R n from the cap's centre (R Q20 · n Q29 is
         // Q49: Q24 after >> 25), in the patch frame.
         let r = f.cap.radius_q20() as i64;

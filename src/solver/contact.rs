@@ -143,7 +143,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         proxy: &Proxy,
         window: &crate::window::Window<EDGES>,
     ) -> Option<[Length; 3]> {
-        match window.cap_frame() {
+        match super::roaming::cap_frame(window) {
             None => self.proxy_point(proxy),
             Some(f) => proxy
                 .centre_cap_at(&self.cap_view(proxy, window), &f)

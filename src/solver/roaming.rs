@@ -5,7 +5,7 @@ use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::cap::Cap;
-use crate::proxy::{Proxy, ProxyError};
+use crate::proxy::{CapFrame, Proxy, ProxyError};
 use crate::q::{self, mul_wide, sat, V3};
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
@@ -126,7 +126,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// On a cap: the free nodes' rest heights from the window's, and each spring's rest
     /// geometry: taken from `old` through the map of direction `dir` where it continues a
     /// spring, else computed from the heights (all of them without `old`).
-    fn set_cap_geometry(&mut self, window: &Window<EDGES>, old: Option<&[(V3, i32); EDGES]>, dir: usize) {
+    fn set_cap_geometry(
+        &mut self,
+        window: &Window<EDGES>,
+        old: Option<&[(V3, i32); EDGES]>,
+        dir: usize,
+    ) {
         let n = window.n;
         for a in 1..n - 1 {
             for b in 1..n - 1 {
@@ -193,7 +198,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         };
         let mut p = in_window(window);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
-        let frame = window.cap_frame();
+        let frame = cap_frame(window);
         match &frame {
             None => proxy.update(&self.view(proxy), p),
             Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, p),
@@ -211,7 +216,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             p = in_window(window);
         }
         self.probe_prev = p;
-        match window.cap_frame() {
+        match cap_frame(window) {
             None => self.proxy_substeps(p, probe_vel, proxy),
             Some(f) => self.proxy_substeps_cap(p, probe_vel, proxy, window, &f),
         }
@@ -274,7 +279,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 let (a, b) = (order(d[0], ka), order(d[1], kb));
                 let (sa, sb) = (a + d[0], b + d[1]);
                 let z = if (0..n).contains(&sa) && (0..n).contains(&sb) {
-                    window.heights.get((sa * n + sb) as usize).copied().unwrap_or(0)
+                    window
+                        .heights
+                        .get((sa * n + sb) as usize)
+                        .copied()
+                        .unwrap_or(0)
                 } else {
                     cap.height(window.corner[0] + sa, window.corner[1] + sb)
                 };
@@ -291,6 +300,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 }
 
+/// The window's cap as the proxy sees it this tick (`None`: flat).
+pub(super) fn cap_frame<const EDGES: usize>(window: &Window<EDGES>) -> Option<CapFrame> {
+    let origin = window.origin();
+    window.cap.map(|cap| CapFrame { cap, origin })
+}
+
 /// A spring's rest geometry `(dir, 1/l0)` (Q23, Q31 per mm) on a cap from its packed
 /// ends and the window's rest heights, in spacings so that every square fits `i64`: the
 /// horizontal offsets are whole spacings, the vertical one `Δz/s` by a product by `1/s`;
@@ -298,7 +313,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 fn edge_geometry<const EDGES: usize>(window: &Window<EDGES>, ends: u32) -> (V3, i32) {
     let [a, b] = unpack_ends(ends);
     let z = |k: [i32; 3]| {
-        let h = window.heights.get((k[0] * window.n + k[1]) as usize).copied().unwrap_or(0);
+        let h = window
+            .heights
+            .get((k[0] * window.n + k[1]) as usize)
+            .copied()
+            .unwrap_or(0);
         h.saturating_sub(k[2].wrapping_mul(window.spacing))
     };
     // Offsets in spacings, Q28 (|Δz| ≤ 128 mm over s ≥ 1 mm: the squares sum within i64).

@@ -61,7 +61,9 @@ impl Tissue {
         }
         if let Shape::Cap { radius } = shape {
             let half_diagonal = (hx * hx + hy * hy).sqrt();
-            if !radius.is_finite() || radius < 4.0 / 3.0 * half_diagonal || radius > MAX_CAP_RADIUS_MM
+            if !radius.is_finite()
+                || radius < 4.0 / 3.0 * half_diagonal
+                || radius > MAX_CAP_RADIUS_MM
             {
                 return Err(RoamError::CapRadius);
             }

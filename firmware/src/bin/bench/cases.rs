@@ -10,7 +10,7 @@ use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
 use mccs::{
     Arith, DefaultArith, Edge, ForceTable64, Length, ProxyConfig, Solver, SolverConfig, Strain,
-    Topology,
+    Topology, WindowConfig,
 };
 use mccs_firmware::demo;
 use mccs_firmware::entry as e;
@@ -263,8 +263,9 @@ fn tick_proxy_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable
 }
 
 /// The demo's roaming ticks (`DemoSpec::roaming`: its patch as a window on the 64 × 64
-/// tissue, friction 0.6 / 0.4): a press to 1 mm at `x = −5` (200 ticks), then a slide
-/// along `x` at 10 mm/s for 1000 ticks (4 window shifts), each tick measured alone.
+/// tissue, friction 0.6 / 0.4), flat or over a cap of radius 150 mm (`cap`): a press to
+/// `z = −1` mm at `x = −5` (200 ticks), then a slide along `x` at 10 mm/s for 1000 ticks
+/// (4 window shifts; over the cap 1 … 0.92 mm deep), each tick measured alone.
 #[derive(Clone, Copy)]
 pub struct RoamingTicks {
     /// The longest tick of the slide without a shift.
@@ -277,11 +278,11 @@ pub struct RoamingTicks {
 
 /// [`RoamingTicks`] for this core's demo patch; `empty` is the harness's own count.
 #[inline(never)]
-pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32, cap: bool) -> RoamingTicks {
     match demo::spec_for(CORE).grid {
-        8 => roaming_in::<37, 214>(h, table, empty),
-        5 => roaming_in::<10, 61>(h, table, empty),
-        _ => roaming_in::<5, 30>(h, table, empty),
+        8 => roaming_in::<37, 214>(h, table, empty, cap),
+        5 => roaming_in::<10, 61>(h, table, empty, cap),
+        _ => roaming_in::<5, 30>(h, table, empty, cap),
     }
 }
 
@@ -290,6 +291,7 @@ fn roaming_in<const N: usize, const E: usize>(
     h: &Harness,
     table: &ForceTable64,
     empty: u32,
+    cap: bool,
 ) -> RoamingTicks {
     let spec = demo::spec_for(CORE);
     let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) else {
@@ -299,7 +301,11 @@ fn roaming_in<const N: usize, const E: usize>(
         exit(false)
     };
     let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
-    let Ok(mut c) = spec.roaming(&mut s, -5.0, 0.4) else {
+    let window = WindowConfig {
+        cap_radius: cap.then_some(150.0),
+        ..demo::WINDOW
+    };
+    let Ok(mut c) = spec.roaming_on(&mut s, &window, -5.0, 0.4) else {
         exit(false)
     };
     let depth = Length::from_num(-1);
