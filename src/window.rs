@@ -34,9 +34,12 @@ pub(crate) const NONE: u16 = u16::MAX;
 /// In a map entry: the spring continued runs the other way (its direction is negated).
 pub(crate) const FLIP: u16 = 1 << 15;
 
-/// The window: where it is on the tissue, and the start-up maps its shifts use.
+/// The window: where it is on the tissue, and the start-up maps its shifts use. `CAP`:
+/// whether it may lie on a cap ([`crate::Solver::shaped_window`]); a flat-only window
+/// ([`crate::Solver::window`], the default) compiles its tick without the cap's code (on
+/// the M0 about 19 KiB of flash).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Window<const EDGES: usize> {
+pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) n: i32,
     pub(crate) w: i32,
     pub(crate) h: i32,
@@ -83,7 +86,7 @@ pub(crate) fn unpack_ends(x: u32) -> [[i32; 3]; 2] {
     [one(x), one(x >> 15)]
 }
 
-impl<const EDGES: usize> Window<EDGES> {
+impl<const EDGES: usize, const CAP: bool> Window<EDGES, CAP> {
     /// The window's centre node, tissue grid coordinates.
     pub fn centre(&self) -> (usize, usize) {
         (

@@ -158,23 +158,11 @@ impl DemoSpec {
         x: f64,
         y: f64,
     ) -> Result<Roaming<E>, DemoError> {
-        self.roaming_on(solver, &WINDOW, x, y)
-    }
-
-    /// [`Self::roaming`] on another tissue (e.g. a cap: the bench).
-    #[inline(never)]
-    pub fn roaming_on<const N: usize, const E: usize, A: Arith>(
-        &self,
-        solver: &mut Solver<N, E, 64, A>,
-        tissue: &WindowConfig,
-        x: f64,
-        y: f64,
-    ) -> Result<Roaming<E>, DemoError> {
         let proxy = solver
             .proxy(&self.proxy_config())
             .map_err(DemoError::Contact)?;
         let window = solver
-            .window(tissue, &proxy, x, y)
+            .window(&WINDOW, &proxy, x, y)
             .map_err(DemoError::Contact)?;
         Ok(Roaming { proxy, window })
     }

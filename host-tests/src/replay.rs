@@ -263,7 +263,7 @@ impl Replay {
         let mut ticks = traj.ticks(self.config.tick_hz).peekable();
         let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
         let mut window = s
-            .window(&window_config, &proxy, start[0], start[1])
+            .shaped_window(&window_config, &proxy, start[0], start[1])
             .map_err(ReplayError::Proxy)?;
         for (time, p) in ticks {
             let force = s.step_roaming(p.map(Length::saturating_from_num), &mut proxy, &mut window);

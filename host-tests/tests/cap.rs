@@ -82,7 +82,7 @@ fn compare<A: Arith>(mu: (f64, f64), radius: f64, x0: f64, y0: f64) -> (f64, f64
     let mut proxy = s.proxy(&proxy_config(mu, radius)).unwrap();
     let start = palpation(x0, y0, 0);
     let mut window = s
-        .window(&window_config(Some(RADIUS)), &proxy, start[0], start[1])
+        .shaped_window(&window_config(Some(RADIUS)), &proxy, start[0], start[1])
         .unwrap();
     let cfg = RoamConfig {
         tissue: Tissue::new(SIDE, SIDE, SPACING, Shape::Cap { radius: RADIUS }).unwrap(),
@@ -171,7 +171,7 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
     let mut s = fixed::<Wide>();
     let mut proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
     let mut window = s
-        .window(&window_config(Some(RADIUS)), &proxy, -40.0, -30.0)
+        .shaped_window(&window_config(Some(RADIUS)), &proxy, -40.0, -30.0)
         .unwrap();
     // The probe far above the cap, moving over it: the window follows the probe.
     let mut checked = 0;
@@ -187,7 +187,7 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
         let mut fresh = fixed::<Wide>();
         let fresh_proxy = fresh.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
         let w2 = fresh
-            .window(&window_config(Some(RADIUS)), &fresh_proxy, at(ci), at(cj))
+            .shaped_window(&window_config(Some(RADIUS)), &fresh_proxy, at(ci), at(cj))
             .unwrap();
         assert_eq!(w2.centre(), (ci, cj));
         for (e, (got, want)) in s
@@ -226,7 +226,9 @@ fn the_cap_at_rest_stays_at_rest() {
     fn run<A: Arith>(cap: Option<f64>) -> f64 {
         let mut s = fixed::<A>();
         let mut proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-        let mut window = s.window(&window_config(cap), &proxy, 0.0, 0.0).unwrap();
+        let mut window = s
+            .shaped_window(&window_config(cap), &proxy, 0.0, 0.0)
+            .unwrap();
         let mut worst = 0.0f64;
         for t in 0..2000 {
             let x = 75.0 * (t as f64 / 2000.0);
@@ -248,16 +250,19 @@ fn the_cap_at_rest_stays_at_rest() {
 }
 
 /// Radii outside 4/3 of the half-diagonal … 2000 mm, a cap whose base would reach below
-/// −100 mm, and (in the M0's arithmetic) springs longer than 16 mm are refused.
+/// −100 mm, (in the M0's arithmetic) springs longer than 16 mm, and a cap for a flat-only
+/// window are refused.
 #[test]
 fn caps_the_core_cannot_run_are_refused() {
     let mut s = fixed::<Wide>();
     let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
     assert!(s
-        .window(&window_config(Some(148.5)), &proxy, 0.0, 0.0)
+        .shaped_window(&window_config(Some(148.5)), &proxy, 0.0, 0.0)
         .is_ok());
     for bad in [148.0, 2000.5, f64::NAN, -150.0] {
-        let got = s.window(&window_config(Some(bad)), &proxy, 0.0, 0.0).err();
+        let got = s
+            .shaped_window(&window_config(Some(bad)), &proxy, 0.0, 0.0)
+            .err();
         assert_eq!(got, Some(ProxyError::Cap), "radius {bad}");
     }
     // 41 × 41 at 5 mm (±100 mm): the smallest cap's corner lies 63.9 mm down, its base
@@ -280,7 +285,9 @@ fn caps_the_core_cannot_run_are_refused() {
         hysteresis: 0.1,
         cap_radius: Some(r),
     };
-    assert!(s.window(&cfg(41, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0).is_ok());
+    assert!(s
+        .shaped_window(&cfg(41, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0)
+        .is_ok());
     let topo = Topology::<10, 61>::standard_patch(N, 10.0).unwrap();
     let table = ForceTable64::new(&Params::TABLE2).unwrap();
     let mut m0 = Solver::with_arith(topo, table, &SolverConfig::default(), Narrow).unwrap();
@@ -291,7 +298,8 @@ fn caps_the_core_cannot_run_are_refused() {
         })
         .unwrap();
     assert_eq!(
-        m0.window(&cfg(21, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0).err(),
+        m0.shaped_window(&cfg(21, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0)
+            .err(),
         Some(ProxyError::Cap)
     );
 }

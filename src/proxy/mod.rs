@@ -67,6 +67,9 @@ pub enum ProxyError {
     /// A cap radius outside 4/3 of the tissue's half-diagonal … 2000 mm, or a cap whose
     /// base reaches below −100 mm or whose longest spring is too long for the arithmetic.
     Cap,
+    /// A cap for a flat-only window (`Solver::window`): a cap needs
+    /// `Solver::shaped_window`.
+    FlatWindow,
 }
 
 impl ProxyError {
@@ -78,6 +81,7 @@ impl ProxyError {
             Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
             Self::Window => "window: the tissue must be n..=64 nodes a side within ±100 mm, the hysteresis 0.05 … 0.45",
             Self::Cap => "cap: the radius must be 4/3 of the tissue's half-diagonal … 2000 mm, its base above -100 mm, its springs within the arithmetic's longest",
+            Self::FlatWindow => "window: a flat-only window (Solver::window) cannot lie on a cap: use Solver::shaped_window",
         }
     }
 }

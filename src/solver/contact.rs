@@ -118,10 +118,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// A window's surface over a cap.
-    pub(super) fn cap_view<'a>(
+    pub(super) fn cap_view<'a, const CAP: bool>(
         &'a self,
         proxy: &Proxy,
-        window: &'a crate::window::Window<EDGES>,
+        window: &'a crate::window::Window<EDGES, CAP>,
     ) -> CapView<'a, NODES, EDGES, S, A> {
         CapView {
             view: self.view(proxy),
@@ -138,10 +138,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 
     /// The proxy's centre (mm, patch frame) on a window's current surface (flat or a
     /// cap), when in contact.
-    pub fn proxy_point_in(
+    pub fn proxy_point_in<const CAP: bool>(
         &self,
         proxy: &Proxy,
-        window: &crate::window::Window<EDGES>,
+        window: &crate::window::Window<EDGES, CAP>,
     ) -> Option<[Length; 3]> {
         match super::roaming::cap_frame(window) {
             None => self.proxy_point(proxy),
@@ -186,12 +186,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// [`Self::proxy_substeps`] on a cap.
-    pub(super) fn proxy_substeps_cap(
+    pub(super) fn proxy_substeps_cap<const CAP: bool>(
         &mut self,
         p: V3,
         probe_vel: V3,
         proxy: &Proxy,
-        window: &crate::window::Window<EDGES>,
+        window: &crate::window::Window<EDGES, CAP>,
         frame: &CapFrame,
     ) {
         let count = self.topo.node_count().min(NODES);

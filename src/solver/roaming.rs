@@ -18,10 +18,11 @@ type Key = [i32; 3];
 const DIRECTIONS: [[i32; 2]; 4] = [[1, 0], [-1, 0], [0, 1], [0, -1]];
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
-    /// A window of this solver's patch onto a tissue of `config`'s size and shape,
-    /// centred on the tissue node nearest `(x, y)` (mm, tissue frame: origin at its
-    /// centre), for a proxy from [`Solver::proxy`] (start-up: the maps take `4 E²`
-    /// comparisons). On a cap the patch takes the window's rest geometry (its
+    /// A window of this solver's patch onto a flat tissue of `config`'s size, centred on
+    /// the tissue node nearest `(x, y)` (mm, tissue frame: origin at its centre), for a
+    /// proxy from [`Solver::proxy`] (start-up: the maps take `4 E²` comparisons). A cap
+    /// (`config.cap_radius`) is refused ([`ProxyError::FlatWindow`]): it needs
+    /// [`Solver::shaped_window`]. On a cap the patch takes the window's rest geometry (its
     /// substeps and [`crate::ParamSet`] fingerprint stay the flat patch's: the cap's
     /// springs are no shorter, so no stiffer).
     pub fn window(
@@ -31,6 +32,34 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         x: f64,
         y: f64,
     ) -> Result<Window<EDGES>, ProxyError> {
+        self.window_as(config, proxy, x, y)
+    }
+
+    /// [`Solver::window`] onto a flat tissue or a cap (`config.cap_radius`): a
+    /// `Window<EDGES, true>`, whose tick carries the cap's code.
+    pub fn shaped_window(
+        &mut self,
+        config: &WindowConfig,
+        proxy: &Proxy,
+        x: f64,
+        y: f64,
+    ) -> Result<Window<EDGES, true>, ProxyError> {
+        self.window_as(config, proxy, x, y)
+    }
+
+    /// [`Solver::window`] (`CAP` false) or [`Solver::shaped_window`] (`CAP` true), for
+    /// code generic over the window's kind.
+    #[inline(never)]
+    pub fn window_as<const CAP: bool>(
+        &mut self,
+        config: &WindowConfig,
+        proxy: &Proxy,
+        x: f64,
+        y: f64,
+    ) -> Result<Window<EDGES, CAP>, ProxyError> {
+        if !CAP && config.cap_radius.is_some() {
+            return Err(ProxyError::FlatWindow);
+        }
         let (n, spacing) = proxy.grid();
         let (w, h) = (config.tissue_w, config.tissue_h);
         let s = to_f64(spacing, LEN_FRAC);
@@ -76,7 +105,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                     .unwrap_or(NONE)
             })
         });
-        let mut window = Window {
+        let mut window = Window::<EDGES, CAP> {
             n: n as i32,
             w: w as i32,
             h: h as i32,
@@ -90,7 +119,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             heights: [0; EDGES],
             ends: core::array::from_fn(|e| pack_ends(keys[e])),
         };
-        if let Some(cap) = cap {
+        if let Some(cap) = cap.filter(|_| CAP) {
             if n * n > EDGES {
                 return Err(ProxyError::Window);
             }
@@ -126,9 +155,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// On a cap: the free nodes' rest heights from the window's, and each spring's rest
     /// geometry: taken from `old` through the map of direction `dir` where it continues a
     /// spring, else computed from the heights (all of them without `old`).
-    fn set_cap_geometry(
+    fn set_cap_geometry<const CAP: bool>(
         &mut self,
-        window: &Window<EDGES>,
+        window: &Window<EDGES, CAP>,
         old: Option<&[(V3, i32); EDGES]>,
         dir: usize,
     ) {
@@ -185,13 +214,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// One haptic tick on the tissue with the probe at `probe` (mm, tissue frame)
     /// touching it through `proxy`; the window follows the contact (see [`Window`]).
     /// Returns the force the device must render (N).
-    pub fn step_roaming(
+    pub fn step_roaming<const CAP: bool>(
         &mut self,
         probe: [Length; 3],
         proxy: &mut Proxy,
-        window: &mut Window<EDGES>,
+        window: &mut Window<EDGES, CAP>,
     ) -> [Force; 3] {
-        let in_window = |w: &Window<EDGES>| {
+        let in_window = |w: &Window<EDGES, CAP>| {
             let o = w.origin();
             let p = probe.map(Length::to_bits);
             [p[0].saturating_sub(o[0]), p[1].saturating_sub(o[1]), p[2]]
@@ -225,7 +254,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 
     /// Moves the window one node along `d` (one axis): node states, warm-start values,
     /// the proxy's place.
-    fn shift(&mut self, window: &mut Window<EDGES>, d: [i32; 2], proxy: &mut Proxy) {
+    fn shift<const CAP: bool>(
+        &mut self,
+        window: &mut Window<EDGES, CAP>,
+        d: [i32; 2],
+        proxy: &mut Proxy,
+    ) {
         let n = window.n;
         let node = |a: i32, b: i32| surface_node(n as usize, a, b);
         // In the direction of the shift, so that every source is read before it is
@@ -252,13 +286,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             [0, 1] => 2,
             _ => 3,
         };
-        if window.cap.is_some() {
+        if CAP && window.cap.is_some() {
             self.shift_cap(window, d, dir);
         }
         let old = self.warm;
         for (e, w) in self.warm.iter_mut().enumerate() {
             let from = window.maps[dir].get(e).copied().unwrap_or(NONE);
-            *w = old.get(from as usize).copied().unwrap_or(A::REST);
+            *w = old.get((from & !FLIP) as usize).copied().unwrap_or(A::REST);
         }
         proxy.shift_grid(d);
         window.corner = [window.corner[0] + d[0], window.corner[1] + d[1]];
@@ -268,7 +302,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// A shift's part on a cap: the rest heights move with the window (the `n` entering
     /// ones computed), then the springs' rest geometry (see [`Self::set_cap_geometry`]).
     #[inline(never)]
-    fn shift_cap(&mut self, window: &mut Window<EDGES>, d: [i32; 2], dir: usize) {
+    fn shift_cap<const CAP: bool>(
+        &mut self,
+        window: &mut Window<EDGES, CAP>,
+        d: [i32; 2],
+        dir: usize,
+    ) {
         let n = window.n;
         let Some(cap) = window.cap else {
             return;
@@ -300,8 +339,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 }
 
-/// The window's cap as the proxy sees it this tick (`None`: flat).
-pub(super) fn cap_frame<const EDGES: usize>(window: &Window<EDGES>) -> Option<CapFrame> {
+/// The window's cap as the proxy sees it this tick (`None`: flat; always for a flat-only
+/// window, so that its tick compiles without the cap's code).
+pub(super) fn cap_frame<const EDGES: usize, const CAP: bool>(
+    window: &Window<EDGES, CAP>,
+) -> Option<CapFrame> {
+    if !CAP {
+        return None;
+    }
     let origin = window.origin();
     window.cap.map(|cap| CapFrame { cap, origin })
 }
@@ -310,7 +355,10 @@ pub(super) fn cap_frame<const EDGES: usize>(window: &Window<EDGES>) -> Option<Ca
 /// ends and the window's rest heights, in spacings so that every square fits `i64`: the
 /// horizontal offsets are whole spacings, the vertical one `Δz/s` by a product by `1/s`;
 /// `s/l0` by one reciprocal square root (within 2e-8).
-fn edge_geometry<const EDGES: usize>(window: &Window<EDGES>, ends: u32) -> (V3, i32) {
+fn edge_geometry<const EDGES: usize, const CAP: bool>(
+    window: &Window<EDGES, CAP>,
+    ends: u32,
+) -> (V3, i32) {
     let [a, b] = unpack_ends(ends);
     let z = |k: [i32; 3]| {
         let h = window
@@ -347,5 +395,59 @@ fn round_shr(x: i64, sh: u32) -> i64 {
         -(m as i64)
     } else {
         m as i64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DIRECTIONS;
+    use crate::window::{FLIP, NONE};
+    use crate::{Arith, DefaultArith, ForceTable64, Params, ProxyConfig, Solver, SolverConfig};
+    use crate::{Topology, WindowConfig};
+
+    /// A shift gives every spring that continues one the warm-start value of that one
+    /// (whichever way it runs), and the others rest: for each direction, on a flat
+    /// window and on a cap. Reversed springs exist in every direction. (The warm-start
+    /// values are marked with their spring's index.)
+    #[test]
+    fn a_shift_carries_every_continued_springs_warm_start_value() {
+        for cap_radius in [None, Some(60.0)] {
+            for (dir, d) in DIRECTIONS.into_iter().enumerate() {
+                let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
+                let table = ForceTable64::new(&Params::TABLE2).unwrap();
+                let mut s = Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default())
+                    .unwrap();
+                let config = ProxyConfig {
+                    grid: 5,
+                    spacing: 2.5,
+                    mu_s: 0.0,
+                    mu_k: 0.0,
+                    probe_radius: 0.0,
+                };
+                let mut proxy = s.proxy(&config).unwrap();
+                let tissue = WindowConfig {
+                    tissue_w: 16,
+                    tissue_h: 16,
+                    hysteresis: 0.1,
+                    cap_radius,
+                };
+                let mut w = s.shaped_window(&tissue, &proxy, 0.0, 0.0).unwrap();
+                for (e, x) in s.warm.iter_mut().enumerate() {
+                    *x = 1000 + e as i32;
+                }
+                s.shift(&mut w, d, &mut proxy);
+                let (mut carried, mut reversed) = (0, 0);
+                for (e, &m) in w.maps[dir].iter().enumerate() {
+                    if m == NONE {
+                        assert_eq!(s.warm[e], <DefaultArith as Arith>::REST, "{d:?} {e}");
+                    } else {
+                        assert_eq!(s.warm[e], 1000 + (m & !FLIP) as i32, "{d:?} {e}");
+                        carried += 1;
+                        reversed += (m & FLIP != 0) as u32;
+                    }
+                }
+                assert!(carried > 30 && reversed > 0, "{d:?}: {carried} {reversed}");
+            }
+        }
     }
 }

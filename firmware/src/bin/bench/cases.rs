@@ -278,20 +278,29 @@ pub struct RoamingTicks {
 
 /// [`RoamingTicks`] for this core's demo patch; `empty` is the harness's own count.
 #[inline(never)]
-pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32, cap: bool) -> RoamingTicks {
+pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
     match demo::spec_for(CORE).grid {
-        8 => roaming_in::<37, 214>(h, table, empty, cap),
-        5 => roaming_in::<10, 61>(h, table, empty, cap),
-        _ => roaming_in::<5, 30>(h, table, empty, cap),
+        8 => roaming_in::<37, 214, false>(h, table, empty),
+        5 => roaming_in::<10, 61, false>(h, table, empty),
+        _ => roaming_in::<5, 30, false>(h, table, empty),
+    }
+}
+
+/// [`roaming`] over a cap of radius 150 mm (`Solver::shaped_window`).
+#[inline(never)]
+pub fn roaming_cap(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    match demo::spec_for(CORE).grid {
+        8 => roaming_in::<37, 214, true>(h, table, empty),
+        5 => roaming_in::<10, 61, true>(h, table, empty),
+        _ => roaming_in::<5, 30, true>(h, table, empty),
     }
 }
 
 #[inline(never)]
-fn roaming_in<const N: usize, const E: usize>(
+fn roaming_in<const N: usize, const E: usize, const CAP: bool>(
     h: &Harness,
     table: &ForceTable64,
     empty: u32,
-    cap: bool,
 ) -> RoamingTicks {
     let spec = demo::spec_for(CORE);
     let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) else {
@@ -301,17 +310,20 @@ fn roaming_in<const N: usize, const E: usize>(
         exit(false)
     };
     let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
-    let window = WindowConfig {
-        cap_radius: cap.then_some(150.0),
+    let Ok(mut proxy) = s.proxy(&spec.proxy_config()) else {
+        exit(false)
+    };
+    let tissue = WindowConfig {
+        cap_radius: CAP.then_some(150.0),
         ..demo::WINDOW
     };
-    let Ok(mut c) = spec.roaming_on(&mut s, &window, -5.0, 0.4) else {
+    let Ok(mut window) = s.window_as::<CAP>(&tissue, &proxy, -5.0, 0.4) else {
         exit(false)
     };
     let depth = Length::from_num(-1);
     for k in 0..200 {
         let z = depth / 200 * k;
-        e::tick_roaming(&mut s, [x0, y, z], &mut c.proxy, &mut c.window);
+        e::tick_roaming(&mut s, [x0, y, z], &mut proxy, &mut window);
     }
     let step = Length::from_num(0.01);
     let mut x = x0;
@@ -323,18 +335,18 @@ fn roaming_in<const N: usize, const E: usize>(
     let mut last = 0;
     for _ in 0..1000 {
         x += step;
-        let before = c.window.shifts();
+        let before = window.shifts();
         let n = h
             .measure(1, || {
                 black_box(e::tick_roaming(
                     &mut s,
                     black_box([x, y, depth]),
-                    &mut c.proxy,
-                    &mut c.window,
+                    &mut proxy,
+                    &mut window,
                 ));
             })
             .saturating_sub(empty);
-        if c.window.shifts() != before {
+        if window.shifts() != before {
             out.shift = out.shift.max(n);
             out.shift_extra = out.shift_extra.max(n.saturating_sub(last));
         } else {
@@ -342,7 +354,7 @@ fn roaming_in<const N: usize, const E: usize>(
         }
         last = n;
     }
-    if c.window.shifts() < 3 || !c.proxy.slipping() {
+    if window.shifts() < 3 || !proxy.slipping() {
         exit(false)
     }
     out

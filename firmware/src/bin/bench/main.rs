@@ -103,7 +103,7 @@ mod firmware {
         figs.report("tick_proxy", cases::tick_proxy(&h, &table) - empty);
         // The demo's roaming: the longest tick without and with a window shift, and a
         // shift's own cost (the most a shift tick took over the tick before).
-        let roam = cases::roaming(&h, &table, empty, false);
+        let roam = cases::roaming(&h, &table, empty);
         figs.report("tick_roaming", roam.steady);
         figs.report("tick_roaming_shift", roam.shift);
         figs.report("window_shift", roam.shift_extra);
@@ -115,7 +115,7 @@ mod firmware {
         );
         // The same over a spherical cap (R = 150 mm): the contact along its normals, and
         // a shift that also computes the entering rest heights and springs.
-        let cap = cases::roaming(&h, &table, empty, true);
+        let cap = cases::roaming_cap(&h, &table, empty);
         figs.report("tick_roaming_cap", cap.steady);
         figs.report("tick_roaming_cap_shift", cap.shift);
         figs.report("window_shift_cap", cap.shift_extra);
