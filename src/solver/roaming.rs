@@ -415,8 +415,8 @@ mod tests {
             for (dir, d) in DIRECTIONS.into_iter().enumerate() {
                 let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
                 let table = ForceTable64::new(&Params::TABLE2).unwrap();
-                let mut s = Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default())
-                    .unwrap();
+                let mut s =
+                    Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default()).unwrap();
                 let config = ProxyConfig {
                     grid: 5,
                     spacing: 2.5,
