@@ -8,7 +8,8 @@
 //!   rest normal under the goal; the probe is in contact while `n' · (goal − probe) > 0`.
 //! - The friction cone is measured across `n'`: the proxy's offset from the goal less its
 //!   part along `n'`, against `μ` times the proxy's own depth along `n'`; a slip moves it
-//!   within that plane onto the cone, then back onto the surface along the radial line.
+//!   within that plane onto the cone, then back onto the surface along the goal's radial
+//!   line.
 //! - The coupling's damping acts along the rest normal under the proxy, and the force is
 //!   unilateral along it.
 //!
@@ -81,8 +82,8 @@ impl Proxy {
     }
 
     /// The grid position of the deformed surface's point on the cap's radial line
-    /// through `p` (patch frame, Q24 mm).
-    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> [i32; 2] {
+    /// through `p` (patch frame, Q24 mm), and that line's direction (Q29).
+    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> ([i32; 2], V3) {
         let n = f.cap.radial([
             p[0].saturating_add(f.origin[0]),
             p[1].saturating_add(f.origin[1]),
@@ -90,9 +91,17 @@ impl Proxy {
         ]);
         // Where the line meets the rest cap: R n from the cap's centre (R Q20 · n Q29 is
         // Q49: Q24 after >> 25), in the patch frame.
-        let r = f.cap.radius_q20() as i64;
-        let on_cap = |k: usize| sat((r * n[k] as i64) >> 25).saturating_sub(f.origin[k]);
-        let mut g = self.rest_grid(on_cap(0), on_cap(1));
+        let r = f.cap.radius_q20();
+        let on_cap = |k: usize| sat(mul_wide(r, n[k]) >> 25).saturating_sub(f.origin[k]);
+        let start = self.rest_grid(on_cap(0), on_cap(1));
+        (self.locate_along(s, p, n, start), n)
+    }
+
+    /// The grid position of the deformed surface's point on the line through `p` along
+    /// `n` (Q29), from grid position `start` near it: [`LOCATE_STEPS`] corrections, each
+    /// by the offset between that line and the surface point there.
+    fn locate_along(&self, s: &impl Surface, p: V3, n: V3, start: [i32; 2]) -> [i32; 2] {
+        let mut g = start;
         for _ in 0..LOCATE_STEPS {
             let sp = self.point(s, g);
             let t = dot(sub(sp, p), n);
@@ -108,7 +117,7 @@ impl Proxy {
 
     /// [`Proxy::update`] on a cap.
     pub(crate) fn update_cap(&mut self, s: &impl Surface, f: &CapFrame, probe: V3) {
-        let goal_g = self.locate_cap(s, f, probe);
+        let (goal_g, line) = self.locate_cap(s, f, probe);
         let (goal, n) = self.centre_cap(s, f, goal_g);
         if dot(sub(goal, probe), n) <= 0 {
             self.release();
@@ -139,7 +148,9 @@ impl Proxy {
             let lambda = scale_to(radius, t2);
             let next: V3 =
                 core::array::from_fn(|k| goal[k].saturating_add(q::mul_weight(t[k], lambda)));
-            at = self.locate_cap(s, f, sub(next, along(self.radius, n)));
+            // The surface point under the slid proxy, along the goal's line, from where
+            // the proxy was.
+            at = self.locate_along(s, sub(next, along(self.radius, n)), line, at);
         }
         self.at = Some(at);
     }

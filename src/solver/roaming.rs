@@ -373,18 +373,18 @@ fn edge_geometry<const EDGES: usize, const CAP: bool>(
     // other end is its exact negation (a continued spring may run the other way), and
     // a unit direction's length stays within rounding of one (no strain at rest).
     let dz = z(b).saturating_sub(z(a));
-    let ds: [i64; 3] = [
-        ((b[0] - a[0]) as i64) << 28,
-        ((b[1] - a[1]) as i64) << 28,
-        round_shr(dz as i64 * window.inv_s as i64, 26),
-    ];
-    let (y, e) = q::rsqrt(ds[0] * ds[0] + ds[1] * ds[1] + ds[2] * ds[2]);
+    // The horizontal offsets are whole spacings (−1, 0 or 1): their squares are exact.
+    let (da, db) = (b[0] - a[0], b[1] - a[1]);
+    let ds_z = sat(round_shr(mul_wide(dz, window.inv_s), 26));
+    let flat2 = ((da * da + db * db) as i64) << 56;
+    let (y, e) = q::rsqrt(flat2 + mul_wide(ds_z, ds_z));
     // s/l0 = y 2^(e/2 − 34) (the sum is Q56), in Q30: y >> (4 − e/2); l0 ≥ s: e ≤ 6.
     let sl = round_shr(y as i64, 4u32.saturating_sub(e >> 1).max(1)) as i32;
     // 1/l0 = (s/l0)(1/s): Q30 · Q30 = Q60, Q31 after >> 29; 1 mm is held at i32::MAX.
     let inv_len = sat(round_shr(mul_wide(sl, window.inv_s), 29));
-    // dir = (Δ/s)(s/l0): Q28 · Q30 = Q58, Q23 after >> 35.
-    let dir = ds.map(|c| sat(round_shr(c * sl as i64, 35)));
+    // dir = (Δ/s)(s/l0): Q28 · Q30 = Q58, Q23 after >> 35 (a whole spacing: sl >> 7).
+    let whole = |d: i32| d.wrapping_mul(round_shr(sl as i64, 7) as i32);
+    let dir = [whole(da), whole(db), sat(round_shr(mul_wide(ds_z, sl), 35))];
     (dir, inv_len)
 }
 

@@ -248,18 +248,24 @@ impl RoamTwin {
         ([0, 1, 2].map(|k| s[k] + r * n[k]), n)
     }
 
-    /// The deformed surface's point on the rest normal line through `p` (for a cap,
-    /// fixed-point steps along the line until the distance along it settles within 1e-12
-    /// mm, at most [`SURFACE_STEPS`]: three left 2 % of the force unsettled under a 1 mm
-    /// sphere pressed 1.5 mm into the cap's slope; flat, exact at once).
+    /// The deformed surface's point on the rest normal line through `p` (for a cap, see
+    /// [`Self::surface_along`]; flat, exact at once).
     fn surface_at(&self, p: V) -> Anchor {
         let tissue = &self.cfg.tissue;
         let (x, y) = tissue.project(p);
-        let mut a = locate(tissue, |c| self.position(c), x, y);
+        let a = locate(tissue, |c| self.position(c), x, y);
         if tissue.shape == Shape::Flat {
             return a;
         }
-        let n = tissue.normal(x, y);
+        self.surface_along(p, tissue.normal(x, y), a)
+    }
+
+    /// The deformed surface's point on the line through `p` along `n`, from `a` near it:
+    /// fixed-point steps along the line until the distance along it settles within 1e-12
+    /// mm, at most [`SURFACE_STEPS`] (three left 2 % of the force unsettled under a 1 mm
+    /// sphere pressed 1.5 mm into the cap's slope).
+    fn surface_along(&self, p: V, n: V, mut a: Anchor) -> Anchor {
+        let tissue = &self.cfg.tissue;
         let mut last = f64::INFINITY;
         for _ in 0..SURFACE_STEPS {
             let s = a.point(|c| self.position(c));
@@ -280,6 +286,10 @@ impl RoamTwin {
 
     fn update_contact(&mut self, p: V) {
         let goal_anchor = self.surface_at(p);
+        let line = {
+            let (x, y) = self.cfg.tissue.project(p);
+            self.cfg.tissue.normal(x, y)
+        };
         let (goal, n) = self.proxy_of(&goal_anchor);
         let depth = dot(n, [0, 1, 2].map(|k| goal[k] - p[k]));
         if depth <= 0.0 {
@@ -313,10 +323,14 @@ impl RoamTwin {
                 break;
             }
             let surface = [0, 1, 2].map(|k| next[k] - self.cfg.probe_radius * n[k]);
+            // On a cap, along the goal's line (as the core does, which then needs no
+            // new square root): from the proxy's place.
             anchor = if next == goal {
                 goal_anchor
-            } else {
+            } else if self.cfg.tissue.shape == Shape::Flat {
                 self.surface_at(surface)
+            } else {
+                self.surface_along(surface, line, anchor)
             };
             if !slip.0 {
                 break;
