@@ -303,3 +303,69 @@ fn caps_the_core_cannot_run_are_refused() {
         Some(ProxyError::Cap)
     );
 }
+
+mod robust {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The device maximum as the core holds it (N), with a hair for the `f64` magnitude.
+    fn device_max() -> f64 {
+        mccs::Force::from_num(SolverConfig::default().coupling.max_force).to_num::<f64>() + 1e-12
+    }
+
+    fn roam<A: Arith>(r_cap: f64, mu: (f64, f64), radius: f64, probes: &[(f64, f64, f64)]) {
+        let mut s = fixed::<A>();
+        let mut proxy = s.proxy(&proxy_config(mu, radius)).unwrap();
+        let mut window = s
+            .shaped_window(&window_config(Some(r_cap)), &proxy, 0.0, 0.0)
+            .unwrap();
+        let height = |x: f64, y: f64| (r_cap * r_cap - x * x - y * y).max(0.0).sqrt() - r_cap;
+        let max = device_max();
+        for &(x, y, dz) in probes {
+            let p = [x, y, height(x, y) + dz];
+            let f = s.step_roaming(p.map(Length::saturating_from_num), &mut proxy, &mut window);
+            let f = f.map(|c| c.to_num::<f64>());
+            let mag = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+            assert!(mag <= max, "{mag} N over the maximum at {p:?}");
+            // Never pulling the probe into the tissue: along the cap's normal under the
+            // proxy (the core's is the chord's, within 1e-4 of it here).
+            if let Some(q) = s.proxy_point_in(&proxy, &window) {
+                let o = window.origin_mm().map(|c| c.to_num::<f64>());
+                let (qx, qy) = (q[0].to_num::<f64>() + o[0], q[1].to_num::<f64>() + o[1]);
+                let n = [qx / r_cap, qy / r_cap, (height(qx, qy) + r_cap) / r_cap];
+                let along = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+                assert!(along >= -1e-3 * mag - 1e-6, "pulled in: {f:?} against {n:?}");
+            } else {
+                assert_eq!(mag, 0.0, "a force out of contact at {p:?}");
+            }
+            let (i, j) = window.centre();
+            assert!((N / 2..SIDE - N / 2).contains(&i) && (N / 2..SIDE - N / 2).contains(&j));
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Any probe path over any cap the 64 × 64 tissue takes, from anywhere within
+        /// ±100 mm (and 60 mm above or below the cap) in jumps of any size, or wandering
+        /// near its surface: no panic (overflow checks are on here), the force within the
+        /// device maximum and never pulling the probe into the tissue, none out of
+        /// contact, the window on the tissue; both arithmetics.
+        #[test]
+        fn any_probe_path_over_any_cap_is_safe(
+            r_cap in 148.5f64..2000.0,
+            mu in (0.0f64..2.0, 0.0f64..2.0),
+            radius in 0.0f64..1.25,
+            probes in prop::collection::vec(
+                prop_oneof![
+                    (-100.0f64..100.0, -100.0f64..100.0, -60.0f64..60.0),
+                    (-8.0f64..8.0, -8.0f64..8.0, -3.0f64..1.0),
+                    (50.0f64..70.0, -70.0f64..-50.0, -3.0f64..1.0),
+                ],
+                1..150,
+            ),
+        ) {
+            roam::<Wide>(r_cap, mu, radius, &probes);
+            roam::<Narrow>(r_cap, mu, radius, &probes);
+        }
+    }
+}
