@@ -38,18 +38,20 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<N
     }
 }
 
-/// The probe touching a flat tissue through a proxy with friction, the patch following
-/// the contact as a window ([`Solver::step_roaming`]); the probe in the tissue frame.
+/// The probe touching a tissue through a proxy with friction, the patch following the
+/// contact as a window ([`Solver::step_roaming`]); the probe in the tissue frame. A flat
+/// tissue by default (`Solver::window`); with `CAP` a window from `Solver::shaped_window`,
+/// flat or a cap, whose tick carries the cap's code.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Roaming<const EDGES: usize> {
+pub struct Roaming<const EDGES: usize, const CAP: bool = false> {
     /// The proxy (from `Solver::proxy`).
     pub proxy: Proxy,
-    /// The window (from `Solver::window`).
-    pub window: Window<EDGES>,
+    /// The window (from `Solver::window`, or with `CAP` `Solver::shaped_window`).
+    pub window: Window<EDGES, CAP>,
 }
 
-impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<NODES, EDGES, S, A>
-    for Roaming<EDGES>
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const CAP: bool>
+    Contact<NODES, EDGES, S, A> for Roaming<EDGES, CAP>
 {
     fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3] {
         solver.step_roaming(probe, &mut self.proxy, &mut self.window)

@@ -334,7 +334,10 @@ mod robust {
                 let (qx, qy) = (q[0].to_num::<f64>() + o[0], q[1].to_num::<f64>() + o[1]);
                 let n = [qx / r_cap, qy / r_cap, (height(qx, qy) + r_cap) / r_cap];
                 let along = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
-                assert!(along >= -1e-3 * mag - 1e-6, "pulled in: {f:?} against {n:?}");
+                assert!(
+                    along >= -1e-3 * mag - 1e-6,
+                    "pulled in: {f:?} against {n:?}"
+                );
             } else {
                 assert_eq!(mag, 0.0, "a force out of contact at {p:?}");
             }

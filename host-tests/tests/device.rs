@@ -498,9 +498,37 @@ fn solver() -> Solver<10, 61, 64> {
     .unwrap()
 }
 
+/// The controller's contact in [`run_as`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Mode {
+    /// The probe glued to the patch's centre node.
+    Glued,
+    /// Roaming a flat tissue.
+    Roaming,
+    /// Roaming a spherical cap of radius 150 mm.
+    Cap,
+}
+
 /// The roaming contact (issue #19) for [`solver`]: friction 0.6 / 0.4, the window on a
 /// 64 × 64 tissue centred under the 1-DOF probe.
 fn roaming(s: &mut Solver<10, 61, 64>) -> Roaming<61> {
+    let (proxy, wc) = roaming_parts(s);
+    let window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
+    Roaming { proxy, window }
+}
+
+/// [`roaming`] over a cap of radius 150 mm (its top under the probe).
+fn roaming_cap(s: &mut Solver<10, 61, 64>) -> Roaming<61, true> {
+    let (proxy, wc) = roaming_parts(s);
+    let wc = WindowConfig {
+        cap_radius: Some(150.0),
+        ..wc
+    };
+    let window = s.shaped_window(&wc, &proxy, 0.0, 0.0).unwrap();
+    Roaming { proxy, window }
+}
+
+fn roaming_parts(s: &Solver<10, 61, 64>) -> (mccs::Proxy, WindowConfig) {
     let proxy = s
         .proxy(&ProxyConfig {
             grid: 5,
@@ -516,16 +544,15 @@ fn roaming(s: &mut Solver<10, 61, 64>) -> Roaming<61> {
         hysteresis: 0.1,
         cap_radius: None,
     };
-    let window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
-    Roaming { proxy, window }
+    (proxy, wc)
 }
 
 /// A 1-DOF device on fakes, the probe pressing in and out (so that the direction
 /// turns), with faults at `spi`, `pin` and `pwm` calls; 400 ticks of a controller, its
-/// probe glued or (`roam`) roaming. Returns the tick of the first failure, the tick the
+/// probe glued or roaming (`mode`). Returns the tick of the first failure, the tick the
 /// fault latched, and whether the actuator was driven (duty above zero with the driver
 /// enabled) at the end of every tick.
-fn run_as(spi: Fail, pin: Fail, pwm: Fail, roam: bool) -> (Option<usize>, Option<usize>, Vec<u16>) {
+fn run_as(spi: Fail, pin: Fail, pwm: Fail, mode: Mode) -> (Option<usize>, Option<usize>, Vec<u16>) {
     let log = Rc::new(RefCell::new(Log::default()));
     // 0.3 mm of travel per 100 counts; down to −3 mm and back, every 100 ticks.
     let sensor = Sensor::new(|n| {
@@ -540,20 +567,32 @@ fn run_as(spi: Fail, pin: Fail, pwm: Fail, roam: bool) -> (Option<usize>, Option
     sensor.0.borrow_mut().fail = Box::new(move |n| spi.at(n));
     let device = rig(&log, sensor, pwm, pin);
     // One tick, returning the telemetry after it: the controller glued or roaming.
-    let mut tick: Box<dyn FnMut() -> mccs_firmware::Telemetry> = if roam {
-        let mut s = solver();
-        let c = roaming(&mut s);
-        let mut ctl = Controller::with_contact(s, c, device, 0);
-        Box::new(move || {
-            ctl.tick(None);
-            ctl.telemetry()
-        })
-    } else {
-        let mut ctl = Controller::new(solver(), device, 0);
-        Box::new(move || {
-            ctl.tick(None);
-            ctl.telemetry()
-        })
+    let mut tick: Box<dyn FnMut() -> mccs_firmware::Telemetry> = match mode {
+        Mode::Roaming => {
+            let mut s = solver();
+            let c = roaming(&mut s);
+            let mut ctl = Controller::with_contact(s, c, device, 0);
+            Box::new(move || {
+                ctl.tick(None);
+                ctl.telemetry()
+            })
+        }
+        Mode::Cap => {
+            let mut s = solver();
+            let c = roaming_cap(&mut s);
+            let mut ctl = Controller::with_contact(s, c, device, 0);
+            Box::new(move || {
+                ctl.tick(None);
+                ctl.telemetry()
+            })
+        }
+        Mode::Glued => {
+            let mut ctl = Controller::new(solver(), device, 0);
+            Box::new(move || {
+                ctl.tick(None);
+                ctl.telemetry()
+            })
+        }
     };
     let mut duties = Vec::new();
     let (mut first_failure, mut latched) = (None, None);
@@ -583,16 +622,16 @@ fn run_as(spi: Fail, pin: Fail, pwm: Fail, roam: bool) -> (Option<usize>, Option
 /// once and failing forever: the actuator is off (zero duty, or the driver disabled
 /// where the PWM refuses every write) at the end of the tick the fault is found in, and
 /// at the end of every tick after (the safe state re-asserted every tick).
-/// The same with the probe glued and roaming (issue #19's contact: the fault path does
-/// not depend on it).
+/// The same with the probe glued and roaming, flat and over a cap (issue #19's contact:
+/// the fault path does not depend on it).
 #[test]
 fn a_fault_at_any_call_site_ends_at_the_actuator() {
-    for roam in [false, true] {
+    for roam in [Mode::Glued, Mode::Roaming, Mode::Cap] {
         let (_, latched, duties) = run_as(Fail::Never, Fail::Never, Fail::Never, roam);
         assert_eq!(latched, None);
         assert!(
             duties.iter().filter(|&&d| d > 0).count() > 100,
-            "roam {roam}: it renders"
+            "{roam:?}: it renders"
         );
         for schedule in [Fail::Once(150), Fail::From(150)] {
             for site in ["spi", "direction", "pwm"] {
@@ -604,12 +643,11 @@ fn a_fault_at_any_call_site_ends_at_the_actuator() {
                     _ => (Fail::Never, Fail::Never, shift(schedule, 150)),
                 };
                 let (_, latched, duties) = run_as(spi, pin, pwm, roam);
-                let t = latched.unwrap_or_else(|| {
-                    panic!("roam {roam}: {site} {schedule:?}: no fault latched")
-                });
+                let t = latched
+                    .unwrap_or_else(|| panic!("{roam:?}: {site} {schedule:?}: no fault latched"));
                 assert!(
                     duties[t..].iter().all(|&d| d == 0),
-                    "roam {roam}: {site} {schedule:?}: duty after the fault at tick {t}: {:?}",
+                    "{roam:?}: {site} {schedule:?}: duty after the fault at tick {t}: {:?}",
                     &duties[t..(t + 10).min(duties.len())]
                 );
             }
