@@ -810,6 +810,22 @@ fn replay_roaming_errors_name_the_argument() {
             ][..],
             &["--cap-radius", "2000 mm"][..],
         ),
+        (
+            // A cap whose corner cell's diagonal is longer than the M0's arithmetic takes.
+            &[
+                "--backend",
+                "fixed",
+                "--arith",
+                "narrow",
+                "--tissue",
+                "21,21",
+                "--spacing",
+                "10",
+                "--cap-radius",
+                "189",
+            ][..],
+            &["--cap-radius", "the arithmetic's longest"][..],
+        ),
         (&["--tissue", "2,64"], &["--tissue", "3..=64"]),
         (&["--tissue", "64"], &["--tissue", "W,H"]),
         (&["--tissue", "64,x"], &["--tissue", "W,H"]),

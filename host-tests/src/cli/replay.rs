@@ -8,6 +8,7 @@ use crate::paramfile;
 use crate::replay::{Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
 use crate::trajectory;
+use mccs::ProxyError;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -127,6 +128,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let w = std::io::BufWriter::new(out);
     let fail = |e| match e {
         ReplayError::Solver(s) => config_error(s, &cfg),
+        ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
         ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
         other => file_error(&a.params, other),
     };
@@ -184,11 +186,14 @@ fn csv(
     run: impl FnOnce(&mut dyn FnMut(String)) -> Result<(), ReplayError>,
     fail: impl FnOnce(ReplayError) -> CliError,
 ) -> Result<(), CliError> {
-    writeln!(w, "{header}").map_err(io_error)?;
-    let mut failed = None;
+    // The header with the first row: a configuration the core refuses (found when the
+    // run starts) leaves stdout empty, as every other usage error does.
+    let (mut failed, mut started) = (None, false);
     run(&mut |line| {
         if failed.is_none() {
-            if let Err(e) = writeln!(w, "{line}") {
+            let header = if started { Ok(()) } else { writeln!(w, "{header}") };
+            started = true;
+            if let Err(e) = header.and_then(|()| writeln!(w, "{line}")) {
                 failed = Some(e);
             }
         }
@@ -196,6 +201,9 @@ fn csv(
     .map_err(fail)?;
     if let Some(e) = failed {
         return Err(io_error(e));
+    }
+    if !started {
+        writeln!(w, "{header}").map_err(io_error)?;
     }
     w.flush().map_err(io_error)
 }
