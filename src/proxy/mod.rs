@@ -112,6 +112,9 @@ pub struct Proxy {
     /// The proxy's grid coordinates, when in contact.
     at: Option<[i32; 2]>,
     slipping: bool,
+    /// On a cap: the rest normal under the proxy (Q29), set by the tick's update for its
+    /// substeps (a window's shift leaves it: it is the tissue's).
+    normal: V3,
 }
 
 /// Surface node `(a, b)`'s current position (Q24 mm), as the solver gives it.
@@ -160,6 +163,7 @@ impl Proxy {
             radius: from_f64(r, LEN_FRAC),
             at: None,
             slipping: false,
+            normal: [0, 0, 1 << 29],
         })
     }
 

@@ -4,7 +4,7 @@
 use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
-use crate::proxy::{CapFrame, Proxy, ProxyConfig, ProxyError, Surface};
+use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
 use crate::q::{self, V3};
 use crate::topology::surface_node;
 use crate::units::{from_f64, Force, Length, LEN_FRAC};
@@ -192,7 +192,6 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         probe_vel: V3,
         proxy: &Proxy,
         window: &crate::window::Window<EDGES, CAP>,
-        frame: &CapFrame,
     ) {
         let count = self.topo.node_count().min(NODES);
         for _ in 0..self.substeps {
@@ -204,7 +203,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 &mut self.nodes,
             );
             let view = self.cap_view(proxy, window);
-            let (f, corners, w) = proxy.force_cap(&view, frame, &self.c.coupling, p, probe_vel);
+            let (f, corners, w) = proxy.force_cap(&view, &self.c.coupling, p, probe_vel);
             self.react(proxy, f, corners, w);
             if let Some(free) = self.nodes.get_mut(1..count) {
                 A::integrate(&self.c.arith, free);

@@ -247,7 +247,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.probe_prev = p;
         match cap_frame(window) {
             None => self.proxy_substeps(p, probe_vel, proxy),
-            Some(f) => self.proxy_substeps_cap(p, probe_vel, proxy, window, &f),
+            Some(_) => self.proxy_substeps_cap(p, probe_vel, proxy, window),
         }
         self.device_force()
     }

@@ -191,7 +191,11 @@ fn csv(
     let (mut failed, mut started) = (None, false);
     run(&mut |line| {
         if failed.is_none() {
-            let header = if started { Ok(()) } else { writeln!(w, "{header}") };
+            let header = if started {
+                Ok(())
+            } else {
+                writeln!(w, "{header}")
+            };
             started = true;
             if let Err(e) = header.and_then(|()| writeln!(w, "{line}")) {
                 failed = Some(e);
