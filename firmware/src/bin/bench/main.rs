@@ -137,6 +137,14 @@ mod firmware {
             mem[2].1,
             mem[3].1
         );
+        // A window: its four shift maps, and (used on a cap) its rest heights and the
+        // springs' packed ends.
+        defmt::println!(
+            "MEM core={=str} window_n4={=usize} window_n8={=usize}",
+            CORE.name(),
+            core::mem::size_of::<mccs::Window<30>>(),
+            core::mem::size_of::<mccs::Window<214>>()
+        );
         for (case, bytes) in mem {
             figs.record(case, bytes as u32);
         }
