@@ -372,3 +372,21 @@ mod robust {
         }
     }
 }
+
+/// A parameter set for a solver on a cap comes from the flat patch's topology (the
+/// solver keeps the flat patch's fingerprint and substeps); one prepared from the cap's
+/// current geometry is refused, so that a set's substeps are always the flat patch's.
+#[test]
+fn a_param_set_on_a_cap_is_prepared_from_the_flat_patch() {
+    let mut s = fixed::<Wide>();
+    let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
+    s.shaped_window(&window_config(Some(RADIUS)), &proxy, 40.0, 20.0)
+        .unwrap();
+    let table = ForceTable64::new(&Params::TABLE2).unwrap();
+    let config = SolverConfig::default();
+    let own = s.prepare(table, &config).unwrap();
+    assert_eq!(s.apply(own).err(), Some(mccs::SolverError::ForeignParamSet));
+    let flat = Topology::<10, 61>::standard_patch(N, SPACING).unwrap();
+    let set = Fixed::<Wide>::prepare_for(&flat, table, &config).unwrap();
+    assert!(s.apply(set).is_ok());
+}
