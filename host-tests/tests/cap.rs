@@ -327,16 +327,20 @@ mod robust {
             let f = f.map(|c| c.to_num::<f64>());
             let mag = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
             assert!(mag <= max, "{mag} N over the maximum at {p:?}");
-            // Never pulling the probe into the tissue: along the cap's normal under the
-            // proxy (the core's is the chord's, within 1e-4 of it here).
+            // Never pulling the probe into the tissue: along the normal the contact used
+            // (the cap's at the proxy's rest point), within the components' truncation;
+            // and that normal within the cap's normals near the proxy.
             if let Some(q) = s.proxy_point_in(&proxy, &window) {
+                let n = proxy.normal();
+                let along = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+                assert!(along >= -1e-5, "pulled in: {f:?} against {n:?}");
                 let o = window.origin_mm().map(|c| c.to_num::<f64>());
                 let (qx, qy) = (q[0].to_num::<f64>() + o[0], q[1].to_num::<f64>() + o[1]);
-                let n = [qx / r_cap, qy / r_cap, (height(qx, qy) + r_cap) / r_cap];
-                let along = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+                let exact = [qx / r_cap, qy / r_cap, (height(qx, qy) + r_cap) / r_cap];
+                let cos: f64 = (0..3).map(|k| n[k] * exact[k]).sum();
                 assert!(
-                    along >= -1e-3 * mag - 1e-6,
-                    "pulled in: {f:?} against {n:?}"
+                    cos > 0.999,
+                    "normal {n:?} against the cap's {exact:?} near the proxy"
                 );
             } else {
                 assert_eq!(mag, 0.0, "a force out of contact at {p:?}");

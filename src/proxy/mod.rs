@@ -178,6 +178,13 @@ impl Proxy {
         (self.n as usize, self.spacing)
     }
 
+    /// The rest normal under the proxy, as this tick's contact used it: along it the
+    /// depth is measured, the coupling damps and the force is unilateral (flat: `z`; on
+    /// a cap, the cap's normal at the proxy's rest point). Meaningful in contact.
+    pub fn normal(&self) -> [f64; 3] {
+        self.normal.map(|c| crate::units::to_f64(c, 29))
+    }
+
     /// Whether the contact slips.
     pub fn slipping(&self) -> bool {
         self.at.is_some() && self.slipping
