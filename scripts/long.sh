@@ -3,7 +3,9 @@
 #   1. the short-trajectory properties of Solver::step at CASES cases per arithmetic
 #      (default 50,000: ten times the test command's, about 10⁷ ticks in all), and the
 #      settling properties at CASES / 100;
-#   2. the force-table bound over 10⁵ random springs (host-tests/tests/table_bound.rs);
+#   2. the roaming probe over random caps and paths at CASES / 10 cases
+#      (host-tests/tests/cap.rs), and the force-table bound over 10⁵ random springs
+#      (host-tests/tests/table_bound.rs);
 #   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
 # Prints the PROPERTY and FUZZ lines; exits with failure if any run fails.
 #   scripts/long.sh [CASES] [FUZZ_SECONDS]
@@ -28,6 +30,12 @@ echo "long.sh: the settling properties at $settle cases per arithmetic" >&2
 PROPTEST_CASES=$settle cargo test --release -p mccs-host --test host \
     -- --show-output solver_properties::after_lift_off >> "$log" 2>&1 || { echo "long.sh: the settling properties failed; see $log" >&2; exit 1; }
 grep -E "^PROPERTY " "$log"
+caps=$(( cases / 10 ))
+echo "long.sh: the roaming probe over random caps at $caps cases" >&2
+PROPTEST_CASES=$caps cargo test --release -p mccs-host --test host \
+    -- cap::robust > target/logs/long/cap.log 2>&1 \
+  || { echo "long.sh: the cap property failed; see target/logs/long/cap.log" >&2; exit 1; }
+echo "PROPERTY case=cap_paths cases=$caps result=ok"
 echo "long.sh: the force-table bound over 10^5 random springs (a few minutes)" >&2
 TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test host \
     -- --show-output table_bound::every_table > target/logs/long/table_bound.log 2>&1 \

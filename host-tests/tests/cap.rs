@@ -350,8 +350,16 @@ mod robust {
         }
     }
 
+    /// 64 cases in the test command; `PROPTEST_CASES` for a long run (`scripts/long.sh`).
+    fn cases() -> u32 {
+        std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(64)
+    }
+
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(64))]
+        #![proptest_config(ProptestConfig::with_cases(cases()))]
         /// Any probe path over any cap the 64 × 64 tissue takes, from anywhere within
         /// ±100 mm (and 60 mm above or below the cap) in jumps of any size, or wandering
         /// near its surface: no panic (overflow checks are on here), the force within the
