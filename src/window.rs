@@ -67,6 +67,13 @@ pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) ends: [u32; EDGES],
 }
 
+/// The spring a map entry names, and whether it runs the other way (`NONE`: an index past
+/// every spring, so that a lookup finds nothing).
+#[inline(always)]
+pub(crate) fn continued(entry: u16) -> (usize, bool) {
+    ((entry & !FLIP) as usize, entry != NONE && entry & FLIP != 0)
+}
+
 /// Two ends `(a, b, layer)` (grid coordinates 0 … 127, layer 1: the base) in one word.
 pub(crate) fn pack_ends(k: [[i32; 3]; 2]) -> u32 {
     let one =

@@ -11,18 +11,11 @@ use mccs_host::patch::{TwinConfig, V};
 use mccs_host::reference::Reference;
 use mccs_host::roam::{Friction, RoamConfig, RoamTwin, Shape, Tissue};
 
-const N: usize = 5;
-const SPACING: f64 = 2.5;
+use crate::common::patch5::{device_max, fixed, proxy_config, Fixed, N, SPACING};
+
 const SIDE: usize = 64;
 /// A cap over the 64 × 64 tissue (half-diagonal 111.4 mm; the smallest radius is 148.5).
 const RADIUS: f64 = 150.0;
-type Fixed<A> = Solver<10, 61, 64, A>;
-
-fn fixed<A: Arith>() -> Fixed<A> {
-    let topo = Topology::standard_patch(N, SPACING).unwrap();
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    Solver::with_arith(topo, table, &SolverConfig::default(), A::default()).unwrap()
-}
 
 fn window_config(radius: Option<f64>) -> WindowConfig {
     WindowConfig {
@@ -30,16 +23,6 @@ fn window_config(radius: Option<f64>) -> WindowConfig {
         tissue_h: SIDE,
         hysteresis: 0.1,
         cap_radius: radius,
-    }
-}
-
-fn proxy_config(mu: (f64, f64), radius: f64) -> ProxyConfig {
-    ProxyConfig {
-        grid: N,
-        spacing: SPACING,
-        mu_s: mu.0,
-        mu_k: mu.1,
-        probe_radius: radius,
     }
 }
 
@@ -307,11 +290,6 @@ fn caps_the_core_cannot_run_are_refused() {
 mod robust {
     use super::*;
     use proptest::prelude::*;
-
-    /// The device maximum as the core holds it (N), with a hair for the `f64` magnitude.
-    fn device_max() -> f64 {
-        mccs::Force::from_num(SolverConfig::default().coupling.max_force).to_num::<f64>() + 1e-12
-    }
 
     fn roam<A: Arith>(r_cap: f64, mu: (f64, f64), radius: f64, probes: &[(f64, f64, f64)]) {
         let mut s = fixed::<A>();

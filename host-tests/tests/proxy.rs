@@ -2,40 +2,12 @@
 //! roaming twin on a tissue the size of the patch (its window cannot move): the same
 //! press and slides, frictionless and with friction, in both arithmetics.
 
-use mccs::{
-    Arith, ForceTable64, Length, Narrow, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
-    Topology, Wide,
-};
+use mccs::{Arith, Length, Narrow, Params, ProxyConfig, ProxyError, SolverConfig, Wide};
 use mccs_host::patch::{TwinConfig, V};
 use mccs_host::reference::Reference;
 use mccs_host::roam::{Friction, RoamConfig, RoamTwin, Shape, Tissue};
 
-const N: usize = 5;
-const SPACING: f64 = 2.5;
-type Fixed<A> = Solver<10, 61, 64, A>;
-
-fn fixed<A: Arith>() -> Fixed<A> {
-    let topo = Topology::standard_patch(N, SPACING).unwrap();
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    Solver::with_arith(topo, table, &SolverConfig::default(), A::default()).unwrap()
-}
-
-/// The proxy configuration of the test patch with friction `mu` and probe radius `radius`.
-fn proxy_config(mu: (f64, f64), radius: f64) -> ProxyConfig {
-    ProxyConfig {
-        grid: N,
-        spacing: SPACING,
-        mu_s: mu.0,
-        mu_k: mu.1,
-        probe_radius: radius,
-    }
-}
-
-/// The default device maximum as the core holds it (N), with a hair for the `f64`
-/// magnitude's rounding.
-fn device_max() -> f64 {
-    mccs::Force::from_num(SolverConfig::default().coupling.max_force).to_num::<f64>() + 1e-12
-}
+use crate::common::patch5::{device_max, fixed, proxy_config, N, SPACING};
 
 fn twin(substeps: u32, mu: (f64, f64), radius: f64) -> RoamTwin {
     let cfg = RoamConfig {

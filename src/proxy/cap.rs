@@ -17,11 +17,10 @@
 //! height blended from the triangle's corners: a unit vector to within the chord's sag,
 //! `s²/(8R²)`).
 
-use super::{held, scale_to, Proxy, Surface, G_FRAC};
+use super::{damping, held, scale_to, spring, Proxy, Surface, G_FRAC};
 use crate::cap::{Cap, N_FRAC};
 use crate::coupling::CouplingQ;
 use crate::q::{self, mul_wide, sat, V3};
-use crate::units::{FORCE_FRAC, LEN_FRAC};
 
 /// The cap as a proxy sees it in one tick: the cap, and the patch frame's origin in the
 /// tissue frame (Q24 mm, `x` and `y`; the frames share `z`).
@@ -192,12 +191,10 @@ impl Proxy {
         let v = Self::blend(w, corners.map(|(a, b)| s.velocity(a, b)));
         // The closing speed along n (Q16 mm/s: a Q16 vector dotted with Q29 is Q16).
         let closing = dot(sub(v, probe_vel), n);
-        const SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
-        let damping = sat(mul_wide(closing, coupling.damping) >> SH);
-        let spring: V3 = core::array::from_fn(|k| {
-            sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> SH)
-        });
-        let force = q::add(spring, along(damping, n));
+        let force = q::add(
+            spring(coupling, proxy, probe),
+            along(damping(coupling, closing), n),
+        );
         if dot(force, n) < 0 {
             return ([0; 3], corners, w);
         }

@@ -377,19 +377,31 @@ impl Proxy {
         // Only the surface's normal (z) velocity enters: the damping acts along z.
         let vz = Self::blend1(w, corners.map(|(a, b)| s.velocity(a, b)[2]));
         let proxy = [p[0], p[1], p[2].saturating_add(self.radius)];
-        // Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after >> 20.
-        const SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
-        const _: () = assert!(VEL_FRAC + 24 - FORCE_FRAC == SH);
-        let mut f: V3 = core::array::from_fn(|k| {
-            sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> SH)
-        });
-        let closing = vz.saturating_sub(probe_vel[2]);
-        f[2] = f[2].saturating_add(sat(mul_wide(closing, coupling.damping) >> SH));
+        let mut f = spring(coupling, proxy, probe);
+        f[2] = f[2].saturating_add(damping(coupling, vz.saturating_sub(probe_vel[2])));
         if f[2] < 0 {
             return ([0; 3], corners, w);
         }
         (held(f, coupling.max_force), corners, w)
     }
+}
+
+/// Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after `>> COUPLING_SH`.
+const COUPLING_SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
+const _: () = assert!(VEL_FRAC + 24 - FORCE_FRAC == COUPLING_SH);
+
+/// The coupling's spring force (Q20 N) between the proxy's centre and the probe (Q24 mm).
+#[inline(always)]
+fn spring(coupling: &CouplingQ, proxy: V3, probe: V3) -> V3 {
+    core::array::from_fn(|k| {
+        sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> COUPLING_SH)
+    })
+}
+
+/// The coupling's damping force (Q20 N) for a closing speed along the normal (Q16 mm/s).
+#[inline(always)]
+fn damping(coupling: &CouplingQ, closing: i32) -> i32 {
+    sat(mul_wide(closing, coupling.damping) >> COUPLING_SH)
 }
 
 /// `f` (Q20 N) held to `max` in magnitude, never above it: the squares in Q12 from each

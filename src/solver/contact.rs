@@ -167,6 +167,32 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// The tick's substeps with the probe at `p` (Q24 mm, patch frame) moving at
     /// `probe_vel` (Q16 mm/s), coupled to `proxy`.
     pub(super) fn proxy_substeps(&mut self, p: V3, probe_vel: V3, proxy: &Proxy) {
+        self.coupled_substeps(proxy, |s| {
+            proxy.force(&s.view(proxy), &s.c.coupling, p, probe_vel)
+        });
+    }
+
+    /// [`Self::proxy_substeps`] on a cap.
+    pub(super) fn proxy_substeps_cap<const CAP: bool>(
+        &mut self,
+        p: V3,
+        probe_vel: V3,
+        proxy: &Proxy,
+        window: &crate::window::Window<EDGES, CAP>,
+    ) {
+        self.coupled_substeps(proxy, |s| {
+            proxy.force_cap(&s.cap_view(proxy, window), &s.c.coupling, p, probe_vel)
+        });
+    }
+
+    /// The tick's substeps, the proxy's coupling force (Q20 N, its triangle and weights)
+    /// from `force` in each.
+    #[inline(always)]
+    fn coupled_substeps(
+        &mut self,
+        proxy: &Proxy,
+        force: impl Fn(&Self) -> (V3, [(usize, usize); 3], [i32; 3]),
+    ) {
         // The glued substep's two calls, written out again: shared through helpers they
         // changed the glued path's compiled code (the M3's N = 7 substep by 4 %).
         let count = self.topo.node_count().min(NODES);
@@ -178,45 +204,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 &mut self.warm,
                 &mut self.nodes,
             );
-            self.proxy_reaction(proxy, p, probe_vel);
-            if let Some(free) = self.nodes.get_mut(1..count) {
-                A::integrate(&self.c.arith, free);
-            }
-        }
-    }
-
-    /// [`Self::proxy_substeps`] on a cap.
-    pub(super) fn proxy_substeps_cap<const CAP: bool>(
-        &mut self,
-        p: V3,
-        probe_vel: V3,
-        proxy: &Proxy,
-        window: &crate::window::Window<EDGES, CAP>,
-    ) {
-        let count = self.topo.node_count().min(NODES);
-        for _ in 0..self.substeps {
-            A::spring_forces(
-                &self.table,
-                &self.c.arith,
-                &self.topo,
-                &mut self.warm,
-                &mut self.nodes,
-            );
-            let view = self.cap_view(proxy, window);
-            let (f, corners, w) = proxy.force_cap(&view, &self.c.coupling, p, probe_vel);
+            let (f, corners, w) = force(self);
             self.react(proxy, f, corners, w);
             if let Some(free) = self.nodes.get_mut(1..count) {
                 A::integrate(&self.c.arith, free);
             }
         }
-    }
-
-    /// The proxy's coupling in one substep: its reaction onto the proxy's triangle (free
-    /// nodes only), and the force on the tissue kept as the coupling force.
-    fn proxy_reaction(&mut self, proxy: &Proxy, probe: V3, probe_vel: V3) {
-        let view = self.view(proxy);
-        let (f, corners, w) = proxy.force(&view, &self.c.coupling, probe, probe_vel);
-        self.react(proxy, f, corners, w);
     }
 
     /// The force `f` (Q20 N) of the proxy on the tissue through its triangle `corners`

@@ -9,7 +9,7 @@ use crate::proxy::{CapFrame, Proxy, ProxyError};
 use crate::q::{self, mul_wide, sat, V3};
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
-use crate::window::{pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
+use crate::window::{continued, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
 
 /// Where a spring's end is on the patch's grid: `(a, b, layer)` (layer 1: the base).
 type Key = [i32; 3];
@@ -177,9 +177,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 Some(_) => window.maps[dir].get(e).copied().unwrap_or(NONE),
                 None => NONE,
             };
-            let taken = old.and_then(|o| o.get((from & !FLIP) as usize));
-            let (dir_v, inv_len) = match taken {
-                Some(&(d, inv)) if from & FLIP != 0 => (d.map(i32::saturating_neg), inv),
+            let (source, reversed) = continued(from);
+            let (dir_v, inv_len) = match old.and_then(|o| o.get(source)) {
+                Some(&(d, inv)) if reversed => (d.map(i32::saturating_neg), inv),
                 Some(&g) => g,
                 None => edge_geometry(window, window.ends.get(e).copied().unwrap_or(0)),
             };
@@ -245,9 +245,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             p = in_window(window);
         }
         self.probe_prev = p;
-        match cap_frame(window) {
-            None => self.proxy_substeps(p, probe_vel, proxy),
-            Some(_) => self.proxy_substeps_cap(p, probe_vel, proxy, window),
+        if CAP && window.is_cap() {
+            self.proxy_substeps_cap(p, probe_vel, proxy, window);
+        } else {
+            self.proxy_substeps(p, probe_vel, proxy);
         }
         self.device_force()
     }
@@ -292,7 +293,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let old = self.warm;
         for (e, w) in self.warm.iter_mut().enumerate() {
             let from = window.maps[dir].get(e).copied().unwrap_or(NONE);
-            *w = old.get((from & !FLIP) as usize).copied().unwrap_or(A::REST);
+            *w = old.get(continued(from).0).copied().unwrap_or(A::REST);
         }
         proxy.shift_grid(d);
         window.corner = [window.corner[0] + d[0], window.corner[1] + d[1]];

@@ -1,9 +1,12 @@
-//! Shared test helpers: random valid springs.
+//! Shared test helpers: random valid springs, and the N = 5 patch the proxy and cap
+//! tests drive (`patch5`).
 #![allow(dead_code)]
 
 use mccs::{Cone, Linear, Params};
 use mccs_host::reference::Reference;
 use proptest::prelude::*;
+
+pub mod patch5;
 
 /// Random valid springs around Table 2: each value × 0.3 … 3, `D2/D1` in 1.05 … 4, and an
 /// optional preload of 0.3 … 3 `F_T` (capped at 0.9 `F_C`); those whose derived quantities
