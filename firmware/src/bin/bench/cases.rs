@@ -12,7 +12,7 @@ use mccs::{
     Arith, DefaultArith, Edge, ForceTable64, Length, ProxyConfig, Solver, SolverConfig, Strain,
     Topology, WindowConfig,
 };
-use mccs_firmware::demo;
+use mccs_firmware::demo::{self, DemoSpec};
 use mccs_firmware::entry as e;
 use mccs_firmware::float_patch::{FloatPatch, Real};
 use mccs_firmware::target::CORE;
@@ -279,21 +279,34 @@ pub struct RoamingTicks {
 /// [`RoamingTicks`] for this core's demo patch; `empty` is the harness's own count.
 #[inline(never)]
 pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
-    match demo::spec_for(CORE).grid {
-        8 => roaming_in::<37, 214, false>(h, table, empty),
-        5 => roaming_in::<10, 61, false>(h, table, empty),
-        _ => roaming_in::<5, 30, false>(h, table, empty),
-    }
+    roaming_of::<false>(h, table, empty)
 }
 
 /// [`roaming`] over a cap of radius 150 mm (`Solver::shaped_window`).
 #[inline(never)]
 pub fn roaming_cap(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
-    match demo::spec_for(CORE).grid {
-        8 => roaming_in::<37, 214, true>(h, table, empty),
-        5 => roaming_in::<10, 61, true>(h, table, empty),
-        _ => roaming_in::<5, 30, true>(h, table, empty),
+    roaming_of::<true>(h, table, empty)
+}
+
+/// [`roaming`] (`CAP` false) or [`roaming_cap`] (`CAP` true).
+fn roaming_of<const CAP: bool>(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    let spec = demo::spec_for(CORE);
+    match spec.grid {
+        8 => roaming_in::<37, 214, CAP>(h, table, empty, &spec),
+        5 => roaming_in::<10, 61, CAP>(h, table, empty, &spec),
+        _ => roaming_in::<5, 30, CAP>(h, table, empty, &spec),
     }
+}
+
+/// [`roaming_cap`] with this core's demo configuration on an N = 5 patch: issue #19's
+/// configuration for the M4F.
+#[inline(never)]
+pub fn roaming_cap_n5(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    let spec = DemoSpec {
+        grid: 5,
+        ..demo::spec_for(CORE)
+    };
+    roaming_in::<10, 61, true>(h, table, empty, &spec)
 }
 
 #[inline(never)]
@@ -301,8 +314,8 @@ fn roaming_in<const N: usize, const E: usize, const CAP: bool>(
     h: &Harness,
     table: &ForceTable64,
     empty: u32,
+    spec: &DemoSpec,
 ) -> RoamingTicks {
-    let spec = demo::spec_for(CORE);
     let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) else {
         exit(false)
     };

@@ -123,6 +123,16 @@ mod firmware {
             "tick_roaming_cap_bound",
             cap.steady.saturating_add(cap.shift_extra),
         );
+        // Issue #19's M4F configuration, N = 5, over the cap (the M4F's demo runs N = 8).
+        if CORE == Core::M4F {
+            let cap5 = cases::roaming_cap_n5(&h, &table, empty);
+            figs.report("tick_roaming_cap_n5", cap5.steady);
+            figs.report("window_shift_cap_n5", cap5.shift_extra);
+            figs.report(
+                "tick_roaming_cap_n5_bound",
+                cap5.steady.saturating_add(cap5.shift_extra),
+            );
+        }
         let mem = [
             ("solver_n4", core::mem::size_of::<Solver<5, 30, 64>>()),
             ("solver_n5", core::mem::size_of::<Solver<10, 61, 64>>()),
