@@ -8,7 +8,8 @@
 //! tissue's centre at `z = 0` and its centre at `(0, 0, −R)`: `z = √(R² − ρ²) − R` with
 //! `ρ² = x² + y²`, and the rest normal at a surface point is `(x, y, z + R)/R`.
 //!
-//! Formats: positions Q24 mm in the tissue frame, `R` Q20 mm, directions Q29. Heights
+//! Formats: positions Q24 mm in the tissue frame, `R` Q20 mm, directions Q29 rounded to a
+//! Q15 grid (so that a product by one takes a 16-bit operand, [`N16_SH`]). Heights
 //! are within `2e-8 R` of the sphere (the reciprocal square root's error; tested against
 //! `f64` over whole tissues).
 
@@ -17,6 +18,22 @@ use crate::units::from_f64;
 
 /// Fraction bits of a direction.
 pub(crate) const N_FRAC: u32 = 29;
+
+/// A direction's low bits that are zero: its components lie on a Q15 grid within
+/// `±(1 − 2⁻¹⁵)`, so that `c >> N16_SH` is exact and a 16-bit operand of [`crate::q::mul_s`]
+/// (one 32 × 16 product: two 32-bit multiplies on the M0 instead of a 64-bit product),
+/// whose `⌊a/2¹⁶⌋ · c · 2` stays within `i32` for every `a`.
+pub(crate) const N16_SH: u32 = N_FRAC - 15;
+
+/// `d` (Q29) rounded to nearest on the Q15 grid, held within `±(1 − 2⁻¹⁵)` (within `2⁻¹⁵`,
+/// 3.1e-5, of `d` per component for a unit vector).
+fn on_q15_grid(d: V3) -> V3 {
+    const TOP: i32 = (1 << N_FRAC) - (1 << N16_SH);
+    d.map(|c| {
+        let r = (c >> N16_SH).saturating_add((c >> (N16_SH - 1)) & 1) << N16_SH;
+        r.clamp(-TOP, TOP)
+    })
+}
 
 /// Largest cap radius, mm (`R` in Q20 within `i32`).
 pub const MAX_CAP_RADIUS_MM: f64 = 2000.0;
@@ -84,19 +101,21 @@ impl Cap {
     }
 
     /// The rest normal at a rest surface point (tissue frame, Q24 mm): `(x, y, z + R)/R`,
-    /// Q29 (a unit vector to the chord's sag: within `s²/(8R²)` of one).
+    /// Q29 on the Q15 grid ([`N16_SH`]; a unit vector to the chord's sag, `s²/(8R²)`, and
+    /// the grid's `2⁻¹⁵` per component).
     pub(crate) fn normal(&self, p: V3) -> V3 {
         // Q24 · Q(31 + sh) = Q(55 + sh): Q29 after >> (26 + sh).
         let scaled = |x: i32| sat(mul_wide(x, self.inv_r) >> (26 + self.inv_sh));
-        [
+        on_q15_grid([
             scaled(p[0]),
             scaled(p[1]),
             (1i32 << N_FRAC).saturating_add(scaled(p[2])),
-        ]
+        ])
     }
 
-    /// The unit vector from the cap's centre through `p` (tissue frame, Q24 mm), Q29: the
-    /// rest normal where that line meets the cap (within 1.5e-7: `p` taken in Q16).
+    /// The unit vector from the cap's centre through `p` (tissue frame, Q24 mm), Q29 on the
+    /// Q15 grid ([`N16_SH`]): the rest normal where that line meets the cap (within
+    /// 1.5e-7 before the grid's `2⁻¹⁵`: `p` taken in Q16).
     pub(crate) fn radial(&self, p: V3) -> V3 {
         // In Q16 (|x|, |y| ≤ 128 mm and z + R ≤ 2128 mm fit i32): the squares by 32-bit
         // halves (no 64-bit library product on the M0), summed within i64.
@@ -110,7 +129,7 @@ impl Cap {
         // d_k (y/2) >> (32 − e/2) (e/2 ≤ 17 here).
         let sh = 32 - (e >> 1);
         let half = (y >> 1) as i32;
-        d.map(|c| sat(mul_wide(c, half) >> sh))
+        on_q15_grid(d.map(|c| sat(mul_wide(c, half) >> sh)))
     }
 
     /// `R`, Q20 mm.
@@ -153,26 +172,34 @@ mod tests {
     }
 
     /// The rest normal and the radial direction against `f64`, within 1e-8 and 1.5e-7 (the
-    /// radial line's point taken in Q16: 1.5e-5 mm over the cap's 150 mm).
+    /// radial line's point taken in Q16: 1.5e-5 mm over the cap's 150 mm) plus one Q15
+    /// step (the grid they are rounded to, held within `1 − 2⁻¹⁵`), and on that grid.
     #[test]
     fn directions_match_f64() {
         let r = 150.0;
         let cap = Cap::new(r, 64, 64, 2.5).unwrap();
         let q24 = |x: f64| from_f64(x, 24);
-        let unq = |x: i32| x as f64 / 2f64.powi(29);
+        let unq = |x: i32| {
+            assert_eq!(x & ((1 << N16_SH) - 1), 0, "{x} off the Q15 grid");
+            x as f64 / 2f64.powi(29)
+        };
         for (x, y) in [(0.0, 0.0), (78.75, -78.75), (-30.0, 55.5), (1.25, 0.0)] {
             let z = (r * r - x * x - y * y).sqrt() - r;
             let n = cap.normal([q24(x), q24(y), q24(z)]).map(unq);
             let want = [x / r, y / r, (z + r) / r];
+            let step = 1.0 / 32768.0;
             for k in 0..3 {
-                assert!((n[k] - want[k]).abs() < 1e-8, "normal at ({x}, {y}): {n:?}");
+                assert!(
+                    (n[k] - want[k]).abs() < 1e-8 + step,
+                    "normal at ({x}, {y}): {n:?}"
+                );
             }
             // A point 3 mm below the surface along the normal: the same direction.
             let p = [0, 1, 2].map(|k| [x, y, z][k] - 3.0 * want[k]);
             let d = cap.radial(p.map(q24)).map(unq);
             for k in 0..3 {
                 assert!(
-                    (d[k] - want[k]).abs() < 1.5e-7,
+                    (d[k] - want[k]).abs() < 1.5e-7 + step,
                     "radial at ({x}, {y}): {d:?}"
                 );
             }

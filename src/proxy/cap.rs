@@ -18,7 +18,7 @@
 //! `s²/(8R²)`).
 
 use super::{damping, held, scale_to, spring, Proxy, Surface, G_FRAC};
-use crate::cap::{Cap, N_FRAC};
+use crate::cap::{Cap, N16_SH};
 use crate::coupling::CouplingQ;
 use crate::q::{self, mul_wide, sat, V3};
 
@@ -39,14 +39,16 @@ const LOCATE_STEPS: usize = 3;
 /// Corrections of a slip's surface point (from where the proxy was, close by).
 const SLIP_STEPS: usize = 2;
 
-/// `a · n` for a Q24 vector and a Q29 direction, Q24.
+/// `a · n` for a Q24 vector and a direction from [`crate::cap`] (Q29 on a Q15 grid),
+/// Q24: one product with a 16-bit operand per axis, floored.
 fn dot(a: V3, n: V3) -> i32 {
-    sat((mul_wide(a[0], n[0]) + mul_wide(a[1], n[1]) + mul_wide(a[2], n[2])) >> N_FRAC)
+    let p = |k: usize| q::mul_s::<15>(a[k], n[k] >> N16_SH);
+    p(0).saturating_add(p(1)).saturating_add(p(2))
 }
 
-/// `x n` for a Q24 length and a Q29 direction, Q24.
+/// `x n` for a Q24 length and a direction from [`crate::cap`], Q24, floored.
 fn along(x: i32, n: V3) -> V3 {
-    n.map(|c| sat(mul_wide(x, c) >> N_FRAC))
+    n.map(|c| q::mul_s::<15>(x, c >> N16_SH))
 }
 
 fn sub(a: V3, b: V3) -> V3 {
