@@ -13,7 +13,7 @@
 //! are within `2e-8 R` of the sphere (the reciprocal square root's error; tested against
 //! `f64` over whole tissues).
 
-use crate::q::{mul_wide, mulhi_u, rsqrt, sat, V3};
+use crate::q::{mul_wide, mulhi_u, narrow, rsqrt, sat, V3};
 use crate::units::from_f64;
 
 /// Fraction bits of a direction.
@@ -28,11 +28,8 @@ pub(crate) const N16_SH: u32 = N_FRAC - 15;
 /// `d` (Q29) rounded to nearest on the Q15 grid, held within `±(1 − 2⁻¹⁵)` (within `2⁻¹⁵`,
 /// 3.1e-5, of `d` per component for a unit vector).
 fn on_q15_grid(d: V3) -> V3 {
-    const TOP: i32 = (1 << N_FRAC) - (1 << N16_SH);
-    d.map(|c| {
-        let r = (c >> N16_SH).saturating_add((c >> (N16_SH - 1)) & 1) << N16_SH;
-        r.clamp(-TOP, TOP)
-    })
+    // |c| ≤ 2³⁰ here (a unit vector's component to within its rounding): no wrap.
+    d.map(|c| narrow::<N16_SH>(c).clamp(-0x7FFF, 0x7FFF) << N16_SH)
 }
 
 /// Largest cap radius, mm (`R` in Q20 within `i32`).

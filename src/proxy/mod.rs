@@ -22,7 +22,8 @@
 //!
 //! Formats: positions Q24 mm, velocities Q16 mm/s, forces Q20 N, grid coordinates and
 //! weights Q16, friction coefficients Q16. The only square roots are reciprocal ones by
-//! two Newton steps from a table's guess (`rsqrt`), for a slip and for a force over the device maximum.
+//! two Newton steps from a table's guess (`rsqrt`), for a slip and for a force over the
+//! device maximum.
 
 mod cap;
 
@@ -456,7 +457,8 @@ fn tan_small(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     /// `rsqrt` against `f64` over its whole domain (1 … 2⁶³, log-spaced, and each power of
-    /// two's neighbours), within 2e-8 relative (the measured figure printed); `scale_to` never above the exact ratio.
+    /// two's neighbours), within 2e-8 relative (the measured figure printed); `scale_to`
+    /// never above the exact ratio.
     #[test]
     fn rsqrt_matches_f64() {
         let mut worst = 0.0f64;
