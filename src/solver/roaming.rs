@@ -105,6 +105,19 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                     .unwrap_or(NONE)
             })
         });
+        // A shift on a cap moves the springs' geometry in place (`move_cap_geometry`):
+        // forwards along +x and +y, where every spring's source comes after it, and
+        // backwards along −x and −y. The standard patch's springs are laid out cell by
+        // cell, so this holds; a topology for which it would not is refused.
+        let ordered = maps.iter().enumerate().all(|(dir, map)| {
+            map.iter().enumerate().all(|(e, &m)| {
+                let (source, _) = continued(m);
+                m == NONE || (dir % 2 == 0 && source > e) || (dir % 2 == 1 && source < e)
+            })
+        });
+        if CAP && config.cap_radius.is_some() && !ordered {
+            return Err(ProxyError::Grid);
+        }
         let mut window = Window::<EDGES, CAP> {
             n: n as i32,
             w: w as i32,
@@ -131,7 +144,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                     }
                 }
             }
-            self.set_cap_geometry(&window, None, 0);
+            self.set_cap_heights(&window);
+            for (e, edge) in self.topo.edges_mut().iter_mut().enumerate() {
+                (edge.dir, edge.inv_len) =
+                    edge_geometry(&window, window.ends.get(e).copied().unwrap_or(0));
+            }
         }
         Ok(window)
     }
@@ -152,15 +169,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         Ok(cap)
     }
 
-    /// On a cap: the free nodes' rest heights from the window's, and each spring's rest
-    /// geometry: taken from `old` through the map of direction `dir` where it continues a
-    /// spring, else computed from the heights (all of them without `old`).
-    fn set_cap_geometry<const CAP: bool>(
-        &mut self,
-        window: &Window<EDGES, CAP>,
-        old: Option<&[(V3, i32); EDGES]>,
-        dir: usize,
-    ) {
+    /// On a cap: the free nodes' rest heights from the window's.
+    fn set_cap_heights<const CAP: bool>(&mut self, window: &Window<EDGES, CAP>) {
         let n = window.n;
         for a in 1..n - 1 {
             for b in 1..n - 1 {
@@ -172,19 +182,34 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
         }
-        for (e, edge) in self.topo.edges_mut().iter_mut().enumerate() {
-            let from = match old {
-                Some(_) => window.maps[dir].get(e).copied().unwrap_or(NONE),
-                None => NONE,
-            };
-            let (source, reversed) = continued(from);
-            let (dir_v, inv_len) = match old.and_then(|o| o.get(source)) {
-                Some(&(d, inv)) if reversed => (d.map(i32::saturating_neg), inv),
-                Some(&g) => g,
+    }
+
+    /// On a cap, at a shift along direction `dir`: each spring's rest geometry taken from
+    /// the spring it continues (negated if that one runs the other way), else computed
+    /// from the window's rest heights. In place, in the order [`Solver::window_as`]
+    /// checked: every source is read before it is overwritten.
+    fn move_cap_geometry<const CAP: bool>(&mut self, window: &Window<EDGES, CAP>, dir: usize) {
+        let edges = self.topo.edges_mut();
+        let count = edges.len();
+        let Some(map) = window.maps.get(dir) else {
+            return;
+        };
+        let step = |edges: &mut [Edge], e: usize| {
+            let (source, reversed) = continued(map.get(e).copied().unwrap_or(NONE));
+            let (d, inv_len) = match edges.get(source) {
+                Some(s) if reversed => (s.dir.map(i32::saturating_neg), s.inv_len),
+                Some(s) => (s.dir, s.inv_len),
                 None => edge_geometry(window, window.ends.get(e).copied().unwrap_or(0)),
             };
-            edge.dir = dir_v;
-            edge.inv_len = inv_len;
+            if let Some(edge) = edges.get_mut(e) {
+                edge.dir = d;
+                edge.inv_len = inv_len;
+            }
+        };
+        if dir % 2 == 0 {
+            (0..count).for_each(|e| step(edges, e));
+        } else {
+            (0..count).rev().for_each(|e| step(edges, e));
         }
     }
 
@@ -301,7 +326,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// A shift's part on a cap: the rest heights move with the window (the `n` entering
-    /// ones computed), then the springs' rest geometry (see [`Self::set_cap_geometry`]).
+    /// ones computed), then the springs' rest geometry ([`Self::move_cap_geometry`]).
     #[inline(never)]
     fn shift_cap<const CAP: bool>(
         &mut self,
@@ -332,11 +357,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
         }
-        let mut old = [([0; 3], 0); EDGES];
-        for (o, e) in old.iter_mut().zip(self.topo.edges()) {
-            *o = (e.dir, e.inv_len);
-        }
-        self.set_cap_geometry(window, Some(&old), dir);
+        self.set_cap_heights(window);
+        self.move_cap_geometry(window, dir);
     }
 }
 
@@ -361,6 +383,12 @@ fn edge_geometry<const EDGES: usize, const CAP: bool>(
     ends: u32,
 ) -> (V3, i32) {
     let [a, b] = unpack_ends(ends);
+    // (da, db) = (0, 0): a vertical spring, from a surface node to the base node a
+    // spacing straight below it (or the other way): its geometry is the flat patch's.
+    if a[0] == b[0] && a[1] == b[1] {
+        let down = if b[2] > a[2] { -1 } else { 1 };
+        return ([0, 0, down << DIR_FRAC], window.inv_s.saturating_mul(2));
+    }
     let z = |k: [i32; 3]| {
         let h = window
             .heights
@@ -403,8 +431,46 @@ fn round_shr(x: i64, sh: u32) -> i64 {
 mod tests {
     use super::DIRECTIONS;
     use crate::window::{FLIP, NONE};
+    use crate::ProxyError;
     use crate::{Arith, DefaultArith, ForceTable64, Params, ProxyConfig, Solver, SolverConfig};
     use crate::{Topology, WindowConfig};
+
+    /// A Table 2 solver on `topo` (N = 5 at 2.5 mm) and a frictionless point proxy.
+    fn patch_and_proxy(topo: Topology<10, 61>) -> (Solver<10, 61, 64>, crate::Proxy) {
+        let table = ForceTable64::new(&Params::TABLE2).unwrap();
+        let s = Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default()).unwrap();
+        let config = ProxyConfig {
+            grid: 5,
+            spacing: 2.5,
+            mu_s: 0.0,
+            mu_k: 0.0,
+            probe_radius: 0.0,
+        };
+        let proxy = s.proxy(&config).unwrap();
+        (s, proxy)
+    }
+
+    /// A cap's window moves its springs' geometry in place, which needs every spring's
+    /// source on one side of it per direction (the standard patch's cell-by-cell order):
+    /// the same patch with its springs in reverse order is refused on a cap (and still
+    /// taken flat, where nothing moves in place).
+    #[test]
+    fn a_cap_refuses_springs_out_of_the_order_its_shift_needs() {
+        let mut topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
+        topo.edges_mut().reverse();
+        let (mut s, proxy) = patch_and_proxy(topo);
+        let tissue = |cap_radius| WindowConfig {
+            tissue_w: 16,
+            tissue_h: 16,
+            hysteresis: 0.1,
+            cap_radius,
+        };
+        assert_eq!(
+            s.shaped_window(&tissue(Some(60.0)), &proxy, 0.0, 0.0),
+            Err(ProxyError::Grid)
+        );
+        assert!(s.shaped_window(&tissue(None), &proxy, 0.0, 0.0).is_ok());
+    }
 
     /// A shift gives every spring that continues one the warm-start value of that one
     /// (whichever way it runs), and the others rest: for each direction, on a flat
@@ -415,17 +481,7 @@ mod tests {
         for cap_radius in [None, Some(60.0)] {
             for (dir, d) in DIRECTIONS.into_iter().enumerate() {
                 let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
-                let table = ForceTable64::new(&Params::TABLE2).unwrap();
-                let mut s =
-                    Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default()).unwrap();
-                let config = ProxyConfig {
-                    grid: 5,
-                    spacing: 2.5,
-                    mu_s: 0.0,
-                    mu_k: 0.0,
-                    probe_radius: 0.0,
-                };
-                let mut proxy = s.proxy(&config).unwrap();
+                let (mut s, mut proxy) = patch_and_proxy(topo);
                 let tissue = WindowConfig {
                     tissue_w: 16,
                     tissue_h: 16,
