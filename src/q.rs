@@ -144,26 +144,9 @@ pub fn mulhi_u_split(a: u32, b: u32) -> u32 {
 /// multiply, else [`mul_t_split`]; the same bits. Larger `t` are masked to 15 bits.
 #[inline(always)]
 pub fn mul_t(a: i32, t: u32) -> i32 {
-    mul_tau(a, tau(t))
-}
-
-/// The operand of [`mul_tau`] for the Q15 fraction in the low 15 bits of `pos` (the
-/// bits above are dropped): `t · 2¹⁶` with a long multiply, else `t`. (Masked with
-/// `0x7FFF_0000`: a constant that takes two instructions to build, once per loop. A shift
-/// up and one back takes one fewer alone, but one more per spring in the patch's loops,
-/// where the constant stays in a register: measured, the M4F's roaming tick +1.3 %.)
-#[inline(always)]
-pub fn tau(pos: u32) -> u32 {
-    long_or_split!(pos & 0x7FFF, (pos & 0x7FFF) << 16)
-}
-
-/// [`mul_t`] on an operand [`tau`] made: `⌊a · t / 2¹⁶⌋`, the same bits, without
-/// rebuilding the operand at each product.
-#[inline(always)]
-pub fn mul_tau(a: i32, tau: u32) -> i32 {
     long_or_split!(
-        mul_t_split(a, tau),
-        ((a as i64 * tau as i32 as i64) >> 32) as i32
+        mul_t_split(a, t),
+        ((a as i64 * (((t & 0x7FFF) << 16) as i32) as i64) >> 32) as i32
     )
 }
 

@@ -109,13 +109,15 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         // forwards along +x and +y, where every spring's source comes after it, and
         // backwards along −x and −y. The standard patch's springs are laid out cell by
         // cell, so this holds; a topology for which it would not is refused.
-        let ordered = maps.iter().enumerate().all(|(dir, map)| {
-            map.iter().enumerate().all(|(e, &m)| {
-                let (source, _) = continued(m);
-                m == NONE || (dir % 2 == 0 && source > e) || (dir % 2 == 1 && source < e)
+        let ordered = || {
+            maps.iter().enumerate().all(|(dir, map)| {
+                map.iter().enumerate().all(|(e, &m)| {
+                    let (source, _) = continued(m);
+                    m == NONE || (dir % 2 == 0 && source > e) || (dir % 2 == 1 && source < e)
+                })
             })
-        });
-        if CAP && config.cap_radius.is_some() && !ordered {
+        };
+        if cap.is_some() && !ordered() {
             return Err(ProxyError::Grid);
         }
         let mut window = Window::<EDGES, CAP> {

@@ -45,7 +45,7 @@
 //! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound.rs`:
 //! `docs/accuracy.md`.
 
-use crate::q::{mul_tau, mul_wide, mulhi, mulhi_u, shr_held, tau};
+use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
 use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
 mod bound;
@@ -256,13 +256,12 @@ impl<const S: usize> ForceTable<S> {
         // D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ², in the same halving Horner form.
         let c3x3 = c[3].wrapping_mul(3);
         let c2x2 = c[2].wrapping_mul(2);
-        let d = c[1].wrapping_add(mul_tau(c2x2.wrapping_add(mul_tau(c3x3, t)), t));
+        let d = c[1].wrapping_add(mul_t(c2x2.wrapping_add(mul_t(c3x3, t)), t));
         let k = mulhi(d, r.stiff_scale).wrapping_mul(r.stiff_post);
         (Force::from_bits(f), Stiffness::from_bits(k))
     }
 
-    /// The segment holding `e` (`strain_lo < e < strain_hi`) and the Q15 position in it
-    /// as [`mul_tau`]'s operand ([`tau`]).
+    /// The segment holding `e` (`strain_lo < e < strain_hi`) and the Q15 position in it.
     #[inline(always)]
     fn segment(&self, e: i32) -> (&[i32; 4], u32) {
         let r = &self.raw;
@@ -276,17 +275,16 @@ impl<const S: usize> ForceTable<S> {
         } else {
             i.min(S - 1)
         };
-        (&r.segments[i], tau(pos))
+        (&r.segments[i], pos & 0x7FFF)
     }
 }
 
-/// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift. `t` is
-/// the position in the segment as [`tau`] makes it (on the M3/M4 `τ · 2³¹`, not `τ` in Q15).
+/// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.
 #[inline(always)]
 pub(crate) fn cubic_value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32) -> i32 {
-    let a = c[2].wrapping_add(mul_tau(c[3], t));
-    let a = c[1].wrapping_add(mul_tau(a, t));
-    c[0].wrapping_add(mul_tau(a, t)).wrapping_shr(r.shift)
+    let a = c[2].wrapping_add(mul_t(c[3], t));
+    let a = c[1].wrapping_add(mul_t(a, t));
+    c[0].wrapping_add(mul_t(a, t)).wrapping_shr(r.shift)
 }
 
 /// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;

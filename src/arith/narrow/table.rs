@@ -129,7 +129,7 @@ pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain
         } else {
             i.min(S - 1)
         };
-        cubic_value(r, &r.segments[i], q::tau(pos))
+        cubic_value(r, &r.segments[i], pos & 0x7FFF)
     };
     f.clamp(-(1 << 26), (1 << 26) - 1)
 }
