@@ -348,10 +348,12 @@ proptest! {
         p in common::any_spring_with_preload(1.5)
             .prop_filter("tabulable", |p| tabulable(p) && stiff_enough(p))
     ) {
-        // A preload above F_T puts the slope kink Δ(P) inside the table; a knot is placed
-        // on it. The grid then no longer starts where the cone leaves its linear phase
-        // (a jump in curvature, not slope), which one segment rounds off: up to 1.9e-3
-        // seen; 5e-3 asserted.
+        // A preload above F_T puts the slope kink Δ(P) inside the table; knots are placed
+        // on it and, where Δ(P) is at least a segment above it, on the cone's own
+        // transition Δ(F_T) (a jump in curvature; see the test below). The largest errors
+        // left are where a cubic cannot follow the law: the transition inside the first
+        // segment (Δ(P) closer to it), or the cone's steep rise just below Δ(P) when P is
+        // close to F_C. Up to 1.9e-3 seen; 5e-3 asserted.
         let r = Reference::new(&p).unwrap();
         let t = ForceTable::<64>::new(&p).unwrap();
         let s = sweep(&r, &t);
@@ -369,6 +371,54 @@ proptest! {
             prop_assert_eq!(sweep(&r, &t).big_decreases, 0);
         }
     }
+}
+
+/// With a preload above `F_T` the grid has knots on both the cone's transition `Δ(F_T)`
+/// (where the table starts) and the preload's kink `Δ(P)`, each to a strain LSB (and the
+/// scale's cut low bits, on `Δ(F_T)`), and its last knot is the first at or above the
+/// solid point or the domain's end: fewer than `S` segments where the longer step gets
+/// there first.
+#[test]
+fn a_preloaded_table_has_knots_on_the_transition_and_the_kink() {
+    let lsb = 1.0 / (1u64 << 24) as f64;
+    let mut fewer = 0;
+    for ratio in [1.05, 1.3, 2.0, 3.0, 5.0, 8.0] {
+        let r0 = Reference::new(&Params::TABLE2).unwrap();
+        let mut p = Params::TABLE2;
+        p.linear.preload = Some(ratio * r0.f_t);
+        if p.validate().is_err() {
+            continue;
+        }
+        let r = Reference::new(&p).unwrap();
+        let t = ForceTable::<64>::new(&p).unwrap();
+        let raw = t.raw();
+        let step = (1u64 << 47) as f64 / (raw.index_pre as f64 * raw.index_scale as f64) * lsb;
+        let (lo, hi) = t.tabulated_range();
+        let (lo, hi) = (lo.to_num::<f64>(), hi.to_num::<f64>());
+        let (e_t, e_p) = (r.strain_t(), r.delta(p.linear.preload.unwrap()));
+        let j = ((e_p - lo) / step).round();
+        assert!(
+            (lo + j * step - e_p).abs() <= 1.5 * lsb,
+            "{ratio}: Δ(P) {e_p} is {} LSB off knot {j}",
+            (lo + j * step - e_p) / lsb
+        );
+        assert!(
+            (lo - e_t).abs() <= 1e-4 * (e_p - e_t) + lsb,
+            "{ratio}: the first knot {lo} is off Δ(F_T) {e_t}"
+        );
+        let end = DOMAIN.1.min(r.strain_c());
+        let used = t.segments_used();
+        assert!(
+            hi >= end && hi < end + step + lsb,
+            "{ratio}: the table ends at {hi}"
+        );
+        assert!((hi - (lo + used as f64 * step)).abs() <= 2.0 * lsb);
+        fewer += usize::from(used < 64);
+    }
+    assert!(
+        fewer > 0,
+        "no preload gave a grid with fewer segments in use"
+    );
 }
 
 /// Table 2 with both shear moduli scaled by `k` (stiffer or softer tissue).

@@ -129,8 +129,9 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
             }
         }
     }
-    let step = (hi - lo) / S as f64;
-    for i in 0..S {
+    let used = table.segments_used();
+    let step = (hi - lo) / used as f64;
+    for i in 0..used {
         for j in 0..=n {
             at(lo + step * (i as f64 + j as f64 / n as f64));
         }

@@ -59,7 +59,23 @@ impl<const S: usize> ForceTable<S> {
     /// [`ForceTable::measured`]).
     #[inline(never)]
     pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
-        let grid = Grid::place::<S>(law, from, to)?;
+        // A grid aligned on both Δ(F_T) and Δ(P) has a longer step, and its last knot may
+        // then lie far enough past the solid point, on the k_p line, to leave the formats:
+        // first the shortest aligned step, then the one whose last knot is closest past
+        // the solid point, then the grid on Δ(P) alone.
+        let mut built = Err(TableError::OutOfRange);
+        for align in [Align::Shortest, Align::NearSolid, Align::Off] {
+            built = Self::on_grid(law, from, to, align);
+            if !matches!(built, Err(TableError::OutOfRange)) {
+                break;
+            }
+        }
+        built
+    }
+
+    /// The table on the grid [`Grid::place`] puts over `[from, to]`.
+    fn on_grid(law: &Law, from: f64, to: f64, align: Align) -> Result<Self, TableError> {
+        let grid = Grid::place::<S>(law, from, to, align)?;
         let shift = coefficient_shift::<S>(law, &grid)?;
         let segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
@@ -86,6 +102,18 @@ impl<const S: usize> ForceTable<S> {
     }
 }
 
+/// Whether and how a grid with a preload's kink inside it is aligned on both `Δ(F_T)`
+/// and `Δ(P)` ([`Grid::place`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Align {
+    /// The shortest step that does it.
+    Shortest,
+    /// Among the 16 shortest, the one whose last knot lies closest past the solid point.
+    NearSolid,
+    /// Not aligned: a knot on `Δ(P)` only.
+    Off,
+}
+
 /// Where the knots are: `lo + i · step`, `i = 0 … S`, with the grid's index in the
 /// evaluation's fixed-point terms.
 struct Grid {
@@ -97,6 +125,8 @@ struct Grid {
     kink_knot: Option<usize>,
     /// Whether the first knot moved below the table's start to put a knot on `Δ(P)`.
     grid_moved: bool,
+    /// The segments in use (`S`, or fewer on a grid aligned on `Δ(F_T)` and `Δ(P)`).
+    used: usize,
     /// The first knot, rounded to the strain format (as an `f64` and in Q24).
     lo: f64,
     strain_lo: i32,
@@ -110,7 +140,12 @@ struct Grid {
 
 impl Grid {
     /// Places `S` segments over the law's curved part inside `[from, to]`.
-    fn place<const S: usize>(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
+    fn place<const S: usize>(
+        law: &Law,
+        from: f64,
+        to: f64,
+        align: Align,
+    ) -> Result<Self, TableError> {
         if S == 0 {
             return Err(TableError::NoSegments);
         }
@@ -128,25 +163,45 @@ impl Grid {
         }
         // A preload above F_T puts the law's one slope kink, Δ(P), inside the table. The
         // grid is then placed so that a knot falls on it, and the two segments meeting
-        // there get the two one-sided slopes: the first knot moves down (into the exact
-        // linear phase, or below the domain) by less than a segment, and the step grows
-        // only if the table would otherwise end short of `hi`.
+        // there get the two one-sided slopes. With `align` on, and Δ(P) at least a segment
+        // above the table's start (the cone's own transition Δ(F_T), a jump in curvature
+        // that a cubic across it follows only to second order; or the domain's edge), the
+        // step is chosen so that a whole number j of segments spans the two, and both
+        // are knots. The step grows by at most a factor 1 + 1/j, which costs less than
+        // that corner (the smooth parts' fourth-order error grows at most 16×, from
+        // ~1e-7), and the table ends at the first knot at or above `hi`, with fewer than
+        // `S` segments in use. Otherwise the first knot moves down (into the exact linear
+        // phase, or below the domain) by less than a segment, and the step grows only if
+        // the table would otherwise end short of `hi`.
         let e_p = law.delta(law.preload);
         let mut kink_knot = None;
         let mut lo_grid = lo;
         let mut width = hi - lo;
+        let mut aligned = false;
         if law.preload > law.f_t && e_p > lo && e_p < hi {
-            let mut step = width / S as f64;
-            let j = libm::ceil((e_p - lo) / step);
-            if j < S as f64 {
-                step = libm::fmax(step, (hi - e_p) / (S as f64 - j));
-                lo_grid = e_p - j * step;
-                width = S as f64 * step;
-                kink_knot = Some(j as usize);
+            let most = libm::floor(S as f64 * (e_p - lo) / (hi - lo));
+            if align != Align::Off && most >= 1.0 {
+                let fit = if at_solid && align == Align::NearSolid {
+                    aligned_on_solid(e_p - lo, hi - lo, most)
+                } else {
+                    most
+                };
+                width = S as f64 * (e_p - lo) / fit;
+                kink_knot = Some(fit as usize);
+                aligned = true;
+            } else {
+                let mut step = width / S as f64;
+                let j = libm::ceil((e_p - lo) / step);
+                if j < S as f64 {
+                    step = libm::fmax(step, (hi - e_p) / (S as f64 - j));
+                    lo_grid = e_p - j * step;
+                    width = S as f64 * step;
+                    kink_knot = Some(j as usize);
+                }
             }
         }
+        let start = lo;
         let strain_lo = checked_from_f64(lo_grid, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        let grid_moved = lo_grid < lo;
         let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
         // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
         // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
@@ -171,8 +226,29 @@ impl Grid {
         let index_scale = narrow_scale(scale as u32);
         // The evaluation places knot i at lo + i · step: build at exactly those strains.
         let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
-        // Strains below strain_lo + d (in Q24 LSBs) have coordinates below S·2¹⁵.
-        let num = (S as u128) << 47;
+        // That step is a little longer than the one asked for (the scale's low bits are
+        // cut, up to 6e-5 of it): the first knot moves down so that the kink's knot stays
+        // on Δ(P), to a strain LSB (the table still reaches `hi`: the step only grew).
+        let (strain_lo, lo) = match kink_knot {
+            Some(j) => {
+                let q = checked_from_f64(e_p - j as f64 * step, STRAIN_FRAC)
+                    .ok_or(TableError::BadDomain)?;
+                (q, q as f64 / (1u64 << STRAIN_FRAC) as f64)
+            }
+            None => (strain_lo, lo),
+        };
+        let grid_moved = lo_grid < start;
+        // The segments in use: all of them, unless the grid was aligned on Δ(F_T) and
+        // Δ(P), whose longer step may reach `hi` before the last one (the table then
+        // ends at the first knot at or above `hi`; the segments above stay zero and are
+        // never reached).
+        let used = if aligned {
+            (libm::ceil((hi - lo) / step) as usize).clamp(1, S)
+        } else {
+            S
+        };
+        // Strains below strain_lo + d (in Q24 LSBs) have coordinates below used·2¹⁵.
+        let num = (used as u128) << 47;
         let den = (index_scale as u128) << index_shift;
         let d = num.div_ceil(den);
         let strain_hi =
@@ -182,6 +258,7 @@ impl Grid {
             at_solid,
             kink_knot,
             grid_moved,
+            used,
             lo,
             strain_lo,
             strain_hi,
@@ -256,7 +333,7 @@ fn coefficient_shift<const S: usize>(law: &Law, grid: &Grid) -> Result<u32, Tabl
     let (mut big_value, mut big_poly) = (1e-30f64, 1e-30f64);
     let mut prev = grid.knot(law, 0)?;
     big_value = libm::fmax(big_value, libm::fabs(prev.value));
-    for i in 1..=S {
+    for i in 1..=grid.used {
         let k = grid.knot(law, i)?;
         let c = hermite(prev.value, k.value, prev.slope_above, k.slope_below);
         big_value = libm::fmax(big_value, libm::fabs(k.value));
@@ -299,7 +376,7 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
     let (mut a0, mut m0) = (libm::round(first.value * scale), first.slope_above);
     let a_first = a0;
     let mut slope_bound = 0.0f64;
-    for (i, c) in coefficients.iter_mut().enumerate() {
+    for (i, c) in coefficients.iter_mut().enumerate().take(grid.used) {
         let k = grid.knot(law, i + 1)?;
         let a1 = libm::round(k.value * scale);
         let [c1, c2, _] = hermite(a0, a1, m0 * scale, k.slope_below * scale);
@@ -375,7 +452,7 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
             .ok_or(TableError::OutOfRange)?;
         (kq, grid.strain_lo, first_q20)
     };
-    let e_hi = grid.lo + S as f64 * grid.step;
+    let e_hi = grid.lo + grid.used as f64 * grid.step;
     let above = if grid.at_solid {
         law.k_p
     } else {
@@ -387,6 +464,26 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
         stiffness_lo,
         stiffness_hi: checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
     })
+}
+
+/// On a grid aligned on `Δ(F_T)` and `Δ(P)` (`j` segments over `to_kink`, `j` ≤ `most`)
+/// that ends at the solid point (`span` from the start): the `j`, among the 16 largest,
+/// whose last knot lies closest past `Δ(F_C)`. The segment across it holds the law's
+/// corner, and the knot past it sits on the steep `k_p` line.
+fn aligned_on_solid(to_kink: f64, span: f64, most: f64) -> f64 {
+    let past = |j: f64| {
+        let h = to_kink / j;
+        libm::ceil(span / h) * h - span
+    };
+    let mut best = most;
+    let mut j = most - 1.0;
+    while j >= 1.0 && j > most - 16.0 {
+        if past(j) < past(best) {
+            best = j;
+        }
+        j -= 1.0;
+    }
+    best
 }
 
 /// `x` with all but its 15 most significant bits cleared.

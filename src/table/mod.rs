@@ -8,7 +8,10 @@
 //! of slope `k`; above `Δ(F_C)` the exact line of slope `k_p`. Where the domain cuts the
 //! curved part short, the line beyond the domain edge is the tangent there (an
 //! under-estimate of the stiffening law above the edge). With a preload above `F_T` the
-//! grid is placed so that a knot sits on the slope kink `Δ(P)`.
+//! grid is placed so that knots sit on the slope kink `Δ(P)` and, where `Δ(P)` is at
+//! least a segment above it, on the cone's own transition `Δ(F_T)` too (the step then
+//! grows a little, and the range may end before the last segment:
+//! [`ForceTable::segments_used`]).
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
@@ -193,12 +196,27 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let mut max = r.stiffness_lo.max(r.stiffness_hi);
         let span = r.strain_hi.saturating_sub(r.strain_lo) as i64;
-        for i in 0..=(2 * S) as i64 {
-            let e = r.strain_lo as i64 + span * i / (2 * S) as i64;
+        let used = self.segments_used() as i64;
+        for i in 0..=2 * used {
+            let e = r.strain_lo as i64 + span * i / (2 * used);
             let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
             max = max.max(k.to_bits());
         }
         Stiffness::from_bits(max)
+    }
+
+    /// The segments the tabulated range spans (1 … `S`): `S`, unless the grid was
+    /// aligned on both the cone's transition and the preload's kink, whose longer step
+    /// may cover the range with fewer (the others are never reached).
+    pub fn segments_used(&self) -> usize {
+        let r = &self.raw;
+        if r.strain_hi <= r.strain_lo {
+            return S.min(1);
+        }
+        // The position of the range's last strain, as the evaluation computes it.
+        let de = (r.strain_hi.wrapping_sub(1).wrapping_sub(r.strain_lo) as u32)
+            .wrapping_mul(r.index_pre);
+        ((mulhi_u(de, r.index_scale) >> 15) as usize + 1).clamp(S.min(1), S)
     }
 
     /// Force (N) at compressive strain `strain`; constant time, saturating, no panic.
