@@ -7,13 +7,24 @@
 #      (host-tests/tests/cap.rs), and the force-table bound over 10⁵ random springs
 #      (host-tests/tests/table_bound.rs);
 #   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
-# Prints the PROPERTY and FUZZ lines; exits with failure if any run fails.
+# First, the whole host test suite in a release build (link-time optimisation, as
+# docs/cli.md builds the CLI), and that build's stack probes
+# (scripts/check_stack_probes.py: an LLVM defect once cost the window its position).
+# Prints the STACKPROBE, PROPERTY and FUZZ lines; exits with failure if any run fails.
 #   scripts/long.sh [CASES] [FUZZ_SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cases=${1:-50000}
 fuzz_seconds=${2:-300}
 mkdir -p target/logs/long
+echo "long.sh: the host tests in a release build (log: target/logs/long/release.log)" >&2
+cargo test --release -p mccs-host > target/logs/long/release.log 2>&1 \
+  || { echo "long.sh: the release host tests failed; see target/logs/long/release.log" >&2; exit 1; }
+echo "long.sh: the release CLI's stack probes" >&2
+rm -f target/release/deps/mccs-*.s
+cargo rustc --release -p mccs-host --bin mccs -- --emit asm -C llvm-args=-x86-asm-syntax=intel \
+  >> target/logs/long/release.log 2>&1
+python3 scripts/check_stack_probes.py target/release/deps/mccs-*.s
 log=target/logs/long/properties.log
 echo "long.sh: the short-trajectory properties at $cases cases per arithmetic (log: $log)" >&2
 start=$(date +%s)

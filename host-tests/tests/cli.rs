@@ -67,9 +67,13 @@ fn curve_prints_the_reference_csv() {
     assert_eq!(rows[0][0], -0.2);
     assert_eq!(rows[15][0], 1.3);
     let r = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
+    // The reference's values to their last bits: within 2 ULP, because `f64::powi` is not
+    // correctly rounded and its result depends on how the compiler inlined it (a
+    // release build of this test and of the CLI differ by one ULP).
+    let close = |a: f64, b: f64| (a - b).abs() <= 2.0 * f64::EPSILON * b.abs();
     for row in &rows {
-        assert_eq!(row[1], r.force(row[0]));
-        assert_eq!(row[2], r.stiffness(row[0]));
+        assert!(close(row[1], r.force(row[0])), "{row:?}");
+        assert!(close(row[2], r.stiffness(row[0])), "{row:?}");
     }
     assert!(rows.windows(2).all(|w| w[1][1] > w[0][1]));
 }

@@ -78,6 +78,44 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             let u = libm::round(p / s + (side - 1) as f64 / 2.0) - (n / 2) as f64;
             u.clamp(0.0, (side - n) as f64) as i32
         };
+        let place = Placement {
+            n,
+            w,
+            h,
+            s,
+            spacing,
+            corner: [corner(x, w), corner(y, h)],
+            limit: from_f64(0.5 + config.hysteresis, 16),
+            cap,
+        };
+        self.build_window(&place)
+    }
+
+    /// The window [`Solver::window_as`] checked and placed: its maps, and on a cap its
+    /// rest heights and the springs' geometry (start-up).
+    ///
+    /// Apart from the checks so that this function's large frame (the maps of every
+    /// spring: some 36 KiB on a host's N = 9 patch) is set up on entry. An x86-64 host
+    /// build with link-time optimisation otherwise moved the checks before the frame's
+    /// stack probe loop, which takes `r11` as its scratch register without checking that
+    /// it is free, and lost the tissue's height held there (an LLVM defect of the same
+    /// kind as llvm/llvm-project#198699 on RISC-V): the window then started at the
+    /// tissue's edge. `scripts/long.sh` checks a release build for it.
+    #[inline(never)]
+    fn build_window<const CAP: bool>(
+        &mut self,
+        place: &Placement,
+    ) -> Result<Window<EDGES, CAP>, ProxyError> {
+        let &Placement {
+            n,
+            w,
+            h,
+            s,
+            spacing,
+            corner,
+            limit,
+            cap,
+        } = place;
         let keys: [[Key; 2]; EDGES] = core::array::from_fn(|e| {
             self.topo
                 .edges()
@@ -124,8 +162,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             n: n as i32,
             w: w as i32,
             h: h as i32,
-            corner: [corner(x, w), corner(y, h)],
-            limit: from_f64(0.5 + config.hysteresis, 16),
+            corner,
+            limit,
             spacing,
             maps,
             shifts: 0,
@@ -362,6 +400,23 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.set_cap_heights(window);
         self.move_cap_geometry(window, dir);
     }
+}
+
+/// Where [`Solver::window_as`] puts a window, once its configuration is checked.
+struct Placement {
+    /// The patch's side, the tissue's width and height (nodes).
+    n: usize,
+    w: usize,
+    h: usize,
+    /// The spacing, mm and Q24 mm.
+    s: f64,
+    spacing: i32,
+    /// The window's corner on the tissue (nodes).
+    corner: [i32; 2],
+    /// The shift threshold, Q16 spacings.
+    limit: i32,
+    /// The cap, if the tissue is one.
+    cap: Option<Cap>,
 }
 
 /// The window's cap as the proxy sees it this tick (`None`: flat; always for a flat-only

@@ -73,7 +73,9 @@ impl<const S: usize> ForceTable<S> {
         built
     }
 
-    /// The table on the grid [`Grid::place`] puts over `[from, to]`.
+    /// The table on the grid [`Grid::place`] puts over `[from, to]` (one copy of the
+    /// builder in flash, however many placements are tried).
+    #[inline(never)]
     fn on_grid(law: &Law, from: f64, to: f64, align: Align) -> Result<Self, TableError> {
         let grid = Grid::place::<S>(law, from, to, align)?;
         let shift = coefficient_shift::<S>(law, &grid)?;

@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Flags x86-64 functions whose stack probe loop may clobber a live r11.
+
+An x86-64 build with link-time optimisation lets LLVM move a function's first checks
+ahead of its prologue (shrink-wrapping). For a frame over 32 KiB the prologue probes
+the stack in a loop that takes r11 as its scratch register without checking that it is
+free (an LLVM defect; llvm/llvm-project#198699 is the same on RISC-V). A value the
+moved checks left in r11 is then lost: `Solver::window_as` lost the tissue's height
+this way until its frame moved into `build_window` (src/solver/roaming.rs).
+
+Reads the assembly of a release build (scripts/long.sh makes it with
+`cargo rustc --release -p mccs-host --bin mccs -- --emit asm`) and lists every function
+that writes r11 before its probe loop (`mov r11, rsp`). A heuristic: the write may be on
+another path than the loop's, so a hit is for a person to read. Exits 1 on any hit.
+
+    scripts/check_stack_probes.py FILE.s
+"""
+import re
+import sys
+
+
+def suspects(path):
+    hits, name, body = [], None, []
+
+    def check():
+        for i, line in enumerate(body):
+            if re.search(r"\bmov\s+r11, rsp\b", line):
+                writes = [b.strip() for b in body[:i] if re.match(r"^\s*\w+\s+r11[dwb]?\b", b)]
+                if writes:
+                    hits.append((name, writes[:2]))
+                return
+
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            m = re.match(r"^(_\S+):\s*$", line)
+            if m:
+                if name:
+                    check()
+                name, body = m.group(1), []
+            elif name and not re.match(r"^\s*(\.|#)", line):
+                body.append(line.rstrip())
+    if name:
+        check()
+    return hits
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__.strip().splitlines()[-1].strip(), file=sys.stderr)
+        return 2
+    hits = suspects(sys.argv[1])
+    for name, writes in hits:
+        print(f"STACKPROBE r11 written before the probe loop: {name} ({'; '.join(writes)})")
+    print(f"STACKPROBE functions={len(hits)} result={'fail' if hits else 'ok'}")
+    return 1 if hits else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
