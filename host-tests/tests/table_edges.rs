@@ -66,6 +66,43 @@ proptest! {
     }
 }
 
+/// A raw table of no segments (`ForceTable<0>`: `mccs table` never emits one, and
+/// `validate` refuses it) still evaluates without a panic: its lines, zeros between.
+/// Before, a strain between its ends indexed an empty array.
+#[test]
+fn a_table_of_no_segments_evaluates_without_panic() {
+    let raw = RawTable::<0> {
+        strain_lo: -(1 << 22),
+        strain_hi: 1 << 23,
+        index_pre: 1 << 8,
+        index_scale: 1 << 20,
+        anchor_lo: 0,
+        force_lo: 0,
+        stiffness_lo: 1 << 16,
+        force_hi: 1 << 20,
+        stiffness_hi: 1 << 17,
+        shift: 0,
+        stiff_scale: 1 << 20,
+        stiff_post: 1,
+        err_force_ppb: 0,
+        err_stiffness_ppb: 0,
+        segments: [],
+    };
+    let t = ForceTable::from_raw(raw);
+    assert!(t.validate().is_err());
+    let narrow = ArithTable::<0, Narrow>::new(t);
+    for bits in [i32::MIN, -(1 << 22), 0, 1 << 20, 1 << 23, i32::MAX] {
+        let e = Strain::from_bits(bits);
+        let (f, _) = t.force_and_stiffness(e);
+        assert_eq!(f, t.force(e));
+        let _ = t.force_within::<26>(e);
+        let _ = table_force(&narrow, e);
+    }
+    assert_eq!(t.force(Strain::from_bits(0)).to_bits(), 0);
+    let _ = t.max_stiffness();
+    assert_eq!(t.segments_used(), 0);
+}
+
 /// The repro: a domain ending a hair above the kink left 17 knots within one
 /// strain LSB (and an index scale of 32 bits, on which the narrow arithmetic's
 /// derivation overflowed). Such a domain is now refused as too narrow.

@@ -196,7 +196,7 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let mut max = r.stiffness_lo.max(r.stiffness_hi);
         let span = r.strain_hi.saturating_sub(r.strain_lo) as i64;
-        let used = self.segments_used() as i64;
+        let used = self.segments_used().max(1) as i64;
         for i in 0..=2 * used {
             let e = r.strain_lo as i64 + span * i / (2 * used);
             let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
@@ -291,11 +291,16 @@ impl<const S: usize> ForceTable<S> {
         let i = if S.is_power_of_two() {
             i & (S - 1)
         } else {
-            i.min(S - 1)
+            i.min(S.saturating_sub(1))
         };
-        (&r.segments[i], pos & 0x7FFF)
+        // Always a segment for S ≥ 1 (the compiler sees i < S: no code); a table of no
+        // segments (only from `from_raw`) reads zeros instead of panicking.
+        (r.segments.get(i).unwrap_or(&NO_SEGMENT), pos & 0x7FFF)
     }
 }
+
+/// What a table with no segments evaluates to between its ends.
+pub(crate) const NO_SEGMENT: [i32; 4] = [0; 4];
 
 /// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.
 #[inline(always)]

@@ -4,7 +4,7 @@
 use super::Narrow;
 use crate::arith::ArithTable;
 use crate::q;
-use crate::table::{cubic_value, RawTable};
+use crate::table::{cubic_value, RawTable, NO_SEGMENT};
 use crate::units::Strain;
 
 /// What [`table_force`] needs beyond the raw table, derived from it: the index scale and
@@ -127,9 +127,10 @@ pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain
         let i = if S.is_power_of_two() {
             i & (S - 1)
         } else {
-            i.min(S - 1)
+            i.min(S.saturating_sub(1))
         };
-        cubic_value(r, &r.segments[i], pos & 0x7FFF)
+        let c = r.segments.get(i).unwrap_or(&NO_SEGMENT);
+        cubic_value(r, c, pos & 0x7FFF)
     };
     f.clamp(-(1 << 26), (1 << 26) - 1)
 }
