@@ -202,9 +202,7 @@ impl Grid {
                 }
             }
         }
-        let start = lo;
-        let strain_lo = checked_from_f64(lo_grid, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
+        let grid_moved = lo_grid < lo;
         // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
         // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
         // scale keeps about 21 significant bits.
@@ -229,17 +227,12 @@ impl Grid {
         // The evaluation places knot i at lo + i · step: build at exactly those strains.
         let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
         // That step is a little longer than the one asked for (the scale's low bits are
-        // cut, up to 6e-5 of it): the first knot moves down so that the kink's knot stays
-        // on Δ(P), to a strain LSB (the table still reaches `hi`: the step only grew).
-        let (strain_lo, lo) = match kink_knot {
-            Some(j) => {
-                let q = checked_from_f64(e_p - j as f64 * step, STRAIN_FRAC)
-                    .ok_or(TableError::BadDomain)?;
-                (q, q as f64 / (1u64 << STRAIN_FRAC) as f64)
-            }
-            None => (strain_lo, lo),
-        };
-        let grid_moved = lo_grid < start;
+        // cut, up to 6e-5 of it): with a kink, the first knot is placed from this step so
+        // that the kink's knot stays on Δ(P), to a strain LSB (the table still reaches
+        // `hi`: the step only grew).
+        let first = kink_knot.map_or(lo_grid, |j| e_p - j as f64 * step);
+        let strain_lo = checked_from_f64(first, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
         // The segments in use: all of them, unless the grid was aligned on Δ(F_T) and
         // Δ(P), whose longer step may reach `hi` before the last one (the table then
         // ends at the first knot at or above `hi`; the segments above stay zero and are

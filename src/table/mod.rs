@@ -213,10 +213,8 @@ impl<const S: usize> ForceTable<S> {
         if r.strain_hi <= r.strain_lo {
             return S.min(1);
         }
-        // The position of the range's last strain, as the evaluation computes it.
-        let de = (r.strain_hi.wrapping_sub(1).wrapping_sub(r.strain_lo) as u32)
-            .wrapping_mul(r.index_pre);
-        ((mulhi_u(de, r.index_scale) >> 15) as usize + 1).clamp(S.min(1), S)
+        // The segment of the range's last strain, as the evaluation finds it.
+        ((self.position(r.strain_hi.wrapping_sub(1)) >> 15) as usize + 1).clamp(S.min(1), S)
     }
 
     /// Force (N) at compressive strain `strain`; constant time, saturating, no panic.
@@ -279,12 +277,19 @@ impl<const S: usize> ForceTable<S> {
         (Force::from_bits(f), Stiffness::from_bits(k))
     }
 
+    /// The position of `e` (`strain_lo < e < strain_hi`) in Q15 segments from `strain_lo`.
+    #[inline(always)]
+    fn position(&self, e: i32) -> u32 {
+        let r = &self.raw;
+        let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
+        mulhi_u(de, r.index_scale)
+    }
+
     /// The segment holding `e` (`strain_lo < e < strain_hi`) and the Q15 position in it.
     #[inline(always)]
     fn segment(&self, e: i32) -> (&[i32; 4], u32) {
         let r = &self.raw;
-        let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
-        let pos = mulhi_u(de, r.index_scale);
+        let pos = self.position(e);
         // strain_hi is placed so that pos < S · 2¹⁵ here: the mask (or min) only keeps
         // the compiler from adding a bounds check.
         let i = (pos >> 15) as usize;
