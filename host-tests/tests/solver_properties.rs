@@ -364,7 +364,7 @@ fn potential_density(eps: f64) -> f64 {
 fn energy<A: Arith>(s: &Patch<A>, mass: f64) -> (f64, bool) {
     let topo = s.topology();
     let law = Reference::new(&Params::TABLE2).unwrap();
-    let r_max = if A::REST == 0 { 7.0 } else { 16.0 };
+    let r_max = A::MAX_RATIO;
     let disp = |i: u16| -> [f64; 3] {
         s.displacement(i)
             .map(|d| d.map(|c| c.to_num::<f64>()))

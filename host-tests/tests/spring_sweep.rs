@@ -21,8 +21,6 @@ struct Limits {
     w_cap: f64,
     /// `l0/l`.
     r_max: f64,
-    /// `|f| l0/l`, N.
-    fr_hold: f64,
     /// Longest rest length, mm.
     l0_max: f64,
     /// The error bound the sweep asserts: `rel` of the larger of the two forces'
@@ -36,8 +34,7 @@ struct Limits {
 const WIDE: Limits = Limits {
     strain_from_step: true,
     w_cap: 2.0,
-    r_max: 16.0,
-    fr_hold: 256.0,
+    r_max: Wide::MAX_RATIO,
     l0_max: 300.0,
     rel: 2e-5,
     strain: 0.0,
@@ -46,8 +43,7 @@ const WIDE: Limits = Limits {
 const NARROW: Limits = Limits {
     strain_from_step: false,
     w_cap: 2.0,
-    r_max: 7.0,
-    fr_hold: f64::INFINITY,
+    r_max: Narrow::MAX_RATIO,
     l0_max: 16.0,
     rel: 2e-3,
     strain: 1e-3,
@@ -56,7 +52,7 @@ const NARROW: Limits = Limits {
 
 /// The spring's force on end `a` (N) in the `f64` model, the documented limits applied:
 /// the edge over its rest length held per axis, `l0/l` held (so that a crushed spring's
-/// force fades to zero), the law force within ±64 N, `|f| l0/l` held, each axis within
+/// force fades to zero), the law force within ±64 N, each axis within
 /// ±64 N. Also the strain (`1 − a r`, as the kernel forms it) and the law's tangent
 /// stiffness there times `1 + l0/l`.
 fn model(law: &Reference, lim: &Limits, x: [f64; 3], l0: f64) -> ([f64; 3], f64, f64) {
@@ -99,7 +95,7 @@ fn model_r(law: &Reference, lim: &Limits, x: [f64; 3], l0: f64) -> ([f64; 3], f6
         (law.force(strain), law.stiffness(strain))
     };
     let f = f.clamp(-64.0, 64.0);
-    let fr = (f * r).clamp(-lim.fr_hold, lim.fr_hold);
+    let fr = f * r;
     (w.map(|c| (-fr * c).clamp(-64.0, 64.0)), strain, k, r)
 }
 
@@ -111,11 +107,7 @@ fn bound(lim: &Limits, scale: f64, k: f64) -> f64 {
 
 /// The arithmetic's warm-start value at `l0/l = r`.
 fn warm_of<A: Arith>(r: f64) -> i32 {
-    if A::REST == 0 {
-        from_f64(r - 1.0, LEN_FRAC)
-    } else {
-        from_f64(r, LEN_FRAC)
-    }
+    A::warm_of_ratio(r)
 }
 
 struct Sweep {

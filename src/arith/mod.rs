@@ -63,12 +63,19 @@ pub trait Arith: Copy + core::fmt::Debug + Default + PartialEq + Eq + 'static {
     type Coeffs: Copy + core::fmt::Debug + PartialEq + Eq;
     /// A spring's warm-start value at rest.
     const REST: i32;
+    /// The hold on a spring's `l0/l` (exclusive): a spring crushed below `l0 / MAX_RATIO`
+    /// keeps `MAX_RATIO`, so that its force fades to zero at zero length.
+    const MAX_RATIO: f64;
     /// The longest rest length, mm, for which the arithmetic holds its documented
     /// precision (`docs/accuracy.md`); a solver refuses longer springs.
     const MAX_REST_LENGTH_MM: f64;
 
     /// The table's extra data for this arithmetic.
     fn table_aux<const S: usize>(table: &ForceTable<S>) -> Self::TableAux;
+
+    /// The warm-start value of a spring at `l0/l = r` (`0 < r <` [`Arith::MAX_RATIO`];
+    /// start-up and tests).
+    fn warm_of_ratio(r: f64) -> i32;
 
     /// The coefficients for `spec`.
     fn coeffs(spec: &StepSpec) -> Self::Coeffs;

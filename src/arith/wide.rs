@@ -7,33 +7,50 @@ use crate::q::{self, V3};
 use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, DISP_LIMIT};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
-use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE, VEL_FRAC};
+use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, VEL_FRAC};
 
 /// 32 × 32 → 64 products: the M3/M4F's arithmetic, and the host's default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Wide;
 
 /// Fraction bits of the spring damping (N·s/mm): Q16 mm/s · Q36 = Q52, the format of the
-/// spring's `w · (f l0/l)` product (Q29 · Q23), whose high word is Q20 N.
+/// spring's `w · (f l0/l)` product (Q30 · Q22), whose high word is Q20 N.
 const DAMP_FRAC: u32 = 36;
-/// Fraction bits of the edge vector over the rest length, `w`: Q29 (±2 held).
-const W_FRAC: u32 = 29;
+/// Fraction bits of the edge vector over the rest length, `w`: Q30 (±2 held; the
+/// square of an axis is ≤ 2³⁰ in the product's high word, Q28, and the sum of three
+/// fits a `u32`).
+const W_FRAC: u32 = 30;
 const _: () = assert!(
     DIR_FRAC == LEN_FRAC + INV_LEN_FRAC - 32,
     "dir + the high word"
 );
-/// Fraction bits of `f l0/l`: Q23 (±256 N held).
-const FR_FRAC: u32 = 23;
+/// Fraction bits of `|w|²` (`u32`, ≤ 12): the high word of two Q30 values' product.
+const A_FRAC: u32 = 2 * W_FRAC - 32;
+/// Fraction bits of the warm-started `l0/l`, `r`: Q27 (held below [`MAX_RATIO`]).
+const R_FRAC: u32 = 27;
+/// Fraction bits of `|w|² r` from the high word of `a · r`: Q23.
+const AR_FRAC: u32 = A_FRAC + R_FRAC - 32;
+/// `|w|² r` held below 4 (Q23): the converged value is `|w| ≤ 2√3`; above, the Newton
+/// factor is at its floor anyway. Then Q28 (`<< 5`), so that `(a r) r` and `(a r) · factor`
+/// are high words too.
+const AR_LIMIT: i32 = 4 << AR_FRAC;
+const AR_Q: u32 = 28;
+/// Fraction bits of `a r²`: the high word of Q28 · Q27, Q23.
+const ARR_FRAC: u32 = AR_Q + R_FRAC - 32;
+/// Largest warm-started `l0/l` (exclusive): a spring crushed below `l0/8` keeps 8.
+pub const MAX_RATIO: i32 = 8;
+const R_MAX: i32 = (MAX_RATIO << R_FRAC) - 1;
+/// `l0/l` as the spring's warm-start value stores it: 1 (rest) in Q27.
+pub const REST_RATIO: i32 = 1 << R_FRAC;
+/// Fraction bits of `−f l0/l`: Q22 (the law force within ±64 N times `l0/l` < 8 is within
+/// ±512 N, which Q22 holds: never clamped).
+const FR_FRAC: u32 = 22;
 // The spring's two products share Q52, whose high word is Q20 N.
 const _: () = assert!(VEL_FRAC + DAMP_FRAC == 32 + FORCE_FRAC);
 const _: () = assert!(W_FRAC + FR_FRAC == 32 + FORCE_FRAC);
-/// Upper bound of the warm-started `l0/l`: springs shorter than `l0/16` keep it at 16.
-const R_MAX: i32 = (16 << LEN_FRAC) - 1;
-/// Largest law force per unit current length, `|f| · l0/l`: 256 N = 2³¹ in Q23.
-pub const FORCE_PER_STRETCH_LIMIT_N: i32 = 256;
-const _: () = assert!(FORCE_PER_STRETCH_LIMIT_N as i64 == 1 << (31 - FR_FRAC));
-/// Largest edge vector over the rest length, per axis: 2 (Q29).
-const W_LIMIT: i32 = 2 << W_FRAC;
+const _: () = assert!((64i64 * MAX_RATIO as i64) << FR_FRAC <= 1 << 31);
+/// Largest edge vector over the rest length, per axis: 2 (Q23, the sum's format).
+const W_LIMIT_23: i32 = 2 << DIR_FRAC;
 
 /// Fraction bits of `h/m` ((mm/s)/N) and of `1 − h c/m` (the velocity kept through the
 /// node damping): Q20 N · Q20 and Q16 mm/s · Q24 are both Q40, shifted by 24 to Q16 mm/s.
@@ -60,10 +77,15 @@ pub struct WideCoeffs {
 impl Arith for Wide {
     type TableAux = ();
     type Coeffs = WideCoeffs;
-    const REST: i32 = ONE;
+    const REST: i32 = REST_RATIO;
+    const MAX_RATIO: f64 = MAX_RATIO as f64;
     const MAX_REST_LENGTH_MM: f64 = f64::INFINITY;
 
     fn table_aux<const S: usize>(_: &ForceTable<S>) {}
+
+    fn warm_of_ratio(r: f64) -> i32 {
+        from_f64(r, R_FRAC).clamp(0, R_MAX)
+    }
 
     fn coeffs(spec: &StepSpec) -> WideCoeffs {
         let StepSpec {
@@ -138,8 +160,8 @@ impl<const S: usize> SpringKernel for Kernel<'_, S> {
 
 /// The force on end `a` of one spring (Q20 N): the law along the edge plus the relative
 /// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
-/// `dir` is the unit rest vector (Q29), `inv_len` is `1/l0` (Q31), `r` the spring's
-/// warm-started `l0/l` (Q24), advanced by one guarded Newton step, and `damping` the
+/// `dir` is the unit rest vector (Q23), `inv_len` is `1/l0` (Q31), `r` the spring's
+/// warm-started `l0/l` (Q27), advanced by one guarded Newton step, and `damping` the
 /// spring damping (Q36 N·s/mm).
 ///
 /// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
@@ -149,11 +171,10 @@ impl<const S: usize> SpringKernel for Kernel<'_, S> {
 /// behaviour:
 /// - the normalised edge vector `(x_b − x_a)/l0` is capped at ±2 per axis: a spring
 ///   stretched further pulls as if stretched to 2 `l0` along that axis;
-/// - `l0/l` stays below 16: a spring crushed below `l0/16` keeps it at 16, so its
+/// - `l0/l` stays below 8: a spring crushed below `l0/8` keeps it at 8, so its
 ///   direction vector shortens with the spring and the force fades to zero at zero length
 ///   instead of flipping;
-/// - the law force is limited to ±64 N, and `|f| l0/l` to 256 N (a spring at 64 N
-///   compressed past `l0/4` pushes as if at `l0/4`);
+/// - the law force is limited to ±64 N;
 /// - one spring's force (law and damping) is limited to ±64 N, so that a node's sum
 ///   cannot overflow.
 ///
@@ -173,44 +194,46 @@ fn spring<const S: usize>(
     // Q24 · Q31 (one `smmla`); |u_b − u_a| < 2³¹ (the displacement clamp) and
     // 1/l0 ≤ 1 keep that high word within ±2³⁰, so the sum cannot overflow. Held within
     // ±2 per axis (one `ssat`), whatever the displacement: a spring stretched further
-    // pulls as if stretched to 2 l0 along that axis, never the other way. Then Q29.
+    // pulls as if stretched to 2 l0 along that axis, never the other way. Then Q30.
     let w: V3 = core::array::from_fn(|k| {
         let w23 = q::mulhi_acc(ub[k].wrapping_sub(ua[k]), inv_len, dir[k]);
-        w23.clamp(-(W_LIMIT >> 6), (W_LIMIT >> 6) - 1) << (W_FRAC - DIR_FRAC)
+        w23.clamp(-W_LIMIT_23, W_LIMIT_23 - 1) << (W_FRAC - DIR_FRAC)
     });
-    // a = |w|² ≤ 12: each square is Q58, its high word Q26; the sum of the three high
-    // words is within 2 LSB (3e-8) of the high word of the sum, and costs the M0 no low
-    // words. (`opaque`: a plain 32-bit value from here, so that the products below stay
-    // single long multiplies.)
-    let a = q::mulhi(w[0], w[0]) + q::mulhi(w[1], w[1]) + q::mulhi(w[2], w[2]);
-    let a = q::opaque(a);
+    // a = |w|² ≤ 12: each square is Q60, its high word Q28 (≤ 2³⁰); the sum of the
+    // three high words (within 2 LSB, 7e-9, of the high word of the sum) fits a `u32`.
+    // (`opaque`: a plain 32-bit value from here, so that the products below stay single
+    // long multiplies.)
+    let a = (q::mulhi(w[0], w[0]) as u32)
+        .wrapping_add(q::mulhi(w[1], w[1]) as u32)
+        .wrapping_add(q::mulhi(w[2], w[2]) as u32);
+    let a = q::opaque(a as i32) as u32;
     let r0 = q::opaque(*r);
-    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r (3/2 − (a r) r / 2). `a r` ≤ 192 fits Q23
-    // (Q26 · Q24 >> 27); held at 8 (|w| ≤ 8/r when converged), which already drives the
-    // factor to its floor.
-    let ar = q::opaque(((q::mul_wide(a, r0) >> 27) as i32).clamp(0, (8 << 23) - 1));
-    // (a r) r / 2 in Q24: Q23 · Q24 = Q47 is a r², so Q48 is its half; ≤ 2³⁰, held
-    // below 1 (one `usat`), so that the factor 3/2 − a r²/2 stays in (1/2, 3/2]: a step
-    // from far above at most halves `r`.
-    let half_x = ((q::mul_wide(ar, r0) >> LEN_FRAC) as i32).clamp(0, ONE - 1);
-    let factor = q::opaque(3 * ONE / 2 - half_x);
-    // r' ≤ 3/2 r, held below 16. No floor is needed: |w| ≤ 2√3 keeps 1/|w| ≥ 0.29, and a
-    // step from above lands at ≥ r/2 > 1/(2|w|) ≥ 1/7.
-    let rn = q::opaque(((q::mul_wide(r0, factor) >> LEN_FRAC) as i32).clamp(0, R_MAX));
+    // Newton for 1/|w|: r ← r (3 − a r²)/2 = r + r g with g = (1 − a r²)/2. `a r`
+    // (Q28 · Q27, high word Q23, ≤ 96) held below 4, then Q28; `a r²` the high word of
+    // Q28 · Q27, Q23, held within [0, 2) (one `usat`), so that the factor 1 + g stays in
+    // (1/2, 3/2]: a step from far above at most halves `r`. g in Q32 is
+    // `2³¹ − 1 − (a r²) · 2⁸` (one `eor`: 2⁻³² below the exact half, a bias of 2e-10).
+    let ar = q::opaque((q::mulhi_u(a, r0 as u32) as i32).clamp(0, AR_LIMIT - 1) << (AR_Q - AR_FRAC));
+    let arr = q::mulhi(ar, r0).clamp(0, (2 << ARR_FRAC) - 1);
+    let g = q::opaque((arr << (32 - 1 - ARR_FRAC)) ^ i32::MAX);
+    // r' = r + r g (one `smmla`) ≤ 3/2 r < 12 (Q27: no overflow), held below 8. No floor
+    // is needed: |w| ≤ 2√3 keeps 1/|w| ≥ 0.29, and a step from above lands at
+    // ≥ r/2 > 1/(2|w|) ≥ 1/7.
+    let rn = q::opaque(q::mulhi_acc(r0, g, r0).clamp(0, R_MAX));
     *r = rn;
-    // |w| = a r' = (a r) · factor: Q23 · Q24 >> 23 → Q24, ≤ 12.
-    let stretch = (q::mul_wide(ar, factor) >> 23) as i32;
-    let strain = Strain::from_bits(ONE - stretch);
+    // |w| = a r' = (a r) + (a r) g: Q28, < 6 (one `smmla`); the strain 1 − |w| in Q24.
+    let stretch = q::mulhi_acc(ar, g, ar);
+    let strain = Strain::from_bits(((1 << AR_Q) - stretch) >> (AR_Q - LEN_FRAC));
     let f = table.force_within::<SPRING_FORCE_BITS>(strain);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
-    // −f r: Q20 · Q24 = Q44; Q23 is `>> 21`, held within ±256 N through the high word
-    // (the low bits of a held value are the product's own, below 2⁻¹² N).
-    let neg_fr = q::shr_held::<{ FORCE_FRAC + LEN_FRAC - FR_FRAC }, 31>(q::mul_wide(-f, rn));
+    // −f r: Q20 · Q27 = Q47, Q22 is `>> 25`: |f| ≤ 64 N and r < 8 keep it within
+    // ±512 N, which Q22 holds.
+    let neg_fr = (q::mul_wide(-f, rn) >> (FORCE_FRAC + R_FRAC - FR_FRAC)) as i32;
     // The velocities are read only now (no instruction: it keeps the compiler from
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
-    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q29 · Q23, both Q52, whose high words are
-    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| < 2²⁹: the sum fits). The two high words are
+    // C (v_b − v_a) + w (−f r): Q16 · Q36 and Q30 · Q22, both Q52, whose high words are
+    // Q20 N (|C (v_b − v_a)| < 2³⁰, |w f r| ≤ 2³⁰: the sum fits). The two high words are
     // rounded to nearest, so that their sum has no bias against the high word of the sum
     // (floors would pull every spring by −1 LSB): one `smmulr` and one `smmlar` on the
     // M3/M4, no 64-bit sum on the M0.

@@ -21,7 +21,7 @@ use crate::q::{self, V3};
 use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, VEL_LIMIT_MM_S};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
-use crate::units::{Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE};
+use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE};
 
 mod step;
 mod table;
@@ -54,8 +54,13 @@ impl Arith for Narrow {
     type TableAux = NarrowTable;
     type Coeffs = NarrowCoeffs;
     const REST: i32 = 0;
+    const MAX_RATIO: f64 = (R_MAX >> LEN_FRAC) as f64;
     /// `1/l0` is a 16-bit operand in Q15: 11 significant bits at 16 mm.
     const MAX_REST_LENGTH_MM: f64 = 16.0;
+
+    fn warm_of_ratio(r: f64) -> i32 {
+        from_f64(r - 1.0, LEN_FRAC).min(R_MAX - ONE - 1)
+    }
 
     fn table_aux<const S: usize>(table: &ForceTable<S>) -> NarrowTable {
         NarrowTable::new(table.raw())
