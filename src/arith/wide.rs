@@ -213,7 +213,8 @@ fn spring<const S: usize>(
     // Q28 · Q27, Q23, held within [0, 2) (one `usat`), so that the factor 1 + g stays in
     // (1/2, 3/2]: a step from far above at most halves `r`. g in Q32 is
     // `2³¹ − 1 − (a r²) · 2⁸` (one `eor`: 2⁻³² below the exact half, a bias of 2e-10).
-    let ar = q::opaque((q::mulhi_u(a, r0 as u32) as i32).clamp(0, AR_LIMIT - 1) << (AR_Q - AR_FRAC));
+    let ar =
+        q::opaque((q::mulhi_u(a, r0 as u32) as i32).clamp(0, AR_LIMIT - 1) << (AR_Q - AR_FRAC));
     let arr = q::mulhi(ar, r0).clamp(0, (2 << ARR_FRAC) - 1);
     let g = q::opaque((arr << (32 - 1 - ARR_FRAC)) ^ i32::MAX);
     // r' = r + r g (one `smmla`) ≤ 3/2 r < 12 (Q27: no overflow), held below 8. No floor
