@@ -25,7 +25,8 @@ pub struct Edge {
     pub a: u16,
     /// Second node (0 = ground: a spring to a fixed point has its fixed end here).
     pub b: u16,
-    /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q29.
+    /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q23
+    /// ([`crate::units::DIR_FRAC`]).
     pub dir: V3,
     /// `1 / l0` in 1/mm, Q31 (`l0 ≥ 1 mm`; 1 mm is stored as `i32::MAX`).
     pub inv_len: i32,

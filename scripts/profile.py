@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""Where a firmware's instructions go, per function, from QEMU's own execution log.
+
+    scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines]
+
+Builds the release firmware `bin` (default `haptic`) for the core, runs it in QEMU with
+the runner's `-icount` and `-d in_asm,exec,nochain` (every translated block once, every
+executed block each time), and prints the instructions executed per function, most
+first, with each one's share of the whole run; with `--lines`, per source line instead
+(the innermost inlined frame of each instruction, by `llvm-symbolizer`: what the code
+inlined into one function does). The counts are QEMU's translated
+instructions, the same measure as the bench's (no cycles). A long run logs a line per
+executed block: the log is read through a pipe, never stored (the haptic demo's 4000
+ticks take about a minute on this machine).
+"""
+import collections
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+
+TARGETS = {"m4f": "thumbv7em-none-eabihf", "m3": "thumbv7m-none-eabi", "m0": "thumbv6m-none-eabi"}
+MACHINES = {
+    "m4f": ["-machine", "netduinoplus2", "-icount", "shift=3,sleep=off"],
+    "m3": ["-machine", "lm3s6965evb", "-icount", "shift=5,sleep=off"],
+    "m0": ["-machine", "microbit", "-icount", "shift=5,sleep=off"],
+}
+
+
+def main():
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    top = 40
+    if "--top" in sys.argv:
+        top = int(sys.argv[sys.argv.index("--top") + 1])
+        args = [a for a in args if a != str(top)]
+    by_line = "--lines" in sys.argv
+    if not args or args[0] not in TARGETS:
+        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N]", file=sys.stderr)
+        sys.exit(2)
+    core, binary = args[0], (args[1] if len(args) > 1 else "haptic")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    target = TARGETS[core]
+    print(f"profile: building {binary} for {core}", file=sys.stderr)
+    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", "mccs-firmware",
+                    "--target", target, "--bin", binary], cwd=root, check=True)
+    elf = os.path.join(root, "target", target, "release", binary)
+    with tempfile.TemporaryDirectory() as d:
+        fifo = os.path.join(d, "qemu.log")
+        os.mkfifo(fifo)
+        cmd = ["qemu-system-arm", *MACHINES[core], "-display", "none", "-serial", "null",
+               "-monitor", "none", "-semihosting-config", "enable=on,target=native",
+               "-d", "in_asm,exec,nochain", "-D", fifo, "-kernel", elf]
+        print(f"profile: running it in QEMU, every executed block logged (a minute or so)",
+              file=sys.stderr)
+        qemu = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        sizes, names, addrs, runs = {}, {}, {}, collections.Counter()
+        trace = re.compile(r"^Trace \d+: 0x[0-9a-f]+ \[[0-9a-f]+/([0-9a-f]+)/")
+        with open(fifo) as log:
+            block, count, name = None, 0, "?"
+            for line in log:
+                if line.startswith("Trace"):
+                    m = trace.match(line)
+                    if m:
+                        runs[int(m.group(1), 16)] += 1
+                elif line.startswith("IN:"):
+                    name = line[3:].strip() or "?"
+                    block, count = None, 0
+                elif line.startswith("0x"):
+                    pc = int(line.split(":")[0], 16)
+                    if block is None:
+                        block, addrs[pc] = pc, []
+                    addrs[block].append(pc)
+                    count += 1
+                    sizes[block], names[block] = count, name
+        qemu.wait()
+    per = collections.Counter()
+    if by_line:
+        each = collections.Counter()
+        for pc, n in runs.items():
+            for a in addrs.get(pc, []):
+                each[a] += n
+        where = symbolize(elf, sorted(each))
+        for a, n in each.items():
+            per[where.get(a, f"0x{a:08x}")] += n
+    else:
+        for pc, n in runs.items():
+            per[names.get(pc, f"0x{pc:08x}")] += n * sizes.get(pc, 0)
+    total = sum(per.values())
+    print(f"PROFILE core={core} bin={binary} instructions={total}")
+    for name, n in per.most_common(top):
+        print(f"{n:>12} {100.0 * n / max(total, 1):6.2f} %  {demangle(name)}")
+
+
+def symbolize(elf, addresses):
+    """`file:line` of each address's innermost inlined frame (paths from `src/`)."""
+    out = subprocess.run(["llvm-symbolizer", "--obj", elf, "--inlining", "--no-demangle",
+                          "--output-style=JSON"],
+                         input="".join(f"0x{a:x}\n" for a in addresses), text=True,
+                         capture_output=True, check=True).stdout
+    import json
+    where = {}
+    for a, line in zip(addresses, out.splitlines()):
+        frames = json.loads(line).get("Symbol", [])
+        if frames:
+            f = frames[0]
+            path = f.get("FileName", "?")
+            # The crate's folder and the path in it: core/src/…, main/src/… (this repo).
+            i = path.rfind("/src/")
+            path = path[path.rfind("/", 0, i) + 1:] if i > 0 else os.path.basename(path)
+            where[a] = f"{path}:{f.get('Line', 0)}"
+    return where
+
+
+def demangle(name):
+    """The Rust path of a legacy-mangled symbol, without its hash."""
+    m = re.match(r"_ZN(.*)17h[0-9a-f]{16}E$", name)
+    if not m:
+        return name
+    out, s = [], m.group(1)
+    while s and s[0].isdigit():
+        n = int(re.match(r"\d+", s).group(0))
+        s = s[len(str(n)):]
+        out.append(s[:n])
+        s = s[n:]
+    return "::".join(out).replace("$LT$", "<").replace("$GT$", ">").replace("$u20$", " ") \
+        .replace("$C$", ",").replace("..", "::").replace("$RF$", "&").replace("_$", "$")
+
+
+if __name__ == "__main__":
+    main()
