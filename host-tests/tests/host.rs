@@ -12,6 +12,8 @@ mod arith;
 mod cap;
 #[path = "cli.rs"]
 mod cli;
+#[path = "contact.rs"]
+mod contact;
 #[path = "demo.rs"]
 mod demo;
 #[path = "device.rs"]

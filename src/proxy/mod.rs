@@ -213,7 +213,7 @@ impl Proxy {
     }
 
     /// The triangle holding grid point `g` (clamped to the patch) and its weights (Q16).
-    fn triangle(&self, g: [i32; 2]) -> ([(usize, usize); 3], [i32; 3]) {
+    pub(crate) fn triangle(&self, g: [i32; 2]) -> ([(usize, usize); 3], [i32; 3]) {
         let top = (self.n - 1) << G_FRAC;
         let (u, v) = (g[0].max(0).min(top), g[1].max(0).min(top));
         let (i, j) = ((u >> G_FRAC).min(self.n - 2), (v >> G_FRAC).min(self.n - 2));

@@ -218,13 +218,110 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     fn react(&mut self, proxy: &Proxy, f: V3, corners: [(usize, usize); 3], w: [i32; 3]) {
         let view = self.view(proxy);
         let nodes = corners.map(|(a, b)| view.node(a, b));
-        for (node, w) in nodes.into_iter().zip(w) {
+        let shares = reaction_shares(f, w);
+        for (node, share) in nodes.into_iter().zip(shares) {
             if let Some(n) = node.and_then(|i| self.nodes.get_mut(i)) {
                 for k in 0..3 {
-                    n.f[k] = n.f[k].saturating_sub(q::mul_weight(f[k], w));
+                    n.f[k] = n.f[k].saturating_sub(share[k]);
                 }
             }
         }
         self.coupling_force = f.map(i32::saturating_neg);
+    }
+}
+
+/// The corners' shares of a contact force `f` (Q20 N, within the device maximum) by
+/// weights `w` (Q16, summing to one): the last two by product ([`q::mul_weight`]), the
+/// first the rest, so that the three sum to `f` exactly (three rounded products could
+/// miss it by two units of the last place).
+#[inline(always)]
+pub(crate) fn reaction_shares(f: V3, w: [i32; 3]) -> [V3; 3] {
+    let s1 = f.map(|x| q::mul_weight(x, w[1]));
+    let s2 = f.map(|x| q::mul_weight(x, w[2]));
+    let s0 = core::array::from_fn(|k| f[k].saturating_sub(s1[k]).saturating_sub(s2[k]));
+    [s0, s1, s2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::reaction_shares;
+    use crate::{ForceTable64, Narrow, Params, ProxyConfig, Solver, SolverConfig, Topology};
+
+    /// A small linear congruential generator: the tests' forces.
+    fn lcg(state: &mut u64) -> i32 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*state >> 32) as i32
+    }
+
+    /// The three shares of any force (the whole `i32` range) by any weights summing to
+    /// one sum to the force exactly.
+    #[test]
+    fn the_shares_sum_to_the_force_exactly() {
+        let mut state = 7;
+        let edges = [i32::MIN, i32::MIN + 1, -1, 0, 1, i32::MAX - 1, i32::MAX];
+        for t in 0..200_000 {
+            let f = if t < 49 {
+                [edges[t % 7], edges[t / 7], 12345]
+            } else {
+                [lcg(&mut state), lcg(&mut state) >> 8, lcg(&mut state) >> 20]
+            };
+            let a = (lcg(&mut state) as u32 >> 15) as i32; // 0 … 2¹⁷
+            let (w1, w2) = (a.min(1 << 16), (lcg(&mut state) as u32 >> 16) as i32);
+            let w2 = w2.min((1 << 16) - w1);
+            let w = [(1 << 16) - w1 - w2, w1, w2];
+            let s = reaction_shares(f, w);
+            for k in 0..3 {
+                let sum = s[0][k] as i64 + s[1][k] as i64 + s[2][k] as i64;
+                assert_eq!(sum, f[k] as i64, "f {f:?} w {w:?}: shares {s:?}");
+            }
+        }
+    }
+
+    /// Through the solver: a contact force on an inner triangle (every corner free), at
+    /// grid points across a cell, its edges and its corners, leaves minus itself on the
+    /// nodes, to the bit.
+    #[test]
+    fn the_node_forces_of_a_contact_sum_to_minus_its_force() {
+        let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
+        let table = ForceTable64::new(&Params::TABLE2).unwrap();
+        let config = SolverConfig::default();
+        let mut s = Solver::<10, 61, 64, Narrow>::with_arith(topo, table, &config, Narrow).unwrap();
+        let proxy = s
+            .proxy(&ProxyConfig {
+                grid: 5,
+                spacing: 2.5,
+                mu_s: 0.6,
+                mu_k: 0.4,
+                probe_radius: 0.0,
+            })
+            .unwrap();
+        let mut state = 11;
+        let limit = (config.coupling.max_force * (1 << 20) as f64) as i32;
+        // Grid points (Q16) over the inner cells, every 1/64 spacing (on their edges and
+        // corners too) plus a random fraction.
+        for a in 64..192 {
+            for b in 64..192 {
+                let jitter =
+                    |s: &mut u64| (lcg(s) as u32 >> 22) as i32 & if a % 7 == 0 { 0 } else { 1023 };
+                let g = [
+                    (a << 10) + jitter(&mut state),
+                    (b << 10) + jitter(&mut state),
+                ];
+                let (corners, w) = proxy.triangle(g);
+                let f = [0; 3].map(|_| lcg(&mut state) % limit);
+                s.nodes.iter_mut().for_each(|n| n.f = [0; 3]);
+                s.react(&proxy, f, corners, w);
+                let free = corners
+                    .iter()
+                    .filter(|&&(i, j)| (1..4).contains(&i) && (1..4).contains(&j));
+                assert_eq!(free.count(), 3, "{g:?}: {corners:?}");
+                for k in 0..3 {
+                    let sum: i64 = s.nodes.iter().map(|n| n.f[k] as i64).sum();
+                    assert_eq!(sum, -(f[k] as i64), "{g:?} {w:?}: axis {k}");
+                }
+            }
+        }
     }
 }
