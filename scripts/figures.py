@@ -57,19 +57,25 @@ def figures() -> dict:
 
 # Instruction counts come from SysTick under -icount, calibrated and averaged: a count
 # can move by one between runs of the same binary. Those figures match within one count
-# or 0.2 %; every other figure to the character.
+# or 0.2 %. A firmware's size depends on where it was built: the paths of the checkout
+# and of CARGO_HOME end up in it (panic locations), so a fresh clone elsewhere measured
+# 24 to 72 bytes more than the committed figures; sizes match within 0.5 %. Every other
+# figure to the character.
 JITTER = ("BENCH.", "FIT.", "BUDGET.", "RATIO.")
+PATH_DEPENDENT = ("SIZE.",)
 
 
 def same(key: str, doc: str, printed: str) -> bool:
     if doc == printed:
         return True
-    if not key.startswith(JITTER):
+    if not key.startswith(JITTER + PATH_DEPENDENT):
         return False
     try:
         a, b = float(doc), float(printed)
     except ValueError:
         return False
+    if key.startswith(PATH_DEPENDENT):
+        return abs(a - b) <= 0.005 * abs(b)
     return abs(a - b) <= max(1.0, 0.002 * abs(b))
 
 

@@ -96,6 +96,9 @@ def main():
 
 def symbolize(elf, addresses):
     """`file:line` of each address's innermost inlined frame (paths from `src/`)."""
+    import shutil
+    if shutil.which("llvm-symbolizer") is None:
+        sys.exit("profile: --lines needs llvm-symbolizer (Debian: apt-get install llvm)")
     out = subprocess.run(["llvm-symbolizer", "--obj", elf, "--inlining", "--no-demangle",
                           "--output-style=JSON"],
                          input="".join(f"0x{a:x}\n" for a in addresses), text=True,

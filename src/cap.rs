@@ -13,7 +13,7 @@
 //! are within `2e-8 R` of the sphere (the reciprocal square root's error; tested against
 //! `f64` over whole tissues).
 
-use crate::q::{mul_wide, mulhi_u, narrow, rsqrt, sat, V3};
+use crate::q::{mul_wide, mul_wide_u, mulhi_u, narrow, rsqrt, sat, V3};
 use crate::units::from_f64;
 
 /// Fraction bits of a direction.
@@ -81,9 +81,16 @@ impl Cap {
     /// `q = ρ²/R² ≤ 9/16`, `√(1 − q) = (1 − q) / √(1 − q)` in Q30.
     pub(crate) fn height(&self, i: i32, j: i32) -> i32 {
         // |2i − W + 1| ≤ 127: the squares fit i32.
-        let sq = |d: i32| d.wrapping_mul(d) as u32 as u64;
-        let m = sq(2 * i - self.w + 1) + sq(2 * j - self.h + 1);
-        let q = m.saturating_mul(self.k).min(1 << 62);
+        let sq = |d: i32| d.wrapping_mul(d) as u32;
+        let m = sq(2 * i - self.w + 1).saturating_add(sq(2 * j - self.h + 1));
+        // m k (m < 2¹⁵) held at 2⁶² by two 32 × 32 products (no 64-bit library product
+        // on the M0): the high word's part alone reaches 2⁶² once it is 2³⁰.
+        let hi = mul_wide_u(m, (self.k >> 32) as u32);
+        let q = if hi >= 1 << 30 {
+            1 << 62
+        } else {
+            ((hi << 32) + mul_wide_u(m, self.k as u32)).min(1 << 62)
+        };
         // 1 − q in Q62, at least 7/16 of one for a node of the tissue (R ≥ 4/3 of its
         // half-diagonal): its leading zeros are 1 … 3, so rsqrt's e is 0 or 2.
         let x = ((1u64 << 62) - q).max(1 << 60);

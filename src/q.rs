@@ -139,6 +139,20 @@ pub fn mulhi_u_split(a: u32, b: u32) -> u32 {
         .wrapping_add(n >> 16)
 }
 
+/// The full unsigned product `a · b`: one `umull` with a long multiply; on the M0 the
+/// high word from [`mulhi_u_split`] and the low word from one 32-bit multiply (the same
+/// bits, without the `__aeabi_lmul` call).
+#[inline(always)]
+pub fn mul_wide_u(a: u32, b: u32) -> u64 {
+    long_or_split!(mul_wide_u_split(a, b), a as u64 * b as u64)
+}
+
+/// [`mul_wide_u`] from [`mulhi_u_split`] and the low word, exact.
+#[inline(always)]
+pub fn mul_wide_u_split(a: u32, b: u32) -> u64 {
+    ((mulhi_u_split(a, b) as u64) << 32) | a.wrapping_mul(b) as u64
+}
+
 /// `⌊a · t / 2¹⁶⌋` for `t ∈ [0, 2¹⁵)`: a product by a Q15 fraction that comes out halved
 /// (callers scale their coefficients for it). One `smull` against `t · 2¹⁶` with a long
 /// multiply, else [`mul_t_split`]; the same bits. Larger `t` are masked to 15 bits.
@@ -258,10 +272,7 @@ const RSQRT_GUESS: [u16; RSQRT_CELLS] = {
 /// the steps' rounding). Each product is a high word of 32 × 32 bits ([`mulhi_u`]: one
 /// `umull`, or four 16-bit products on the M0): six in all.
 pub(crate) fn rsqrt(x: i64) -> (u32, u32) {
-    let x = x.max(1) as u64;
-    let e = x.leading_zeros() & !1;
-    // m ∈ [2^62, 2^64): M = m / 2^64 ∈ [¼, 1), here in Q30 (m30 ∈ [2^28, 2^30)).
-    let m30 = ((x << e) >> 34) as u32;
+    let (m30, e) = normalise(x.max(1) as u64);
     // The guess's interval: M's bits below ¼ in steps of 2⁻⁸ (0 … 191).
     let cell = ((m30 >> 22) as usize).saturating_sub(64);
     let guess = RSQRT_GUESS.get(cell).copied().unwrap_or(0);
@@ -274,6 +285,25 @@ pub(crate) fn rsqrt(x: i64) -> (u32, u32) {
         y = mulhi_u(y, (3u32 << 30) - my2) << 1;
     }
     (y, e)
+}
+
+/// `x > 0` normalised by an even shift `e`: `m = x 2^e ∈ [2^62, 2^64)`, so that
+/// `M = m / 2^64 ∈ [¼, 1)`, returned in Q30 (`m30 ∈ [2^28, 2^30)`) with `e`. By 32-bit
+/// halves: the Cortex-M0 has no `clz` (each is a library call) and no 64-bit shift (one
+/// more), so that a 64-bit `leading_zeros` took two calls and the shift a third. The
+/// same bits as `((x << e) >> 34, leading_zeros(x) & !1)` (tested).
+#[inline(always)]
+pub(crate) fn normalise(x: u64) -> (u32, u32) {
+    let (hi, lo) = ((x >> 32) as u32, x as u32);
+    if hi != 0 {
+        let e = hi.leading_zeros() & !1;
+        // The top word of x 2^e: hi's bits, then lo's top e (none when e = 0).
+        let top = if e == 0 { hi } else { hi << e | lo >> (32 - e) };
+        (top >> 2, e)
+    } else {
+        let e = 32 + (lo.leading_zeros() & !1);
+        ((lo << (e - 32)) >> 2, e)
+    }
 }
 
 /// `x`, through an empty `asm!` block: no instruction, but the optimiser cannot see what

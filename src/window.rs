@@ -124,7 +124,7 @@ impl<const EDGES: usize, const CAP: bool> Window<EDGES, CAP> {
         let c = self.centre();
         // (i − (W − 1)/2) s = (2i − W + 1) s / 2, exact for an odd raw spacing too.
         let at = |i: usize, w: i32| {
-            crate::q::sat(((2 * i as i32 - w + 1) as i64 * self.spacing as i64) >> 1)
+            crate::q::sat(crate::q::mul_wide(2 * i as i32 - w + 1, self.spacing) >> 1)
         };
         [at(c.0, self.w), at(c.1, self.h)]
     }

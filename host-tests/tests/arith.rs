@@ -5,7 +5,8 @@
 
 use mccs::q::{
     mul_s, mul_s_by, mul_s_by_split, mul_s_split, mul_t, mul_t_split, mul_wide, mul_wide_split,
-    mulhi, mulhi_round, mulhi_round_split, mulhi_split, mulhi_u, mulhi_u_split,
+    mul_wide_u, mul_wide_u_split, mulhi, mulhi_round, mulhi_round_split, mulhi_split, mulhi_u,
+    mulhi_u_split,
 };
 use proptest::prelude::*;
 
@@ -45,6 +46,8 @@ fn split_products_match_at_the_edges() {
                 ((ua as u64 * ub as u64) >> 32) as u32
             );
             assert_eq!(mulhi_u(ua, ub), mulhi_u_split(ua, ub));
+            assert_eq!(mul_wide_u_split(ua, ub), ua as u64 * ub as u64);
+            assert_eq!(mul_wide_u(ua, ub), ua as u64 * ub as u64);
             for t in [0u32, 1, 0x4000, 0x7FFE, 0x7FFF] {
                 let want = ((a as i64 * t as i64) >> 16) as i32;
                 assert_eq!(mul_t_split(a, t), want, "{a} {t}");
@@ -143,6 +146,8 @@ proptest! {
         prop_assert_eq!(mulhi_round(a, b), round);
         let (ua, ub) = (a as u32, b as u32);
         prop_assert_eq!(mulhi_u_split(ua, ub), ((ua as u64 * ub as u64) >> 32) as u32);
+        prop_assert_eq!(mul_wide_u_split(ua, ub), ua as u64 * ub as u64);
+        prop_assert_eq!(mul_wide_u(ua, ub), ua as u64 * ub as u64);
         prop_assert_eq!(mul_t_split(a, t), ((a as i64 * t as i64) >> 16) as i32);
         prop_assert_eq!(mul_t(a, t), mul_t_split(a, t));
     }

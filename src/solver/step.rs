@@ -21,7 +21,20 @@ enum Drive {
 /// at `tick_hz`, saturating.
 pub(super) fn tick_velocity(from: V3, to: V3, tick_hz: i32) -> V3 {
     const SH: u32 = crate::units::LEN_FRAC - VEL_FRAC;
-    core::array::from_fn(|i| q::sat(((to[i] as i64 - from[i] as i64) * tick_hz as i64) >> SH))
+    core::array::from_fn(|i| {
+        // `to − from` in 33 bits: the wrapped difference, and ±2³² when it wrapped; its
+        // product by `tick_hz` by one 32 × 32 product (no 64-bit library product on the
+        // M0) and the correction in the high word, exact.
+        let (d, wrapped) = to[i].overflowing_sub(from[i]);
+        let carry = if !wrapped {
+            0
+        } else if d < 0 {
+            tick_hz as i64
+        } else {
+            -(tick_hz as i64)
+        };
+        q::sat((q::mul_wide(d, tick_hz) + (carry << 32)) >> SH)
+    })
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
@@ -121,5 +134,43 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// A velocity (Q16 mm/s, within the limit) as the nodes store it.
     pub(super) fn stored_velocity(&self, v: i32) -> i32 {
         A::store_velocity(&self.c.arith, v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_velocity;
+
+    /// The velocity of a tick against the 64-bit formula, saturated to `i32`, for every
+    /// pair of extreme positions (a difference that wraps `i32` either way) and rates
+    /// from 1 Hz to 100 kHz.
+    #[test]
+    fn tick_velocity_matches_the_64_bit_product() {
+        let xs = [
+            i32::MIN,
+            i32::MIN + 1,
+            -(1 << 30),
+            -123_456_789,
+            -1,
+            0,
+            1,
+            987_654_321,
+            1 << 30,
+            i32::MAX - 1,
+            i32::MAX,
+        ];
+        for hz in [1, 7, 255, 256, 1000, 4096, 100_000] {
+            for &a in &xs {
+                for &b in &xs {
+                    let want = ((b as i64 - a as i64) * hz as i64) >> 8;
+                    let want = want.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                    let got = tick_velocity([a, b, 0], [b, a, a], hz);
+                    let back = ((a as i64 - b as i64) * hz as i64) >> 8;
+                    let back = back.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                    assert_eq!(got[0], want, "{a} -> {b} at {hz} Hz");
+                    assert_eq!(got[1], back, "{b} -> {a} at {hz} Hz");
+                }
+            }
+        }
     }
 }
