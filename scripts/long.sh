@@ -50,7 +50,7 @@ echo "PROPERTY case=cap_paths cases=$caps result=ok"
 echo "long.sh: the force-table bound over 10^5 random springs (about an hour; its progress every 10 s)" >&2
 # The log keeps everything; the progress lines also go to the terminal.
 TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test host \
-    -- --show-output table_bound::every_table 2>&1 | tee target/logs/long/table_bound.log \
+    -- --nocapture table_bound::every_table 2>&1 | tee target/logs/long/table_bound.log \
     | { grep --line-buffered "^table_bound:" >&2 || true; } \
   || { echo "long.sh: the table bound failed; see target/logs/long/table_bound.log" >&2; exit 1; }
 grep -E "^TABLEBOUND " target/logs/long/table_bound.log
