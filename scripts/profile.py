@@ -14,8 +14,10 @@ executed block: the log is read through a pipe, never stored (the haptic demo's 
 ticks take about a minute on this machine).
 """
 import collections
+import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -37,7 +39,7 @@ def main():
         args = [a for a in args if a != str(top)]
     by_line = "--lines" in sys.argv
     if not args or args[0] not in TARGETS:
-        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N]", file=sys.stderr)
+        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines]", file=sys.stderr)
         sys.exit(2)
     core, binary = args[0], (args[1] if len(args) > 1 else "haptic")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -96,14 +98,12 @@ def main():
 
 def symbolize(elf, addresses):
     """`file:line` of each address's innermost inlined frame (paths from `src/`)."""
-    import shutil
     if shutil.which("llvm-symbolizer") is None:
         sys.exit("profile: --lines needs llvm-symbolizer (Debian: apt-get install llvm)")
     out = subprocess.run(["llvm-symbolizer", "--obj", elf, "--inlining", "--no-demangle",
                           "--output-style=JSON"],
                          input="".join(f"0x{a:x}\n" for a in addresses), text=True,
                          capture_output=True, check=True).stdout
-    import json
     where = {}
     for a, line in zip(addresses, out.splitlines()):
         frames = json.loads(line).get("Symbol", [])

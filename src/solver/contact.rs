@@ -244,8 +244,9 @@ pub(crate) fn reaction_shares(f: V3, w: [i32; 3]) -> [V3; 3] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_patch::patch_and_proxy;
     use super::reaction_shares;
-    use crate::{ForceTable64, Narrow, Params, ProxyConfig, Solver, SolverConfig, Topology};
+    use crate::{SolverConfig, Topology};
 
     /// A small linear congruential generator: the tests' forces.
     fn lcg(state: &mut u64) -> i32 {
@@ -285,20 +286,9 @@ mod tests {
     #[test]
     fn the_node_forces_of_a_contact_sum_to_minus_its_force() {
         let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
-        let table = ForceTable64::new(&Params::TABLE2).unwrap();
-        let config = SolverConfig::default();
-        let mut s = Solver::<10, 61, 64, Narrow>::with_arith(topo, table, &config, Narrow).unwrap();
-        let proxy = s
-            .proxy(&ProxyConfig {
-                grid: 5,
-                spacing: 2.5,
-                mu_s: 0.6,
-                mu_k: 0.4,
-                probe_radius: 0.0,
-            })
-            .unwrap();
+        let (mut s, proxy) = patch_and_proxy(topo);
         let mut state = 11;
-        let limit = (config.coupling.max_force * (1 << 20) as f64) as i32;
+        let limit = (SolverConfig::default().coupling.max_force * (1 << 20) as f64) as i32;
         // Grid points (Q16) over the inner cells, every 1/64 spacing (on their edges and
         // corners too) plus a random fraction.
         for a in 64..192 {

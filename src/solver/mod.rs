@@ -40,6 +40,8 @@ mod param_set;
 mod roaming;
 pub mod stability;
 mod step;
+#[cfg(test)]
+mod test_patch;
 
 pub use config::{ConfigKey, SolverConfig};
 pub use error::SolverError;

@@ -486,26 +486,11 @@ fn round_shr(x: i64, sh: u32) -> i64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_patch::patch_and_proxy;
     use super::DIRECTIONS;
     use crate::window::{FLIP, NONE};
     use crate::ProxyError;
-    use crate::{Arith, DefaultArith, ForceTable64, Params, ProxyConfig, Solver, SolverConfig};
-    use crate::{Topology, WindowConfig};
-
-    /// A Table 2 solver on `topo` (N = 5 at 2.5 mm) and a frictionless point proxy.
-    fn patch_and_proxy(topo: Topology<10, 61>) -> (Solver<10, 61, 64>, crate::Proxy) {
-        let table = ForceTable64::new(&Params::TABLE2).unwrap();
-        let s = Solver::<10, 61, 64>::new(topo, table, &SolverConfig::default()).unwrap();
-        let config = ProxyConfig {
-            grid: 5,
-            spacing: 2.5,
-            mu_s: 0.0,
-            mu_k: 0.0,
-            probe_radius: 0.0,
-        };
-        let proxy = s.proxy(&config).unwrap();
-        (s, proxy)
-    }
+    use crate::{Arith, DefaultArith, Topology, WindowConfig};
 
     /// A cap's window moves its springs' geometry in place, which needs every spring's
     /// source on one side of it per direction (the standard patch's cell-by-cell order):
