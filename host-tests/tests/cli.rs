@@ -487,6 +487,35 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             assert!(err.contains(part), "{part}: {err}");
         }
     }
+    // A spring 1,000 times weaker than Table 2: half an LSB of the output formats is over
+    // the bound, and the refusal says that no knot count or domain helps.
+    let weak = TABLE2
+        .replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e2")
+        .replace("shear_modulus = 4.9151e5", "shear_modulus = 4.9151e2");
+    let weak_file = temp_file("weak.toml", &weak);
+    let out = mccs(&[
+        "table",
+        "--params",
+        weak_file.to_str().unwrap(),
+        "--knots",
+        "129",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for part in [
+        "weak.toml",
+        "misses the bound",
+        "the fixed-point formats cannot hold this spring",
+        "no knot count or domain meets it",
+        "--accept-error",
+    ] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    assert!(
+        !err.contains("more knots") && !err.contains("narrower"),
+        "{err}"
+    );
     let out = mccs(&[
         "table",
         "--params",

@@ -81,6 +81,24 @@ fn ppb(x: f64) -> u32 {
     }
 }
 
+/// The least error the output formats allow a table of `law` over `[from, to]`, in the
+/// terms of [`measure`]: half a Q20 force LSB relative to `F(to)`, and half a Q16
+/// stiffness LSB relative to the law's least stiffness on the domain (sampled at 1,001
+/// strains). No placement of knots can bring a table's largest errors below these: a
+/// bound below them is out of the formats' reach.
+pub fn format_floor(law: &Law, from: f64, to: f64) -> TableBound {
+    let half_lsb = |frac: u32| 0.5 / (1u64 << frac) as f64;
+    let mut least = f64::INFINITY;
+    for i in 0..=1000 {
+        let (_, k) = law.force_and_stiffness(from + (to - from) * i as f64 / 1000.0);
+        least = libm::fmin(least, k);
+    }
+    TableBound {
+        force: half_lsb(FORCE_FRAC) / libm::fabs(law.force(to)),
+        stiffness: half_lsb(STIFF_FRAC) / least,
+    }
+}
+
 /// Measures `table` against `law` over `[from, to]` (see the module docs).
 pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: f64) -> TableBound {
     let scale = libm::fabs(law.force(to));

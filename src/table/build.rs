@@ -33,7 +33,7 @@ impl<const S: usize> ForceTable<S> {
         bound: &TableBound,
     ) -> Result<Self, TableError> {
         let law = Law::new(params)?;
-        let t = Self::from_law(&law, from, to)?.measured(&law, from, to);
+        let t = Self::from_law_best(&law, from, to)?;
         if t.max_error().is_some_and(|e| e.within(bound)) {
             Ok(t)
         } else {
@@ -55,8 +55,55 @@ impl<const S: usize> ForceTable<S> {
         self
     }
 
+    /// Builds the table for `law` over `[from, to]` on each grid placement the builder
+    /// knows (a knot on the inner corner `Δ(max(F_T, P))` or not, and where the grid then
+    /// ends against the solid point), measures each ([`measure`]), and keeps the one
+    /// with the least error relative to [`TableBound::PRODUCT`] (the larger of its two
+    /// ratios), measured. No placement is best for every spring: the knot on the corner
+    /// lengthens the step, and the grid may then end past `Δ(F_C)` with the solid
+    /// point's corner inside its last segment. Up to four builds and measurements: what
+    /// `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
+    #[inline(never)]
+    pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
+        let mut best: Option<(f64, Self)> = None;
+        let mut first_err = None;
+        // Without an inner corner inside the table every placement is the same grid
+        // (the same table: its range and index say where every knot is): each distinct
+        // one is measured once.
+        let mut tried = [None; 4];
+        for (n, align) in [Align::Shortest, Align::NearSolid, Align::Off, Align::Plain]
+            .into_iter()
+            .enumerate()
+        {
+            match Self::on_grid(law, from, to, align) {
+                Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
+                Ok(t) => {
+                    tried[n] = Some(grid_of(&t.raw));
+                    let t = t.measured(law, from, to);
+                    let e = t.max_error().map_or(f64::INFINITY, |e| {
+                        libm::fmax(
+                            e.force / TableBound::PRODUCT.force,
+                            e.stiffness / TableBound::PRODUCT.stiffness,
+                        )
+                    });
+                    if best.as_ref().is_none_or(|(b, _)| e < *b) {
+                        best = Some((e, t));
+                    }
+                }
+                Err(e) => {
+                    first_err.get_or_insert(e);
+                }
+            }
+        }
+        match (best, first_err) {
+            (Some((_, t)), _) => Ok(t),
+            (None, Some(e)) => Err(e),
+            (None, None) => Err(TableError::OutOfRange),
+        }
+    }
+
     /// Builds the table for an already derived law (not measured: see
-    /// [`ForceTable::measured`]).
+    /// [`ForceTable::measured`]; [`ForceTable::from_law_best`] tries every placement).
     #[inline(never)]
     pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         // A grid aligned on both Δ(F_T) and Δ(P) has a longer step, and its last knot may
@@ -114,6 +161,8 @@ enum Align {
     NearSolid,
     /// Not aligned: a knot on `Δ(P)` only.
     Off,
+    /// No knot on the inner corner: the grid uniform from the table's start to its end.
+    Plain,
 }
 
 /// Where the knots are: `lo + i · step`, `i = 0 … S`, with the grid's index in the
@@ -175,12 +224,20 @@ impl Grid {
         // `S` segments in use. Otherwise the first knot moves down (into the exact linear
         // phase, or below the domain) by less than a segment, and the step grows only if
         // the table would otherwise end short of `hi`.
-        let e_p = law.delta(law.preload);
+        // A preload below F_T puts the cone's own transition Δ(F_T) inside instead, above
+        // the slope kink Δ(P) where the table starts: a jump in curvature only. The
+        // grid is aligned on both as above, but anchored on the table's start (a slope
+        // kink, which the first knot must not leave), so that the knot near Δ(F_T) lies
+        // within the narrowed step's drift of it and is an ordinary knot; no aligned
+        // grid, no knot on it (moving the first knot below Δ(P) would cost more).
+        let kink_force = inner_corner(law);
+        let slope_kink = law.preload > law.f_t;
+        let e_p = law.delta(kink_force);
         let mut kink_knot = None;
         let mut lo_grid = lo;
         let mut width = hi - lo;
         let mut aligned = false;
-        if law.preload > law.f_t && e_p > lo && e_p < hi {
+        if align != Align::Plain && kink_force > law.first_kink() && e_p > lo && e_p < hi {
             let most = libm::floor(S as f64 * (e_p - lo) / (hi - lo));
             if align != Align::Off && most >= 1.0 {
                 let fit = if at_solid && align == Align::NearSolid {
@@ -191,7 +248,7 @@ impl Grid {
                 width = S as f64 * (e_p - lo) / fit;
                 kink_knot = Some(fit as usize);
                 aligned = true;
-            } else {
+            } else if slope_kink {
                 let mut step = width / S as f64;
                 let j = libm::ceil((e_p - lo) / step);
                 if j < S as f64 {
@@ -230,7 +287,10 @@ impl Grid {
         // cut, up to 6e-5 of it): with a kink, the first knot is placed from this step so
         // that the kink's knot stays on Δ(P), to a strain LSB (the table still reaches
         // `hi`: the step only grew).
-        let first = kink_knot.map_or(lo_grid, |j| e_p - j as f64 * step);
+        let first = match kink_knot {
+            Some(j) if slope_kink => e_p - j as f64 * step,
+            _ => lo_grid,
+        };
         let strain_lo = checked_from_f64(first, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         let lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
         // The segments in use: all of them, unless the grid was aligned on Δ(F_T) and
@@ -251,7 +311,7 @@ impl Grid {
         Ok(Self {
             at_kink,
             at_solid,
-            kink_knot,
+            kink_knot: kink_knot.filter(|_| slope_kink),
             grid_moved,
             used,
             lo,
@@ -268,7 +328,20 @@ impl Grid {
     fn knot(&self, law: &Law, i: usize) -> Result<Knot, TableError> {
         let unit = (1u64 << FORCE_FRAC) as f64;
         let e = self.lo + i as f64 * self.step;
-        let f = law.force(e);
+        // A knot on a kink takes the law's value at the kink itself, not at its strain
+        // rounded to Q24: the two segments meeting there are each one side's smooth
+        // curve, and on the steep side half an LSB of strain is a force that, against a
+        // soft side's rise over a segment, bends that side's cubic (a stiffness error of
+        // 2e-3 over the segment above `Δ(P)` when `k_p ≪ k`). The same for the first knot
+        // when it sits on the first kink (an aligned grid's may lie well below it).
+        let lsb = 1.0 / (1u64 << STRAIN_FRAC) as f64;
+        let f = if self.kink_knot == Some(i) {
+            law.preload
+        } else if i == 0 && self.at_kink && libm::fabs(e - law.strain_t()) <= lsb {
+            law.first_kink()
+        } else {
+            law.force(e)
+        };
         // At a kink, the one-sided slopes at the kink itself (the knot's strain is
         // rounded, and may sit a hair to either side). The first knot's segment lies
         // above the kink it starts at.
@@ -479,6 +552,21 @@ fn aligned_on_solid(to_kink: f64, span: f64, most: f64) -> f64 {
         j -= 1.0;
     }
     best
+}
+
+/// Where a table's knots are: its range and index.
+fn grid_of<const S: usize>(r: &RawTable<S>) -> (i32, i32, u32, u32) {
+    (r.strain_lo, r.strain_hi, r.index_pre, r.index_scale)
+}
+
+/// The force at the law's inner corner, the second of its two changes of phase above the
+/// line `k ε`: `max(F_T, P)`. With a preload above `F_T` it is the slope kink `Δ(P)`,
+/// where the series spring starts to move; with one below, the cone's own transition
+/// `Δ(F_T)`, a jump in curvature (the stiffness starts to climb) that a cubic across it
+/// follows only to second order (a stiffness error of 4e-3 measured on a segment over
+/// it). With no preload (`P = F_T`) there is none: it is the first kink itself.
+fn inner_corner(law: &Law) -> f64 {
+    libm::fmax(law.f_t, law.preload)
 }
 
 /// `x` with all but its 15 most significant bits cleared.

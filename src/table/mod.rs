@@ -7,11 +7,13 @@
 //! uniform in strain with `S` segments (`S + 1` knots). Below it the law is the exact line
 //! of slope `k`; above `Δ(F_C)` the exact line of slope `k_p`. Where the domain cuts the
 //! curved part short, the line beyond the domain edge is the tangent there (an
-//! under-estimate of the stiffening law above the edge). With a preload above `F_T` the
-//! grid is placed so that knots sit on the slope kink `Δ(P)` and, where `Δ(P)` is at
-//! least a segment above it, on the cone's own transition `Δ(F_T)` too (the step then
-//! grows a little, and the range may end before the last segment:
-//! [`ForceTable::segments_used`]).
+//! under-estimate of the stiffening law above the edge). With a preload, the grid is
+//! placed so that a knot sits on the law's inner corner `Δ(max(F_T, P))` (the slope kink
+//! `Δ(P)` for a preload above `F_T`, the cone's own transition `Δ(F_T)` for one below)
+//! and, where that is at least a segment above it, on the table's start too (the step
+//! then grows a little, and the range may end before the last segment:
+//! [`ForceTable::segments_used`]). [`ForceTable::from_law_best`] builds each placement
+//! and keeps the one with the least measured error.
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
@@ -55,7 +57,7 @@ mod bound;
 mod build;
 mod error;
 
-pub use bound::{measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
+pub use bound::{format_floor, measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
 pub use error::TableError;
 
 /// The default strain domain `[ε_min, ε_max]`.

@@ -49,18 +49,26 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         );
         if !reached.within(&bound) && !a.accept_error {
             let law = mccs::Law::new(&p).map_err(|e| file_error(&a.params, e))?;
+            let floor = mccs::table::format_floor(&law, from, to);
+            let advice = if !floor.within(&bound) {
+                // No knots or domain help: say so, not "more knots".
+                format!(
+                    "the fixed-point formats cannot hold this spring to it (half an output LSB is {:.1e} of F({to:?}) and {:.1e} of its least stiffness): no knot count or domain meets it; emit it anyway with --accept-error",
+                    floor.force, floor.stiffness
+                )
+            } else if knots < 129 {
+                "use more knots (--knots 129) or a narrower domain (--from/--to), or emit it anyway with --accept-error".to_string()
+            } else {
+                "use a narrower domain (--from/--to), or emit it anyway with --accept-error"
+                    .to_string()
+            };
             return Err(file_error(
                 &a.params,
                 format!(
-                    "the {knots}-knot table misses the bound ({promise}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e} (k_p/k = {:.2e}); use {}, or emit it anyway with --accept-error",
+                    "the {knots}-knot table misses the bound ({promise}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e} (k_p/k = {:.2e}); {advice}",
                     reached.force,
                     reached.stiffness,
                     law.k_p / law.k,
-                    if knots < 129 {
-                        "more knots (--knots 129) or a narrower domain (--from/--to)"
-                    } else {
-                        "a narrower domain (--from/--to)"
-                    }
                 ),
             ));
         }
@@ -150,29 +158,27 @@ pub(super) fn table<const S: usize>(
         return Err(arg_error("--to", "must be > --from"));
     }
     let law = mccs::Law::new(p).map_err(|e| file_error(file, e))?;
-    ForceTable::<S>::from_law(&law, from, to)
-        .map(|t| t.measured(&law, from, to))
-        .map_err(|e| match e {
-            TableError::NoNonlinearPhase if to <= law.strain_t() => arg_error(
-                "--to",
-                &format!(
-                    "must exceed {:.6}, where this spring's law stops being linear",
-                    law.strain_t()
-                ),
+    ForceTable::<S>::from_law_best(&law, from, to).map_err(|e| match e {
+        TableError::NoNonlinearPhase if to <= law.strain_t() => arg_error(
+            "--to",
+            &format!(
+                "must exceed {:.6}, where this spring's law stops being linear",
+                law.strain_t()
             ),
-            TableError::NoNonlinearPhase => arg_error(
-                "--from",
-                &format!(
-                    "must be below {:.6}, where this spring's cone is solid",
-                    law.strain_c()
-                ),
+        ),
+        TableError::NoNonlinearPhase => arg_error(
+            "--from",
+            &format!(
+                "must be below {:.6}, where this spring's cone is solid",
+                law.strain_c()
             ),
-            TableError::TooNarrow => arg_error(
-                "--from/--to",
-                "the nonlinear phase inside them is too narrow for this many knots",
-            ),
-            other => file_error(file, other),
-        })
+        ),
+        TableError::TooNarrow => arg_error(
+            "--from/--to",
+            "the nonlinear phase inside them is too narrow for this many knots",
+        ),
+        other => file_error(file, other),
+    })
 }
 
 /// The table the solvers run: 65 knots over the default domain. Its errors name the
@@ -185,6 +191,7 @@ pub(super) fn solver_table(p: &Params, file: &Path) -> Result<mccs::ForceTable64
 fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable<S>, CliError> {
     let (from, to) = mccs::table::DEFAULT_DOMAIN;
     let law = mccs::Law::new(p).map_err(|e| file_error(file, e))?;
+    // As a device builds it (`ForceTable::new`), measured.
     ForceTable::<S>::from_law(&law, from, to)
         .map(|t| t.measured(&law, from, to))
         .map_err(|e| match e {
