@@ -331,6 +331,38 @@ fn the_inner_corner_is_on_a_knot_and_meets_the_bound() {
     }
 }
 
+/// `from_law_best` (what `mccs table` emits) is never worse than the placement a device
+/// takes (`from_law`, the first that builds), on 200 random springs: its largest error
+/// relative to the product's bound is at most the other's. Prints how many it improved.
+#[test]
+fn the_best_placement_is_no_worse_than_a_devices() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
+    let ratio = |t: &ForceTable<128>| {
+        let e = t.max_error().unwrap();
+        (e.force / TableBound::PRODUCT.force).max(e.stiffness / TableBound::PRODUCT.stiffness)
+    };
+    let (mut compared, mut improved) = (0, 0);
+    for _ in 0..200 {
+        let (p, _) = spring(&mut rng);
+        let law = mccs::Law::new(&p).unwrap();
+        let first = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1)
+            .map(|t| t.measured(&law, DOMAIN.0, DOMAIN.1));
+        let best = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1);
+        match (first, best) {
+            (Ok(first), Ok(best)) => {
+                assert!(ratio(&best) <= ratio(&first), "{p:?}");
+                compared += 1;
+                improved += usize::from(ratio(&best) < ratio(&first));
+            }
+            // Another placement may build where the first to fail stops a device's.
+            (Err(_), _) => {}
+            (Ok(_), Err(e)) => panic!("{p:?}: a device's placement builds, the best is {e}"),
+        }
+    }
+    println!("BESTPLACEMENT springs=200 compared={compared} improved={improved}");
+    assert!(compared > 150);
+}
+
 /// The cases docs/accuracy.md lists, at 65 and 129 knots: what each table reaches.
 #[test]
 fn named_springs_report_their_bound() {
