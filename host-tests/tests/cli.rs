@@ -41,6 +41,18 @@ fn assert_usage_error(out: &Output, needles: &[&str]) {
     }
 }
 
+/// Asserts exit 2, empty stdout, and exactly one stderr line containing every `needle` —
+/// for a mistake found past the argument parser (no usage hint).
+fn assert_one_line_error(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(out.stdout.is_empty(), "stdout not empty");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} lacks {n:?}");
+    }
+}
+
 const TABLE2: &str = include_str!("../../params/table2.toml");
 
 #[test]
@@ -473,19 +485,16 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         ("129", "a narrower domain"),
     ] {
         let out = mccs(&["table", "--params", path, "--knots", knots]);
-        assert_eq!(out.status.code(), Some(2));
-        assert!(out.stdout.is_empty());
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(err.lines().count(), 1, "{err}");
-        for part in [
-            "stiff-series.toml",
-            "misses the bound",
-            "k_p/k = 2.01e3",
-            advice,
-            "--accept-error",
-        ] {
-            assert!(err.contains(part), "{part}: {err}");
-        }
+        assert_one_line_error(
+            &out,
+            &[
+                "stiff-series.toml",
+                "misses the bound",
+                "k_p/k = 2.01e3",
+                advice,
+                "--accept-error",
+            ],
+        );
     }
     // A spring 1,000 times weaker than Table 2: half an LSB of the output formats is over
     // the bound, and the refusal says that no knot count or domain helps.
@@ -500,18 +509,17 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         "--knots",
         "129",
     ]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_one_line_error(
+        &out,
+        &[
+            "weak.toml",
+            "misses the bound",
+            "the fixed-point formats cannot hold this spring",
+            "no knot count or domain meets it",
+            "--accept-error",
+        ],
+    );
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(err.lines().count(), 1, "{err}");
-    for part in [
-        "weak.toml",
-        "misses the bound",
-        "the fixed-point formats cannot hold this spring",
-        "no knot count or domain meets it",
-        "--accept-error",
-    ] {
-        assert!(err.contains(part), "{part}: {err}");
-    }
     assert!(
         !err.contains("more knots") && !err.contains("narrower"),
         "{err}"

@@ -337,10 +337,7 @@ fn the_inner_corner_is_on_a_knot_and_meets_the_bound() {
 #[test]
 fn the_best_placement_is_no_worse_than_a_devices() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
-    let ratio = |t: &ForceTable<128>| {
-        let e = t.max_error().unwrap();
-        (e.force / TableBound::PRODUCT.force).max(e.stiffness / TableBound::PRODUCT.stiffness)
-    };
+    let ratio = |t: &ForceTable<128>| t.max_error().unwrap().ratio_to(&TableBound::PRODUCT);
     let (mut compared, mut improved) = (0, 0);
     for _ in 0..200 {
         let (p, _) = spring(&mut rng);

@@ -51,6 +51,12 @@ impl TableBound {
         self.force <= bound.force && self.stiffness <= bound.stiffness
     }
 
+    /// How far `self` is from `bound`: the larger of its two ratios to it (at most 1
+    /// exactly when [`TableBound::within`]).
+    pub fn ratio_to(&self, bound: &Self) -> f64 {
+        libm::fmax(self.force / bound.force, self.stiffness / bound.stiffness)
+    }
+
     /// In parts per 10⁹, saturating (as stored in the raw table).
     pub fn to_ppb(&self) -> (u32, u32) {
         (ppb(self.force), ppb(self.stiffness))

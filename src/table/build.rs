@@ -80,12 +80,9 @@ impl<const S: usize> ForceTable<S> {
                 Ok(t) => {
                     tried[n] = Some(grid_of(&t.raw));
                     let t = t.measured(law, from, to);
-                    let e = t.max_error().map_or(f64::INFINITY, |e| {
-                        libm::fmax(
-                            e.force / TableBound::PRODUCT.force,
-                            e.stiffness / TableBound::PRODUCT.stiffness,
-                        )
-                    });
+                    let e = t
+                        .max_error()
+                        .map_or(f64::INFINITY, |e| e.ratio_to(&TableBound::PRODUCT));
                     if best.as_ref().is_none_or(|(b, _)| e < *b) {
                         best = Some((e, t));
                     }
@@ -95,10 +92,10 @@ impl<const S: usize> ForceTable<S> {
                 }
             }
         }
+        // Without a table every placement failed (a duplicate implies one built).
         match (best, first_err) {
             (Some((_, t)), _) => Ok(t),
-            (None, Some(e)) => Err(e),
-            (None, None) => Err(TableError::OutOfRange),
+            (None, e) => Err(e.unwrap_or(TableError::OutOfRange)),
         }
     }
 
@@ -332,7 +329,7 @@ impl Grid {
         // rounded to Q24: the two segments meeting there are each one side's smooth
         // curve, and on the steep side half an LSB of strain is a force that, against a
         // soft side's rise over a segment, bends that side's cubic (a stiffness error of
-        // 2e-3 over the segment above `Δ(P)` when `k_p ≪ k`). The same for the first knot
+        // 3.2e-3 above `Δ(P)` when `k_p ≪ k`: `the_inner_corner_is_on_a_knot_…`). The same for the first knot
         // when it sits on the first kink (an aligned grid's may lie well below it).
         let lsb = 1.0 / (1u64 << STRAIN_FRAC) as f64;
         let f = if self.kink_knot == Some(i) {
@@ -563,8 +560,8 @@ fn grid_of<const S: usize>(r: &RawTable<S>) -> (i32, i32, u32, u32) {
 /// line `k ε`: `max(F_T, P)`. With a preload above `F_T` it is the slope kink `Δ(P)`,
 /// where the series spring starts to move; with one below, the cone's own transition
 /// `Δ(F_T)`, a jump in curvature (the stiffness starts to climb) that a cubic across it
-/// follows only to second order (a stiffness error of 4e-3 measured on a segment over
-/// it). With no preload (`P = F_T`) there is none: it is the first kink itself.
+/// follows only to second order (a stiffness error of 2.3e-3 with no knot on it:
+/// `the_inner_corner_is_on_a_knot_…`). With no preload (`P = F_T`) there is none: it is the first kink itself.
 fn inner_corner(law: &Law) -> f64 {
     libm::fmax(law.f_t, law.preload)
 }
