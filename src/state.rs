@@ -19,8 +19,10 @@ pub const VEL_LIMIT_MM_S: f64 = 16384.0;
 
 /// One node's state: displacement from rest, stored velocity and the force accumulator of
 /// the current substep, together so that a spring reaches all of an end through one
-/// address.
+/// address. In declaration order (`repr(C)`, 36 bytes: the ARMv7E-M spring loop reads
+/// it by offset, `arith/wide_dsp.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct Node {
     /// Displacement from rest, Q24 mm.
     pub u: V3,

@@ -18,18 +18,20 @@ pub const GROUND: u16 = 0;
 /// [`crate::arith::SPRING_FORCE_LIMIT`]) cannot overflow the Q20 accumulator.
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
 
-/// One spring of the patch.
+/// One spring of the patch. In declaration order (`repr(C)`, 20 bytes), so that the
+/// ARMv7E-M spring loop loads a whole edge with one `ldm` (`arith/wide_dsp.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct Edge {
-    /// First node: always a free one.
-    pub a: u16,
-    /// Second node (0 = ground: a spring to a fixed point has its fixed end here).
-    pub b: u16,
     /// Rest vector from `a` to `b` divided by the rest length `l0`: a unit vector, Q23
     /// ([`crate::units::DIR_FRAC`]).
     pub dir: V3,
     /// `1 / l0` in 1/mm, Q31 (`l0 ≥ 1 mm`; 1 mm is stored as `i32::MAX`).
     pub inv_len: i32,
+    /// First node: always a free one.
+    pub a: u16,
+    /// Second node (0 = ground: a spring to a fixed point has its fixed end here).
+    pub b: u16,
 }
 
 /// An end of an edge being added: a free node, or a fixed point.

@@ -21,6 +21,8 @@ use crate::topology::{Edge, Topology};
 
 pub mod narrow;
 pub mod wide;
+#[cfg(mccs_dsp)]
+mod wide_dsp;
 
 pub use narrow::Narrow;
 pub use wide::Wide;

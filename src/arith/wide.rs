@@ -132,17 +132,42 @@ impl Arith for Wide {
         warm: &mut [i32; EDGES],
         nodes: &mut [Node; NODES],
     ) {
-        let kernel = Kernel {
-            table: &table.table,
-            damping: c.damping,
-        };
-        for_each_spring(topo, warm, nodes, &kernel);
+        #[cfg(mccs_dsp)]
+        if super::wide_dsp::serves::<S>() {
+            super::wide_dsp::spring_forces(&table.table, c.damping, topo, warm, nodes);
+            return;
+        }
+        spring_forces_portable(&table.table, c, topo, warm, nodes);
     }
 
     #[inline(always)]
     fn integrate(c: &WideCoeffs, free: &mut [Node]) {
-        free.iter_mut().for_each(|n| integrate(c, n));
+        #[cfg(mccs_dsp)]
+        {
+            super::wide_dsp::integrate(c.keep, c.h_over_m, c.half_h, free);
+        }
+        #[cfg(not(mccs_dsp))]
+        integrate_portable(c, free);
     }
+}
+
+/// Every spring's force, accumulated on its two nodes, in Rust: what [`Wide`] runs on
+/// every core but the Armv7E-M ones (M4F), whose loop is in assembly
+/// (`arith/wide_dsp.rs`) and must give the same bits; public so that the bench firmware
+/// can check that on the M4F itself.
+#[inline(always)]
+pub fn spring_forces_portable<const S: usize, const NODES: usize, const EDGES: usize>(
+    table: &ForceTable<S>,
+    c: &WideCoeffs,
+    topo: &Topology<NODES, EDGES>,
+    warm: &mut [i32; EDGES],
+    nodes: &mut [Node; NODES],
+) {
+    let kernel = Kernel {
+        table,
+        damping: c.damping,
+    };
+    for_each_spring(topo, warm, nodes, &kernel);
 }
 
 /// [`spring`] with its table and damping, for the solver's loop.
@@ -243,6 +268,14 @@ fn spring<const S: usize>(
         let p = q::mulhi_round(dv, damping) + q::mulhi_round(w[k], neg_fr);
         p.clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
     })
+}
+
+/// The paper's improved Euler on every node of `free`, in Rust: what [`Wide`] runs on
+/// every core but the Armv7E-M ones, whose loop is in assembly (`arith/wide_dsp.rs`)
+/// and must give the same bits (the bench firmware checks it on the M4F).
+#[inline(always)]
+pub fn integrate_portable(c: &WideCoeffs, free: &mut [Node]) {
+    free.iter_mut().for_each(|n| integrate(c, n));
 }
 
 /// Improved Euler for one node (eqs. 21, 22), and the node's force accumulator cleared

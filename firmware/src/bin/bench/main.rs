@@ -23,6 +23,8 @@ mod cases;
 #[cfg(target_os = "none")]
 mod harness;
 #[cfg(target_os = "none")]
+mod kernel_check;
+#[cfg(target_os = "none")]
 mod report;
 
 #[cfg(target_os = "none")]
@@ -30,7 +32,7 @@ mod firmware {
     use super::fw_common::exit;
     use super::harness::Harness;
     use super::report::{check_budgets, fits, largest_patch, Figures, Steps};
-    use super::{cases, harness};
+    use super::{cases, harness, kernel_check};
     use core::hint::black_box;
     use cortex_m_rt::entry;
     use mccs::{ForceTable64, Length, Solver};
@@ -50,6 +52,8 @@ mod firmware {
             black_box(0u32);
         });
         let table = black_box(TABLE2);
+        // The M4F's assembly spring loop against the portable one, before any figure.
+        kernel_check::check(&table);
         // These two take off their own harness (the empty call included).
         figs.report(
             "force_and_stiffness",

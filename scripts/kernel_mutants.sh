@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Shows that the bench firmware's kernel check (firmware/src/bin/bench/kernel_check.rs)
+# catches faults in the M4F's assembly loops (src/arith/wide_dsp.rs): puts one fault at a
+# time into a scratch worktree of HEAD, runs the M4F bench up to its KERNEL line and
+# prints `MUTANT <fault>: <n> of <states> states differ`; the last line counts the
+# faults caught. Not in the test command (about 10 s per fault once built; the first
+# build takes a minute or two). Usage: scripts/kernel_mutants.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+T=thumbv7em-none-eabihf
+root=$(pwd)
+work=$(mktemp -d)
+trap 'git worktree remove --force "$work" >/dev/null 2>&1 || rm -rf "$work"' EXIT
+git worktree add --detach "$work" HEAD >/dev/null
+cargo build --quiet -p defmt-log
+export CARGO_TARGET_DIR="$root/target/mutants"
+src="$work/src/arith/wide_dsp.rs"
+cp "$src" "$work/wide_dsp.rs.orig"
+
+# name | text to replace (its first occurrence) | replacement
+mutants=(
+  "edge vector hold one bit narrower|ssat r0, #25, r0|ssat r0, #24, r0"
+  "|w|² r hold one bit narrower|usat r9, #25, r9|usat r9, #24, r9"
+  "Newton factor hold one bit narrower|usat r8, #24, r8|usat r8, #23, r8"
+  "warm start hold one bit narrower|usat r10, #30, r10|usat r10, #29, r10"
+  "force hold one bit narrower|\"ssat r5, #27, r5|\"ssat r5, #26, r5"
+  "lower line's product hold one bit narrower|\"ssat r5, #20, r5|\"ssat r5, #19, r5"
+  "lower line's sum not saturating|\"qadd r5, r5, r3|\"add r5, r5, r3"
+  "lower line's difference not saturating|\"qsub r3, r9, r3|\"sub r3, r9, r3"
+  "upper line's difference not saturating|\"qsub r3, r9, r5|\"sub r3, r9, r5"
+  "tau shifted arithmetically|\"lsr r3, r3, #1|\"asr r3, r3, #1"
+  "coefficients' shift not masked|\"ldr r3, [sp, #12]|\"ldr r3, [r11, #-24]"
+  "push hold one bit narrower|#27, \", \$w|#26, \", \$w"
+  "ground damping added, not subtracted|\"smmlsr \", \$w|\"smmlar \", \$w"
+  "integrator velocity hold one bit narrower|ssat r8, #23, r8|ssat r8, #22, r8"
+  "integrator displacement hold one bit narrower|ssat r1, #31, r1|ssat r1, #30, r1"
+  "accumulator cleared at the wrong offset|\"str r3, [lr, #8]\"|\"str r3, [lr, #4]\""
+)
+caught=0
+for m in "${mutants[@]}"; do
+  IFS='|' read -r name from to <<< "$m"
+  cp "$work/wide_dsp.rs.orig" "$src"
+  python3 - "$src" "$from" "$to" <<'EOF'
+import sys
+p, a, b = sys.argv[1:]
+s = open(p).read()
+if a not in s:
+    sys.exit(f"kernel_mutants: '{a}' is not in {p}")
+open(p, "w").write(s.replace(a, b, 1))
+EOF
+  echo "... $name: building and running the M4F bench" >&2
+  (cd "$work" && cargo build --quiet --release -p mccs-firmware --target $T --bin bench)
+  line=$( (cd "$work" && timeout --foreground 300 cargo run --quiet --release -p mccs-firmware \
+      --target $T --bin bench < /dev/null 2>/dev/null || true) \
+    | target/debug/defmt-log "$CARGO_TARGET_DIR/$T/release/bench" | grep -m1 '^KERNEL' || true)
+  n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
+  of=$(sed -n 's/.*states=\([0-9]*\).*/\1/p' <<< "$line")
+  echo "MUTANT $name: ${n:-no KERNEL line, so none} of ${of:-the} states differ"
+  if [ -n "$n" ] && [ "$n" != 0 ]; then caught=$((caught + 1)); fi
+done
+echo "$caught of ${#mutants[@]} faults caught"

@@ -1,0 +1,451 @@
+//! [`spring_forces`]: [`super::Wide`]'s spring loop in Armv7E-M assembly (the Cortex-M4F's
+//! DSP instructions: `smmla`, `smmulr`, `qadd`, `ssat`, …), bit for bit the portable loop
+//! ([`super::wide::spring_forces_portable`]), which every other core runs and against
+//! which the bench firmware checks this one on random states before it measures
+//! (`firmware/src/bin/bench/kernel_check.rs`).
+//!
+//! Why assembly: the compiler's loop spends about a fifth of each spring on moving
+//! values (spills of the edge vector around the table lookup, the warm-start pointer
+//! kept on the stack, masks rebuilt for every spring, node addresses from two
+//! multiplies each), and small source changes move that cost unpredictably
+//! (`docs/performance.md`, "The spring loop in assembly"). Here every register is
+//! chosen: an edge is one `ldm`, a node's three components one `ldm`/`stm`, and the
+//! loop keeps the edge and warm-start pointers in registers.
+//!
+//! The arithmetic is [`super::wide`]'s `spring`, step for step; its comments give the
+//! formats and ranges. Only for tables of a power-of-two segment count (the index is a
+//! bit field); others take the portable loop.
+
+use crate::q::V3;
+use crate::state::Node;
+use crate::table::{ForceTable, RawTable};
+use crate::topology::{Edge, Topology};
+
+/// What the loop reads at entry (`repr(C)`: one `ldm`).
+#[repr(C)]
+struct LoopArgs {
+    nodes: *mut Node,
+    end: *const Edge,
+    segments: *const [i32; 4],
+    /// The coefficients' shift, masked as `wrapping_shr` masks it.
+    shift: u32,
+    damping: i32,
+    edges: *const Edge,
+    warm: *mut i32,
+}
+
+// The layouts the assembly reads by offset.
+const _: () = {
+    assert!(core::mem::size_of::<Edge>() == 20);
+    assert!(core::mem::offset_of!(Edge, dir) == 0);
+    assert!(core::mem::offset_of!(Edge, inv_len) == 12);
+    assert!(core::mem::offset_of!(Edge, a) == 16);
+    assert!(core::mem::offset_of!(Edge, b) == 18);
+    assert!(core::mem::size_of::<Node>() == 36);
+    assert!(core::mem::offset_of!(Node, u) == 0);
+    assert!(core::mem::offset_of!(Node, v) == 12);
+    assert!(core::mem::offset_of!(Node, f) == 24);
+    assert!(core::mem::size_of::<V3>() == 12);
+};
+
+/// Offsets of the table's header fields from its first segment (bytes, negative).
+const fn header<const S: usize>() -> [i32; 9] {
+    let seg = core::mem::offset_of!(RawTable<S>, segments) as i32;
+    [
+        core::mem::offset_of!(RawTable<S>, strain_lo) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, strain_hi) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, index_pre) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, index_scale) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, anchor_lo) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, force_lo) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, stiffness_lo) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, force_hi) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, stiffness_hi) as i32 - seg,
+    ]
+}
+
+/// The header as the assembly addresses it: `ldrd` pairs (`strain_lo, strain_hi` and
+/// `index_pre, index_scale`) and `ldr`s, word-aligned within 255 bytes before the first
+/// segment.
+const fn header_fits<const S: usize>() -> bool {
+    let h = header::<S>();
+    let mut i = 0;
+    let mut ok = h[1] == h[0] + 4 && h[3] == h[2] + 4;
+    while i < h.len() {
+        ok = ok && h[i] >= -252 && h[i] < 0 && h[i] % 4 == 0;
+        i += 1;
+    }
+    ok
+}
+
+/// Whether this loop serves tables of `S` segments.
+pub(super) const fn serves<const S: usize>() -> bool {
+    S.is_power_of_two() && S <= 1 << 16 && header_fits::<S>()
+}
+
+/// `asm!` with every register but r0, r6, r7, r13 and r15 declared written: the blocks
+/// below use them all (r0 is each block's input, r6 and r7 they save themselves).
+macro_rules! asm_writing_all {
+    ($($operands:tt)*) => {
+        core::arch::asm!(
+            $($operands)*
+            out("r1") _,
+            out("r2") _,
+            out("r3") _,
+            out("r4") _,
+            out("r5") _,
+            out("r8") _,
+            out("r9") _,
+            out("r10") _,
+            out("r11") _,
+            out("r12") _,
+            out("lr") _,
+        )
+    };
+}
+
+/// The part of one spring both of its kinds share: from `dir + d/l0` (r0–r2, Q23) to
+/// the edge vector `w` (r0–r2, Q30), the advanced warm-start `l0/l` (r10, stored
+/// through r7, which moves on) and `−f l0/l` (r8, Q22); r3 is the damping. Keeps r4
+/// (node b), r6 (node a), r7, r12.
+macro_rules! spring_body {
+    () => {
+        concat!(
+            // w held within ±2 (Q23), then Q30.
+            "ssat r0, #25, r0\n",
+            "ssat r1, #25, r1\n",
+            "ssat r2, #25, r2\n",
+            "lsl r0, r0, #7\n",
+            "lsl r1, r1, #7\n",
+            "lsl r2, r2, #7\n",
+            // a = |w|² (u32, Q28).
+            "smmul r3, r0, r0\n",
+            "smmla r3, r1, r1, r3\n",
+            "smmla r3, r2, r2, r3\n",
+            // Newton: ar = hi_u(a r) held below 4, Q28; arr = hi(ar r) held in [0, 2);
+            // g = (arr << 8) ^ i32::MAX; r' = r + hi(r g) held below 8.
+            "ldr r5, [r7]\n",
+            "umull r8, r9, r3, r5\n",
+            "usat r9, #25, r9\n",
+            "lsl r9, r9, #5\n",
+            "smmul r8, r9, r5\n",
+            "usat r8, #24, r8\n",
+            "mvn r10, #0x80000000\n",
+            "eor r8, r10, r8, lsl #8\n",
+            "smmla r10, r5, r8, r5\n",
+            "usat r10, #30, r10\n",
+            "str r10, [r7], #4\n",
+            // |w| = ar + hi(ar g) (Q28); the strain (1 − |w|) in Q24.
+            "smmla r9, r9, r8, r9\n",
+            "rsb r9, r9, #0x10000000\n",
+            "asr r9, r9, #4\n",
+            // The table: below, above, or in a segment.
+            "ldr r11, [sp, #8]\n",
+            "ldrd r3, r5, [r11, #{strain_lo}]\n",
+            "cmp r9, r3\n",
+            "ble 51f\n",
+            "cmp r9, r5\n",
+            "bge 52f\n",
+            // pos = hi_u((e − lo) · pre, scale): segment index above bit 15, τ below.
+            "ldrd r5, r8, [r11, #{index_pre}]\n",
+            "sub r3, r9, r3\n",
+            "mul r3, r3, r5\n",
+            "umull r5, r3, r3, r8\n",
+            "ubfx r5, r3, #15, #{log2s}\n",
+            "add r5, r11, r5, lsl #4\n",
+            "ldm r5, {{r5, r8, r11, lr}}\n",
+            "lsl r3, r3, #17\n",
+            "lsr r3, r3, #1\n",
+            // Three halving Horner steps, then the coefficients' shift.
+            "smmla r11, lr, r3, r11\n",
+            "smmla r8, r11, r3, r8\n",
+            "smmla r5, r8, r3, r5\n",
+            "ldr r3, [sp, #12]\n",
+            "asr r5, r5, r3\n",
+            "b 53f\n",
+            // Below: force_lo + (stiffness_lo · (e ⊖ anchor_lo)) >> 20, held.
+            "51:\n",
+            "ldr r3, [r11, #{anchor_lo}]\n",
+            "qsub r3, r9, r3\n",
+            "ldr r5, [r11, #{stiffness_lo}]\n",
+            "smull r3, r5, r5, r3\n",
+            "ssat r5, #20, r5\n",
+            "lsl r5, r5, #12\n",
+            "orr r3, r5, r3, lsr #20\n",
+            "ldr r5, [r11, #{force_lo}]\n",
+            "qadd r5, r5, r3\n",
+            "b 53f\n",
+            // Above: force_hi + (stiffness_hi · (e ⊖ strain_hi)) >> 20, held.
+            "52:\n",
+            "qsub r3, r9, r5\n",
+            "ldr r5, [r11, #{stiffness_hi}]\n",
+            "smull r3, r5, r5, r3\n",
+            "ssat r5, #20, r5\n",
+            "lsl r5, r5, #12\n",
+            "orr r3, r5, r3, lsr #20\n",
+            "ldr r5, [r11, #{force_hi}]\n",
+            "qadd r5, r5, r3\n",
+            // f within ±64 N; −f r' >> 25 (Q22); the damping.
+            "53:\n",
+            "ssat r5, #27, r5\n",
+            "rsb r5, r5, #0\n",
+            "smull r3, r8, r5, r10\n",
+            "lsl r8, r8, #7\n",
+            "orr r8, r8, r3, lsr #25\n",
+            "ldr r3, [sp, #16]\n",
+        )
+    };
+}
+
+/// One axis of a spring between two nodes: `p = round(C dv) + round(w (−f r))`, held
+/// within ±64 N, into the axis' `w` register. `$w`: w's register; `$vb`: the offset of
+/// b's velocity component; `$va`: the register holding a's.
+macro_rules! axis_two {
+    ($w:literal, $vb:literal, $va:literal) => {
+        concat!(
+            "ldr lr, [r4, #",
+            $vb,
+            "]\n",
+            "sub ",
+            $va,
+            ", lr, ",
+            $va,
+            "\n",
+            "smmulr ",
+            $va,
+            ", ",
+            $va,
+            ", r3\n",
+            "smmlar ",
+            $w,
+            ", ",
+            $w,
+            ", r8, ",
+            $va,
+            "\n",
+            "ssat ",
+            $w,
+            ", #27, ",
+            $w,
+            "\n",
+        )
+    };
+}
+
+/// The same for a spring to the ground (at rest): `dv = −v_a`, its rounded product
+/// subtracted (`smmlsr`: `t − round(v_a C)` is `t + round(−v_a C)`; `v_a` is never
+/// `i32::MIN`, see [`spring_forces`]).
+macro_rules! axis_ground {
+    ($w:literal, $va:literal) => {
+        concat!(
+            "smmulr ", $w, ", ", $w, ", r8\n", "smmlsr ", $w, ", ", $va, ", r3, ", $w, "\n",
+            "ssat ", $w, ", #27, ", $w, "\n",
+        )
+    };
+}
+
+/// Node a's accumulator (r6) takes `p` (r0–r2); the next spring, until the end.
+macro_rules! a_takes_p_and_loops {
+    () => {
+        concat!(
+            "add r6, r6, #24\n",
+            "ldm r6, {{r5, r9, r10}}\n",
+            "add r5, r5, r0\n",
+            "add r9, r9, r1\n",
+            "add r10, r10, r2\n",
+            "stm r6, {{r5, r9, r10}}\n",
+            "ldr r5, [sp, #4]\n",
+            "cmp r12, r5\n",
+            "bne 20b\n",
+        )
+    };
+}
+
+/// Every spring's force, accumulated on its two nodes: [`super::wide`]'s loop, in
+/// assembly. Only for tables it [`serves`] (the caller's choice, a constant).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usize>(
+    table: &ForceTable<S>,
+    damping: i32,
+    topo: &Topology<NODES, EDGES>,
+    warm: &mut [i32; EDGES],
+    nodes: &mut [Node; NODES],
+) {
+    let edges = topo.edges();
+    let n = edges.len().min(EDGES);
+    let raw = table.raw();
+    let args = LoopArgs {
+        nodes: nodes.as_mut_ptr(),
+        end: edges.as_ptr().wrapping_add(n),
+        segments: raw.segments.as_ptr(),
+        shift: raw.shift & 31,
+        damping,
+        edges: edges.as_ptr(),
+        warm: warm.as_mut_ptr(),
+    };
+    // SAFETY: the loop reads the `n` edges of `topo` (`edges` up to `end`) and as many
+    // warm-start values (n ≤ EDGES), writes only those values and the nodes' force
+    // accumulators, and reads the table's header and segments. Every node index is in
+    // bounds of `nodes` and `a` is never the ground nor equal to `b`, as
+    // `Topology::add_edge`, the only way in, guarantees (see `state::for_each_spring`);
+    // the segment index is masked to `S − 1` and `S` is a power of two; the layouts it
+    // reads are asserted above. It saves and restores r6 and r7 itself (the registers
+    // the compiler reserves), declares every other register it writes, and leaves the
+    // stack as it found it.
+    unsafe {
+        asm_writing_all!(
+            "push {{r6, r7}}",
+            "ldm r0, {{r1, r2, r3, r4, r5, r6, r7}}",
+            "push {{r1, r2, r3, r4, r5}}",
+            "mov r12, r6",
+            "cmp r12, r2",
+            "beq 90f",
+            // One spring: the edge (dir, 1/l0, a | b << 16) and its node addresses.
+            "20:",
+            "ldm r12!, {{r0, r1, r2, r3, r4}}",
+            "ldr r5, [sp]",
+            "uxth r6, r4",
+            "add r6, r6, r6, lsl #3",
+            "add r6, r5, r6, lsl #2",
+            "lsrs r4, r4, #16",
+            "beq 30f",
+            "add r4, r4, r4, lsl #3",
+            "add r4, r5, r4, lsl #2",
+            "ldm r4, {{r5, r8, r9}}",
+            "ldm r6, {{r10, r11, lr}}",
+            "sub r5, r5, r10",
+            "sub r8, r8, r11",
+            "sub r9, r9, lr",
+            // dir + hi(d / l0).
+            "smmla r0, r5, r3, r0",
+            "smmla r1, r8, r3, r1",
+            "smmla r2, r9, r3, r2",
+            spring_body!(),
+            "add r11, r6, #12",
+            "ldm r11, {{r5, r9, r10}}",
+            axis_two!("r0", "12", "r5"),
+            axis_two!("r1", "16", "r9"),
+            axis_two!("r2", "20", "r10"),
+            // b's accumulator takes −p, a's p.
+            "add r4, r4, #24",
+            "ldm r4, {{r5, r9, r10}}",
+            "sub r5, r5, r0",
+            "sub r9, r9, r1",
+            "sub r10, r10, r2",
+            "stm r4, {{r5, r9, r10}}",
+            a_takes_p_and_loops!(),
+            "b 90f",
+            // A spring to the ground: b at rest, d = −u_a, so dir − hi(u_a / l0)
+            // (`smmls`, exact: u_a is never i32::MIN).
+            "30:",
+            "ldm r6, {{r10, r11, lr}}",
+            "smmls r0, r10, r3, r0",
+            "smmls r1, r11, r3, r1",
+            "smmls r2, lr, r3, r2",
+            spring_body!(),
+            "add r11, r6, #12",
+            "ldm r11, {{r5, r9, r10}}",
+            axis_ground!("r0", "r5"),
+            axis_ground!("r1", "r9"),
+            axis_ground!("r2", "r10"),
+            a_takes_p_and_loops!(),
+            "90:",
+            "add sp, sp, #20",
+            "pop {{r6, r7}}",
+            log2s = const if serves::<S>() { S.trailing_zeros() } else { 1 },
+            strain_lo = const header::<S>()[0],
+            index_pre = const header::<S>()[2],
+            anchor_lo = const header::<S>()[4],
+            force_lo = const header::<S>()[5],
+            stiffness_lo = const header::<S>()[6],
+            force_hi = const header::<S>()[7],
+            stiffness_hi = const header::<S>()[8],
+            inout("r0") core::ptr::addr_of!(args) => _,
+        );
+    }
+}
+
+/// What [`integrate`] reads at entry (`repr(C)`: one `ldm`).
+#[repr(C)]
+struct IntegrateArgs {
+    begin: *mut Node,
+    end: *mut Node,
+    keep: i32,
+    h_over_m: i32,
+    half_h: i32,
+}
+
+/// The paper's improved Euler on every node of `free` and its accumulator cleared:
+/// [`super::wide`]'s `integrate`, in assembly (one `ldm` of a node's displacement and
+/// velocity, one `stm` back). `keep`, `h_over_m` and `half_h` are [`super::WideCoeffs`]'
+/// (Q24, Q20, Q40).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn integrate(keep: i32, h_over_m: i32, half_h: i32, free: &mut [Node]) {
+    let range = free.as_mut_ptr_range();
+    let args = IntegrateArgs {
+        begin: range.start,
+        end: range.end,
+        keep,
+        h_over_m,
+        half_h,
+    };
+    // SAFETY: reads and writes the nodes of `free` (from `begin` up to `end`) only, at
+    // the offsets asserted above. r6 and r7 are saved and restored by the block itself,
+    // every other register it writes is declared, and the stack is left as it was found.
+    unsafe {
+        asm_writing_all!(
+            "push {{r6, r7}}",
+            "ldm r0, {{r1, r2, r10, r11, r12}}",
+            "mov lr, r1",
+            "push {{r2}}",
+            "cmp lr, r2",
+            "beq 99f",
+            "70:",
+            "ldm lr, {{r0, r1, r2, r3, r4, r5}}",
+            // Per axis: v' = (v keep + f h/m) >> 24, held within ±2³⁰ through the high
+            // word; u' = u + hi((v + v') h/2), held within ±2³⁰. v0' in r6, v1' in r8,
+            // v2' in r9 (so that u and v' go back in one `stm`).
+            "ldr r7, [lr, #24]",
+            "smull r6, r8, r3, r10",
+            "smlal r6, r8, r7, r11",
+            "ssat r8, #23, r8",
+            "lsl r8, r8, #8",
+            "orr r6, r8, r6, lsr #24",
+            "add r3, r3, r6",
+            "smmla r0, r3, r12, r0",
+            "ssat r0, #31, r0",
+            "ldr r7, [lr, #28]",
+            "smull r8, r9, r4, r10",
+            "smlal r8, r9, r7, r11",
+            "ssat r9, #23, r9",
+            "lsl r9, r9, #8",
+            "orr r8, r9, r8, lsr #24",
+            "add r4, r4, r8",
+            "smmla r1, r4, r12, r1",
+            "ssat r1, #31, r1",
+            "ldr r3, [lr, #32]",
+            "smull r9, r7, r5, r10",
+            "smlal r9, r7, r3, r11",
+            "ssat r7, #23, r7",
+            "lsl r7, r7, #8",
+            "orr r9, r7, r9, lsr #24",
+            "add r5, r5, r9",
+            "smmla r2, r5, r12, r2",
+            "ssat r2, #31, r2",
+            "mov r3, #0",
+            "stm lr!, {{r0, r1, r2, r6, r8, r9}}",
+            "strd r3, r3, [lr]",
+            "str r3, [lr, #8]",
+            "add lr, lr, #12",
+            "ldr r7, [sp]",
+            "cmp lr, r7",
+            "bne 70b",
+            "99:",
+            "add sp, sp, #4",
+            "pop {{r6, r7}}",
+            inout("r0") core::ptr::addr_of!(args) => _,
+        );
+    }
+}
