@@ -20,7 +20,7 @@ cp "$src" "$work/wide_dsp.rs.orig"
 # name | text to replace (its first occurrence) | replacement
 mutants=(
   "edge vector hold one bit narrower|ssat r0, #25, r0|ssat r0, #24, r0"
-  "|w|² r hold one bit narrower|usat r9, #25, r9|usat r9, #24, r9"
+  "a r hold one bit narrower|usat r9, #25, r9|usat r9, #24, r9"
   "Newton factor hold one bit narrower|usat r8, #24, r8|usat r8, #23, r8"
   "warm start hold one bit narrower|usat r10, #30, r10|usat r10, #29, r10"
   "force hold one bit narrower|\"ssat r5, #27, r5|\"ssat r5, #26, r5"
