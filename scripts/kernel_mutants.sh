@@ -36,6 +36,8 @@ mutants=(
   "integrator displacement hold one bit narrower|ssat r1, #31, r1|ssat r1, #30, r1"
   "accumulator cleared at the wrong offset|\"str r3, [lr, #8]\"|\"str r3, [lr, #4]\""
 )
+echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
+(cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)
 caught=0
 for m in "${mutants[@]}"; do
   IFS='|' read -r name from to <<< "$m"

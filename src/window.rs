@@ -2,8 +2,8 @@
 //! (issue #19; the `f64` reference is `mccs_host::roam`, `docs/roaming.md`).
 //!
 //! The tissue is `W × H` nodes at the patch's spacing, centred on the origin (its top at
-//! `z = 0`), flat or a spherical cap ([`crate::cap`]); the patch simulates the `n × n` of them around its centre node, outer ring
-//! fixed at rest. When the contact point (out of contact: the probe) is more than
+//! `z = 0`), flat or a spherical cap (`src/cap.rs`); the patch simulates the `n × n` of
+//! them around its centre node, outer ring fixed at rest. When the contact point (out of contact: the probe) is more than
 //! `½ + hysteresis` spacings from the centre along an axis, the window moves one node
 //! that way and stays inside the tissue: the free nodes that stay free keep their state,
 //! the others start at rest, each spring takes the warm-start value of the spring it

@@ -1,20 +1,26 @@
-//! [`spring_forces`]: [`super::Wide`]'s spring loop in Armv7E-M assembly (the Cortex-M4F's
-//! DSP instructions: `smmla`, `smmulr`, `qadd`, `ssat`, …), bit for bit the portable loop
-//! ([`super::wide::spring_forces_portable`]), which every other core runs and against
-//! which the bench firmware checks this one on random states before it measures
+//! [`spring_forces`] and [`integrate`]: [`super::Wide`]'s spring loop and integrator in
+//! Armv7E-M assembly (the Cortex-M4F's DSP instructions: `smmla`, `smmulr`, `qadd`,
+//! `ssat`, …), bit for bit the portable loops ([`super::wide::spring_forces_portable`],
+//! [`super::wide::integrate_portable`]), which every other core runs and against which
+//! the bench firmware checks these on random states before it measures
 //! (`firmware/src/bin/bench/kernel_check.rs`).
 //!
-//! Why assembly: the compiler's loop spends about a fifth of each spring on moving
+//! Why assembly: the compiler's loop spent about a fifth of each spring on moving
 //! values (spills of the edge vector around the table lookup, the warm-start pointer
 //! kept on the stack, masks rebuilt for every spring, node addresses from two
-//! multiplies each), and small source changes move that cost unpredictably
-//! (`docs/performance.md`, "The spring loop in assembly"). Here every register is
+//! multiplies each), and small source changes moved that cost unpredictably
+//! (`docs/performance.md`, "The M4F's loops in assembly"). Here every register is
 //! chosen: an edge is one `ldm`, a node's three components one `ldm`/`stm`, and the
 //! loop keeps the edge and warm-start pointers in registers.
 //!
-//! The arithmetic is [`super::wide`]'s `spring`, step for step; its comments give the
-//! formats and ranges. Only for tables of a power-of-two segment count (the index is a
-//! bit field); others take the portable loop.
+//! The arithmetic is [`super::wide`]'s `spring` and `integrate`, step for step; their
+//! comments give the formats and ranges. One precondition the portable loop does not
+//! have: no displacement or stored velocity is `i32::MIN` (a spring to the ground
+//! subtracts `u_a`'s and `v_a`'s products instead of negating them). Every writer of the
+//! nodes holds both within ±2³⁰ (the integrator, `Solver::set_state`, the held drive, a
+//! window's shift, which copies them), so the solver never holds one. Only for tables of
+//! a power-of-two segment count (the index is a bit field); others take the portable
+//! loop.
 
 use crate::q::V3;
 use crate::state::Node;
