@@ -102,9 +102,9 @@ impl NarrowLine {
 }
 
 /// [`ForceTable::force_within::<26>`](crate::table::ForceTable::force_within) for the
-/// narrow spring: the same segment, position and cubic (the index scale has 15 significant bits, so its product is two 32-bit
-/// multiplies), and the straight lines with their slopes to 15 bits (2⁻¹⁵ relative),
-/// held at ±1024 N. Raw Q24 strain in, within ±8 (a spring's strain is within (−2.5, 1));
+/// narrow spring: the same segment, position and cubic (the index scale has 15
+/// significant bits, so its product is two 32-bit multiplies), and the straight lines
+/// with their slopes to 15 bits (2⁻¹⁵ relative), held at ±1024 N. Raw Q24 strain in, within ±8 (a spring's strain is within (−2.5, 1));
 /// raw Q20 N out, within ±64 N.
 #[inline(always)]
 pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain) -> i32 {
