@@ -1,6 +1,6 @@
 //! The M4F's spring loop and integrator are assembly (`mccs/src/arith/wide_dsp.rs`);
-//! this checks them against the portable Rust loops they replace, bit for bit, on the core itself, before
-//! anything is measured, on two sets of states:
+//! this checks them against the portable Rust loops they replace, bit for bit, on the
+//! core itself, before anything is measured, on two sets of states:
 //! - the standard N = 5 patch (61 springs, 25 of them between two free nodes) at random
 //!   displacements from 0.25 µm to past the 64 mm clamp;
 //! - 48 springs of their own (rest lengths 1 … 10 mm, random directions; half of them
@@ -19,8 +19,8 @@
 //! state runs a few loops in a row with the integrator between them (its velocity and
 //! displacement holds included), so that the warm start also converges. Prints
 //! `KERNEL core=<c> states=<n> springs=<n> mismatches=<n>`; a mismatch exits with
-//! failure. On the M3 both sides are the portable loop (the check is then trivially
-//! met, and says so); the M0's arithmetic is [`mccs::Narrow`], not checked here.
+//! failure. On the M3 both sides are the portable loop, so there its line shows only
+//! that the check runs; the M0's arithmetic is [`mccs::Narrow`], not checked here.
 
 use super::fw_common::exit;
 use mccs::arith::{wide, ArithTable, StepSpec};
@@ -184,7 +184,8 @@ fn run(table: &ForceTable64) {
     }
 }
 
-/// Table 2's table, and the two variants that reach the holds (module docs).
+/// Table 2's table, and the four variants that reach the holds and saturations (module
+/// docs).
 fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 5] {
     let raw = *table.raw();
     let mut large = raw;
@@ -222,8 +223,8 @@ struct Singles {
 }
 
 /// `SINGLE` springs at random directions and rest lengths of 1.01 … 10 mm (the
-/// topology's least is 1 mm), each with nodes
-/// of its own: the first half to the ground, the second between two free nodes.
+/// topology's least is 1 mm), each with nodes of its own: the first half to the ground,
+/// the second between two free nodes.
 fn single_springs(rng: &mut Rng) -> Option<Singles> {
     let mut topo = Topology::new();
     let mut springs = core::array::from_fn(|_| Single {
