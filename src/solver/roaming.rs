@@ -7,6 +7,7 @@ use crate::arith::Arith;
 use crate::cap::Cap;
 use crate::proxy::{CapFrame, Proxy, ProxyError};
 use crate::q::{self, mul_wide, sat, V3};
+use crate::state::Node;
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
 use crate::window::{continued, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
@@ -143,7 +144,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                     .unwrap_or(NONE)
             })
         });
-        // A shift on a cap moves the springs' geometry in place (`move_cap_geometry`):
+        // A shift on a cap moves the springs' geometry and warm-start values in place
+        // (`move_cap_springs`):
         // forwards along +x and +y, where every spring's source comes after it, and
         // backwards along −x and −y. The standard patch's springs are laid out cell by
         // cell, so this holds; a topology for which it would not is refused.
@@ -224,32 +226,51 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
-    /// On a cap, at a shift along direction `dir`: each spring's rest geometry taken from
-    /// the spring it continues (negated if that one runs the other way), else computed
-    /// from the window's rest heights. In place, in the order [`Solver::window_as`]
-    /// checked: every source is read before it is overwritten.
-    fn move_cap_geometry<const CAP: bool>(&mut self, window: &Window<EDGES, CAP>, dir: usize) {
-        let edges = self.topo.edges_mut();
-        let count = edges.len();
+    /// On a cap, at a shift along direction `dir`: each spring's rest geometry and
+    /// warm-start value taken from the spring it continues (its direction negated if that
+    /// one runs the other way), else the geometry computed from the window's rest heights
+    /// and the value at rest. In place, in the order [`Solver::window_as`] checked: every
+    /// source is read before it is overwritten.
+    fn move_cap_springs<const CAP: bool>(&mut self, window: &Window<EDGES, CAP>, dir: usize) {
         let Some(map) = window.maps.get(dir) else {
             return;
         };
-        let step = |edges: &mut [Edge], e: usize| {
-            let (source, reversed) = continued(map.get(e).copied().unwrap_or(NONE));
-            let (d, inv_len) = match edges.get(source) {
-                Some(s) if reversed => (s.dir.map(i32::saturating_neg), s.inv_len),
-                Some(s) => (s.dir, s.inv_len),
-                None => edge_geometry(window, window.ends.get(e).copied().unwrap_or(0)),
-            };
-            if let Some(edge) = edges.get_mut(e) {
-                edge.dir = d;
-                edge.inv_len = inv_len;
+        let edges = self.topo.edges_mut();
+        let count = edges.len();
+        let warm = &mut self.warm;
+        // The entry's spring (`NONE` names none: its index is past every spring) is
+        // copied out before the edge is written; each path writes the edge itself, so
+        // that a copy does not go through the computed path's memory.
+        let mut step = |e: usize| {
+            let entry = map.get(e).copied().unwrap_or(NONE);
+            let source = (entry & !FLIP) as usize;
+            let value = warm.get(source).copied().unwrap_or(A::REST);
+            if let Some(w) = warm.get_mut(e) {
+                *w = value;
+            }
+            if let Some(&Edge { dir, inv_len, .. }) = edges.get(source) {
+                let dir = if entry & FLIP != 0 {
+                    dir.map(i32::saturating_neg)
+                } else {
+                    dir
+                };
+                if let Some(edge) = edges.get_mut(e) {
+                    edge.dir = dir;
+                    edge.inv_len = inv_len;
+                }
+            } else {
+                let (dir, inv_len) =
+                    edge_geometry(window, window.ends.get(e).copied().unwrap_or(0));
+                if let Some(edge) = edges.get_mut(e) {
+                    edge.dir = dir;
+                    edge.inv_len = inv_len;
+                }
             }
         };
         if dir % 2 == 0 {
-            (0..count).for_each(|e| step(edges, e));
+            (0..count).for_each(&mut step);
         } else {
-            (0..count).rev().for_each(|e| step(edges, e));
+            (0..count).rev().for_each(&mut step);
         }
     }
 
@@ -326,23 +347,32 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         d: [i32; 2],
         proxy: &mut Proxy,
     ) {
-        let n = window.n;
-        let node = |a: i32, b: i32| surface_node(n as usize, a, b);
-        // In the direction of the shift, so that every source is read before it is
-        // overwritten.
-        let order = |s: i32, k: i32| if s > 0 { k } else { n - 1 - k };
-        for ka in 0..n {
-            for kb in 0..n {
-                let (a, b) = (order(d[0], ka), order(d[1], kb));
-                let Some(i) = node(a, b) else {
-                    continue;
-                };
-                let (u, v): (V3, V3) = node(a + d[0], b + d[1])
-                    .and_then(|j| self.nodes.get(j))
-                    .map_or(([0; 3], [0; 3]), |x| (x.u, x.v));
-                if let Some(x) = self.nodes.get_mut(i) {
-                    x.u = u;
-                    x.v = v;
+        // The free nodes are the inner `m × m` of the window's surface, node `(i, j)` at
+        // `1 + i m + j` (`surface_node`); node `(i, j)` takes `(i, j) + d`'s state, which
+        // is `d₀ m + d₁` slots on, or rest when that is the fixed ring. In the direction
+        // of the shift, so that every source is read before it is overwritten.
+        let m = window.n - 2;
+        let offset = d[0] * m + d[1];
+        let order = |s: i32, k: i32| if s > 0 { k } else { m - 1 - k };
+        for ki in 0..m {
+            let i = order(d[0], ki);
+            let row_in = (0..m).contains(&(i + d[0]));
+            for kj in 0..m {
+                let j = order(d[1], kj);
+                let slot = 1 + i * m + j;
+                // Each path writes the node itself (a merged value would go through the
+                // stack).
+                let source = (row_in && (0..m).contains(&(j + d[1])))
+                    .then(|| self.nodes.get((slot + offset) as usize))
+                    .flatten();
+                if let Some(&Node { u, v, .. }) = source {
+                    if let Some(x) = self.nodes.get_mut(slot as usize) {
+                        x.u = u;
+                        x.v = v;
+                    }
+                } else if let Some(x) = self.nodes.get_mut(slot as usize) {
+                    x.u = [0; 3];
+                    x.v = [0; 3];
                 }
             }
         }
@@ -353,12 +383,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             _ => 3,
         };
         if CAP && window.cap.is_some() {
+            // The warm-start values move with the geometry, in place.
             self.shift_cap(window, d, dir);
-        }
-        let old = self.warm;
-        for (e, w) in self.warm.iter_mut().enumerate() {
-            let from = window.maps[dir].get(e).copied().unwrap_or(NONE);
-            *w = old.get(continued(from).0).copied().unwrap_or(A::REST);
+        } else {
+            let old = self.warm;
+            for (e, w) in self.warm.iter_mut().enumerate() {
+                let from = window.maps[dir].get(e).copied().unwrap_or(NONE);
+                *w = old.get(continued(from).0).copied().unwrap_or(A::REST);
+            }
         }
         proxy.shift_grid(d);
         window.corner = [window.corner[0] + d[0], window.corner[1] + d[1]];
@@ -366,7 +398,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     }
 
     /// A shift's part on a cap: the rest heights move with the window (the `n` entering
-    /// ones computed), then the springs' rest geometry ([`Self::move_cap_geometry`]).
+    /// ones computed), then the springs' rest geometry and warm-start values
+    /// ([`Self::move_cap_springs`]).
     #[inline(never)]
     fn shift_cap<const CAP: bool>(
         &mut self,
@@ -378,27 +411,44 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let Some(cap) = window.cap else {
             return;
         };
-        let order = |s: i32, k: i32| if s > 0 { k } else { n - 1 - k };
-        for ka in 0..n {
-            for kb in 0..n {
-                let (a, b) = (order(d[0], ka), order(d[1], kb));
-                let (sa, sb) = (a + d[0], b + d[1]);
-                let z = if (0..n).contains(&sa) && (0..n).contains(&sb) {
-                    window
-                        .heights
-                        .get((sa * n + sb) as usize)
-                        .copied()
-                        .unwrap_or(0)
-                } else {
-                    cap.height(window.corner[0] + sa, window.corner[1] + sb)
-                };
-                if let Some(slot) = window.heights.get_mut((a * n + b) as usize) {
+        // Height `(a, b)` at `a n + b` takes `(a, b) + d`'s: whole rows move along x, each
+        // row's heights along y, in the direction of the shift (every source is read
+        // before it is overwritten); the entering row or column is the cap's. (Indexed
+        // loops: `copy_within` would leave a panic path in the tick.)
+        let nu = n.max(0) as usize;
+        let nn = nu * nu;
+        let h = &mut window.heights;
+        let mut take = |to: usize, from: usize| {
+            if let (Some(&z), true) = (h.get(from), to < nn) {
+                if let Some(slot) = h.get_mut(to) {
                     *slot = z;
                 }
             }
+        };
+        match d {
+            [1, 0] => (0..nn.saturating_sub(nu)).for_each(|i| take(i, i + nu)),
+            [-1, 0] => (nu..nn).rev().for_each(|i| take(i, i - nu)),
+            [0, 1] => (0..nn).step_by(nu.max(1)).for_each(|r| {
+                (r..r + nu.saturating_sub(1)).for_each(|i| take(i, i + 1));
+            }),
+            _ => (0..nn).step_by(nu.max(1)).for_each(|r| {
+                (r + 1..r + nu).rev().for_each(|i| take(i, i - 1));
+            }),
+        }
+        for k in 0..n {
+            let (a, b) = match d {
+                [1, 0] => (n - 1, k),
+                [-1, 0] => (0, k),
+                [0, 1] => (k, n - 1),
+                _ => (k, 0),
+            };
+            let z = cap.height(window.corner[0] + a + d[0], window.corner[1] + b + d[1]);
+            if let Some(h) = window.heights.get_mut((a * n + b) as usize) {
+                *h = z;
+            }
         }
         self.set_cap_heights(window);
-        self.move_cap_geometry(window, dir);
+        self.move_cap_springs(window, dir);
     }
 }
 
