@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where a firmware's instructions go, per function, from QEMU's own execution log.
 
-    scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines]
+    scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines] [--mix PATTERN]
 
 Builds the release firmware `bin` (default `haptic`) for the core, runs it in QEMU with
 the runner's `-icount` and `-d in_asm,exec,nochain` (every translated block once, every
@@ -12,6 +12,11 @@ inlined into one function does). The counts are QEMU's translated
 instructions, the same measure as the bench's (no cycles). A long run logs a line per
 executed block: the log is read through a pipe, never stored (the haptic demo's 4000
 ticks take about a minute on this machine).
+
+With `--mix PATTERN`, the instructions executed in the functions whose name contains
+PATTERN instead, per mnemonic and per call (the calls are the runs of the function's
+first executed block, its entry; the run stops once 256 calls have returned): `scripts/profile.py m0 bench --mix entry::spring` is where the M0's one
+spring goes (docs/performance.md, "Where a spring's instructions go (M0)").
 """
 import collections
 import json
@@ -38,8 +43,13 @@ def main():
         top = int(sys.argv[sys.argv.index("--top") + 1])
         args = [a for a in args if a != str(top)]
     by_line = "--lines" in sys.argv
+    mix = None
+    if "--mix" in sys.argv:
+        mix = sys.argv[sys.argv.index("--mix") + 1]
+        args = [a for a in args if a != mix]
     if not args or args[0] not in TARGETS:
-        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines]", file=sys.stderr)
+        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines] [--mix PATTERN]",
+              file=sys.stderr)
         sys.exit(2)
     core, binary = args[0], (args[1] if len(args) > 1 else "haptic")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -59,6 +69,7 @@ def main():
         qemu = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
         sizes, names, addrs, runs = {}, {}, {}, collections.Counter()
+        mnemonics, seen, entry = {}, {}, None
         trace = re.compile(r"^Trace \d+: 0x[0-9a-f]+ \[[0-9a-f]+/([0-9a-f]+)/")
         with open(fifo) as log:
             block, count, name = None, 0, "?"
@@ -66,7 +77,19 @@ def main():
                 if line.startswith("Trace"):
                     m = trace.match(line)
                     if m:
-                        runs[int(m.group(1), 16)] += 1
+                        pc = int(m.group(1), 16)
+                        runs[pc] += 1
+                        # With --mix: the function's first executed block is its
+                        # entry; once 256 calls have run (the bench measures each case
+                        # over 256) and the last has returned, the rest of the run is
+                        # not needed.
+                        if mix is not None and pc not in seen:
+                            seen[pc] = pattern_in(mix, names.get(pc, ""))
+                            if seen[pc] and entry is None:
+                                entry = pc
+                        if entry is not None and runs[entry] >= 256 and not seen[pc]:
+                            qemu.kill()
+                            break
                 elif line.startswith("IN:"):
                     name = line[3:].strip() or "?"
                     block, count = None, 0
@@ -75,9 +98,13 @@ def main():
                     if block is None:
                         block, addrs[pc] = pc, []
                     addrs[block].append(pc)
+                    mnemonics[pc] = mnemonic(line)
                     count += 1
                     sizes[block], names[block] = count, name
         qemu.wait()
+    if mix is not None:
+        print_mix(core, binary, mix, names, addrs, runs, mnemonics, entry)
+        return
     per = collections.Counter()
     if by_line:
         each = collections.Counter()
@@ -94,6 +121,38 @@ def main():
     print(f"PROFILE core={core} bin={binary} instructions={total}")
     for name, n in per.most_common(top):
         print(f"{n:>12} {100.0 * n / max(total, 1):6.2f} %  {demangle(name)}")
+
+
+def mnemonic(line):
+    """The mnemonic of one line of QEMU's `in_asm` log (`0x…:  <encoding>  <mnemonic> …`),
+    without the condition or width suffix (`ldr.w` is `ldr`)."""
+    words = line.split(":", 1)[1].split()
+    words = [w for w in words if not re.fullmatch(r"[0-9a-f]{4}|[0-9a-f]{8}", w)]
+    return words[0].split(".")[0] if words else "?"
+
+
+def pattern_in(pattern, name):
+    """Whether a block's function name contains `pattern` (demangled)."""
+    return pattern in demangle(name)
+
+
+def print_mix(core, binary, pattern, names, addrs, runs, mnemonics, entry):
+    """The instructions executed in the functions named like `pattern`, per mnemonic and
+    per call, most first."""
+    blocks = [pc for pc in runs if pattern_in(pattern, names.get(pc, ""))]
+    if not blocks:
+        sys.exit(f"profile: no executed function matches {pattern!r}")
+    calls = runs[entry]
+    each = collections.Counter()
+    for pc in blocks:
+        for a in addrs.get(pc, []):
+            each[mnemonics.get(a, "?")] += runs[pc]
+    total = sum(each.values())
+    function = demangle(names[entry])
+    print(f"MIX core={core} bin={binary} function={function} calls={calls} "
+          f"instructions_per_call={total / calls:.1f}")
+    for m, n in each.most_common():
+        print(f"{n / calls:>8.1f}  {m}")
 
 
 def symbolize(elf, addresses):
