@@ -327,6 +327,49 @@ pub fn opaque(mut x: i32) -> i32 {
     x
 }
 
+/// `x` held within `[−2^B, 2^B − 1]` (`1 ≤ B ≤ 30`): `x.clamp(−2^B, 2^B − 1)`. On the
+/// Cortex-M0 in assembly: a value within costs a sign extension from bit `B` (two
+/// shifts), a compare and a branch, with no bound loaded from a literal (seven
+/// instructions with one from the compiler); a value outside takes `sign ^ (2^B − 1)`.
+/// The bench firmware checks it against `clamp` on the M0 before it measures
+/// (`firmware/src/bin/bench/hold_check.rs`).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub fn hold<const B: u32>(x: i32) -> i32 {
+    const { assert!(B >= 1 && B <= 30) };
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    {
+        let mut x = x;
+        // SAFETY: registers only (`x` and a scratch one, both declared; the flags are
+        // not declared preserved), no memory, no stack; the branch stays within the
+        // block.
+        unsafe {
+            core::arch::asm!(
+                "lsls {t}, {x}, #{up}",
+                "asrs {t}, {t}, #{up}",
+                "cmp {t}, {x}",
+                "beq 2f",
+                "asrs {x}, {x}, #31",
+                "movs {t}, #1",
+                "lsls {t}, {t}, #{b}",
+                "subs {t}, {t}, #1",
+                "eors {x}, {t}",
+                "2:",
+                x = inout(reg) x,
+                t = out(reg) _,
+                up = const 31 - B,
+                b = const B,
+                options(pure, nomem, nostack),
+            );
+        }
+        x
+    }
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    {
+        x.clamp(-(1 << B), (1 << B) - 1)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     /// `mul_weight` against the exact product, over weights 0 … 2¹⁶ and values up to ±2³¹.

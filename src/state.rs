@@ -11,7 +11,9 @@ use crate::q::V3;
 use crate::topology::{Edge, Topology, GROUND};
 
 /// Largest displacement from rest, mm in Q24: just under 64 mm.
-pub const DISP_LIMIT: i32 = 1 << 30;
+pub const DISP_LIMIT: i32 = 1 << DISP_LIMIT_BITS;
+/// [`DISP_LIMIT`] as a power of two.
+pub const DISP_LIMIT_BITS: u32 = 30;
 /// Largest speed, mm/s in Q16: just under 16384 mm/s.
 pub const VEL_LIMIT: i32 = 1 << 30;
 /// [`VEL_LIMIT`] in mm/s.

@@ -16,7 +16,7 @@
 //! - the integrator's coefficients are 16-bit operands with run-time shifts
 //!   ([`NarrowStep`]), with a fixed-shift fast path when every force's velocity step fits.
 
-use super::{Arith, ArithTable, StepSpec, SPRING_FORCE_LIMIT};
+use super::{Arith, ArithTable, StepSpec, SPRING_FORCE_BITS};
 use crate::q::{self, V3};
 use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, VEL_LIMIT_MM_S};
 use crate::table::ForceTable;
@@ -234,7 +234,7 @@ fn spring<const S: usize, const UNIT: bool>(
     // (|d + w| < 3).
     let w: V3 = core::array::from_fn(|k| {
         let qk = q::mul_s::<16>(ub[k].wrapping_sub(ua[k]), inv);
-        d[k].wrapping_add(qk).clamp(-(2 << 23), (2 << 23) - 1)
+        q::hold::<24>(d[k].wrapping_add(qk))
     });
     // s = |w|² − 1 = Σ q (d + w): Q23 · Q13 / 2¹⁶ = Q20, each term ≤ 9.
     let s = q::opaque(
@@ -283,7 +283,6 @@ fn spring<const S: usize, const UNIT: bool>(
         } else {
             q::mul_s::<16>(dv, mul) >> sh
         };
-        push.wrapping_add(damp)
-            .clamp(-SPRING_FORCE_LIMIT, SPRING_FORCE_LIMIT - 1)
+        q::hold::<SPRING_FORCE_BITS>(push.wrapping_add(damp))
     })
 }

@@ -4,7 +4,7 @@
 use super::NarrowDamping;
 use crate::arith::StepSpec;
 use crate::q;
-use crate::state::{Node, DISP_LIMIT, VEL_LIMIT_MM_S};
+use crate::state::{Node, DISP_LIMIT_BITS, VEL_LIMIT_MM_S};
 use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
 
 /// The integrator's coefficients as 16-bit operands with run-time shifts (each to 2⁻¹⁵
@@ -164,7 +164,7 @@ pub(super) fn integrate<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
         } else {
             q::mul_s::<14>(vv, c.fast_hh) >> c.fast_hh_sh
         };
-        n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
+        n.u[j] = q::hold::<DISP_LIMIT_BITS>(u.wrapping_add(du));
         n.v[j] = v_new;
     }
     n.f = [0; 3];

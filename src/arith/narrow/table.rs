@@ -132,5 +132,5 @@ pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain
         let c = r.segments.get(i).unwrap_or(&NO_SEGMENT);
         cubic_value(r, c, pos & 0x7FFF)
     };
-    f.clamp(-(1 << 26), (1 << 26) - 1)
+    q::hold::<26>(f)
 }

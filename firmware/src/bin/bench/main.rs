@@ -23,6 +23,8 @@ mod cases;
 #[cfg(target_os = "none")]
 mod harness;
 #[cfg(target_os = "none")]
+mod hold_check;
+#[cfg(target_os = "none")]
 mod kernel_check;
 #[cfg(target_os = "none")]
 mod report;
@@ -32,7 +34,7 @@ mod firmware {
     use super::fw_common::exit;
     use super::harness::Harness;
     use super::report::{check_budgets, fits, largest_patch, Figures, Steps};
-    use super::{cases, harness, kernel_check};
+    use super::{cases, harness, hold_check, kernel_check};
     use core::hint::black_box;
     use cortex_m_rt::entry;
     use mccs::{ForceTable64, Length, Solver};
@@ -52,8 +54,10 @@ mod firmware {
             black_box(0u32);
         });
         let table = black_box(TABLE2);
-        // The M4F's assembly spring loop against the portable one, before any figure.
+        // The assembly against the Rust it replaces, before any figure: the M4F's spring
+        // loop and integrator, the M0's holds.
         kernel_check::check(&table);
+        hold_check::check();
         // These two take off their own harness (the empty call included).
         figs.report(
             "force_and_stiffness",
