@@ -67,11 +67,12 @@ pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) ends: [u32; EDGES],
 }
 
-/// The spring a map entry names, and whether it runs the other way (`NONE`: an index past
-/// every spring, so that a lookup finds nothing).
+/// The spring a map entry names, and whether it runs the other way. `NONE`'s index,
+/// 2¹⁵ − 1, is past every spring (a window has fewer: `Solver::window_as` asserts it),
+/// so that a lookup finds nothing and its flag is never read.
 #[inline(always)]
 pub(crate) fn continued(entry: u16) -> (usize, bool) {
-    ((entry & !FLIP) as usize, entry != NONE && entry & FLIP != 0)
+    ((entry & !FLIP) as usize, entry & FLIP != 0)
 }
 
 /// Two ends `(a, b, layer)` (grid coordinates 0 … 127, layer 1: the base) in one word.

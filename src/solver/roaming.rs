@@ -124,6 +124,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 .map_or([[-9; 3]; 2], |edge| self.keys(edge, n, s))
         });
         let count = self.topo.edges().len().min(EDGES);
+        // A map entry is a spring's index below `FLIP`, and `NONE`'s index names none.
+        const { assert!(EDGES < (NONE & !FLIP) as usize) };
         let maps = DIRECTIONS.map(|d| {
             core::array::from_fn(|e| {
                 if e >= count {
@@ -238,18 +240,16 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let edges = self.topo.edges_mut();
         let count = edges.len();
         let warm = &mut self.warm;
-        // The entry's spring (`NONE` names none: its index is past every spring) is
-        // copied out before the edge is written; each path writes the edge itself, so
-        // that a copy does not go through the computed path's memory.
+        // The source spring is copied out before the edge is written; each path writes
+        // the edge itself, so that a copy does not go through the computed path's memory.
         let mut step = |e: usize| {
-            let entry = map.get(e).copied().unwrap_or(NONE);
-            let source = (entry & !FLIP) as usize;
+            let (source, reversed) = continued(map.get(e).copied().unwrap_or(NONE));
             let value = warm.get(source).copied().unwrap_or(A::REST);
             if let Some(w) = warm.get_mut(e) {
                 *w = value;
             }
             if let Some(&Edge { dir, inv_len, .. }) = edges.get(source) {
-                let dir = if entry & FLIP != 0 {
+                let dir = if reversed {
                     dir.map(i32::saturating_neg)
                 } else {
                     dir
@@ -419,7 +419,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let nn = nu * nu;
         let h = &mut window.heights;
         let mut take = |to: usize, from: usize| {
-            if let (Some(&z), true) = (h.get(from), to < nn) {
+            if let Some(&z) = h.get(from) {
                 if let Some(slot) = h.get_mut(to) {
                     *slot = z;
                 }

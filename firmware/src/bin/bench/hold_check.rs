@@ -8,6 +8,7 @@
 //! line shows only that the check runs.
 
 use super::fw_common::exit;
+use super::rng::Rng;
 use mccs::q::hold;
 use mccs_firmware::target::CORE;
 
@@ -15,7 +16,7 @@ use mccs_firmware::target::CORE;
 const RANDOM: u32 = 20_000;
 
 /// The values `hold::<B>` gets that differ from `clamp`, and how many were tried.
-fn check_width<const B: u32>(seed: &mut u32) -> (u32, u32) {
+fn check_width<const B: u32>(rng: &mut Rng) -> (u32, u32) {
     let (lo, hi) = (-(1i32 << B), (1i32 << B) - 1);
     let mut tried = 0;
     let mut wrong = 0;
@@ -32,12 +33,8 @@ fn check_width<const B: u32>(seed: &mut u32) -> (u32, u32) {
         one(x);
     }
     for _ in 0..RANDOM {
-        // xorshift; the magnitude from 2⁰ to 2³¹.
-        let mut x = *seed;
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        *seed = x;
+        // The magnitude from 2⁰ to 2³¹.
+        let x = rng.next();
         one((x as i32) >> (x & 31));
     }
     (tried, wrong)
@@ -46,11 +43,11 @@ fn check_width<const B: u32>(seed: &mut u32) -> (u32, u32) {
 /// Runs the check and exits with failure on a mismatch.
 #[inline(never)]
 pub fn check() {
-    let mut seed = 0x9E37_79B9;
+    let mut rng = Rng(0x9E37_79B9);
     let widths = [
-        check_width::<24>(&mut seed),
-        check_width::<26>(&mut seed),
-        check_width::<30>(&mut seed),
+        check_width::<24>(&mut rng),
+        check_width::<26>(&mut rng),
+        check_width::<30>(&mut rng),
     ];
     let values: u32 = widths.iter().map(|w| w.0).sum();
     let mismatches: u32 = widths.iter().map(|w| w.1).sum();

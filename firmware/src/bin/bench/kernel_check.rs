@@ -23,6 +23,7 @@
 //! that the check runs; the M0's arithmetic is [`mccs::Narrow`], not checked here.
 
 use super::fw_common::exit;
+use super::rng::Rng;
 use mccs::arith::{wide, ArithTable, StepSpec};
 use mccs::state::Node;
 use mccs::{Arith, End, ForceTable64, Topology, Wide};
@@ -34,30 +35,6 @@ const STATES: u32 = 400;
 const ROUNDS: usize = 3;
 /// The single springs: half to the ground, half between two free nodes.
 const SINGLE: usize = 48;
-
-/// A xorshift generator: the check is the same on every run.
-struct Rng(u32);
-
-impl Rng {
-    fn next(&mut self) -> u32 {
-        let mut x = self.0;
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        self.0 = x;
-        x
-    }
-
-    /// A value within about `±2^bits` (`bits` ≤ 31).
-    fn within(&mut self, bits: u32) -> i32 {
-        (self.next() as i32) >> (31 - bits.min(31))
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next() as f64 / 4_294_967_296.0)
-    }
-}
 
 /// Both loops on copies of one state, `ROUNDS` times; whether they ever differ.
 fn differs<const N: usize, const E: usize>(

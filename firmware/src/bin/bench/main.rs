@@ -28,6 +28,8 @@ mod hold_check;
 mod kernel_check;
 #[cfg(target_os = "none")]
 mod report;
+#[cfg(target_os = "none")]
+mod rng;
 
 #[cfg(target_os = "none")]
 mod firmware {
