@@ -154,15 +154,15 @@ struct Tally {
     other: usize,
 }
 
-/// Whether the fixed-point formats alone put the bound out of reach: one Q20 force LSB
-/// (9.5e-7 N), or one Q16 LSB of the tension line's slope over the domain's tension end
-/// (2⁻¹⁶ × 0.5 = 7.6e-6 N), is more than the force bound (`F(0.95)` below 0.048 N, or
-/// below 0.38 N); or one Q16 stiffness LSB (1.5e-5) is more than the stiffness bound of
-/// the law's smallest stiffness on the domain (below 0.015 N per unit strain).
+/// Whether the output formats alone put the bound out of reach: one Q20 force LSB
+/// (9.5e-7 N) is more than the force bound (`F(0.95)` below 0.048 N), or one Q16
+/// stiffness LSB (1.5e-5) more than the stiffness bound of the law's smallest stiffness
+/// on the domain (below 0.015 N per unit strain). (The tension line's Q16 slope, whose
+/// LSB over the domain's tension end is 7.6e-6 N, is not such a limit: the builder
+/// also tabulates the tension end, `Align::FromDomain`.)
 fn format_limited(p: &Params, bound: &TableBound) -> bool {
     let r = Reference::new(p).unwrap();
-    let tension_slope_lsb = STIFFNESS_LSB * DOMAIN.0.abs();
-    FORCE_LSB.max(tension_slope_lsb) > bound.force * r.force(DOMAIN.1)
+    FORCE_LSB > bound.force * r.force(DOMAIN.1)
         || STIFFNESS_LSB > bound.stiffness * smallest_stiffness(&r)
 }
 
@@ -329,6 +329,50 @@ fn the_inner_corner_is_on_a_knot_and_meets_the_bound() {
         let best = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT);
         assert!(best.is_ok(), "k_p/k = {ratio}, P = {preload} F_T: {best:?}");
     }
+}
+
+/// A small spring (Table 2 with both shear moduli scaled to `F(0.95)` ≈ 0.2 N, no
+/// preload, and `k` 0.9 LSB above a Q16 value): the line below the kink, its slope `k`
+/// floored to Q16, misses the force bound by itself at the domain's tension end (0.9 of
+/// a slope LSB there is 6.9e-6 N, 3.4e-5 of 0.2 N), so a device's table (from the kink)
+/// is over it; `mccs table`'s tabulates the tension end (from the domain's start, a
+/// knot on `Δ(F_T)`) and meets it, as the independent reference confirms. (It was
+/// refused before that placement.)
+#[test]
+fn a_small_springs_tension_end_is_tabulated() {
+    let mut p = Params::TABLE2;
+    let r = Reference::new(&p).unwrap();
+    let k = r.k * 0.2 / r.force(DOMAIN.1) / STIFFNESS_LSB;
+    let scale = (k.floor() + 0.9) * STIFFNESS_LSB / r.k;
+    p.cone.shear_modulus *= scale;
+    p.linear.shear_modulus *= scale;
+    let r = Reference::new(&p).unwrap();
+    assert!((r.force(DOMAIN.1) - 0.2).abs() < 1e-3 && r.strain_t() > DOMAIN.0);
+    let law = mccs::Law::new(&p).unwrap();
+    let device = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1)
+        .unwrap()
+        .measured(&law, DOMAIN.0, DOMAIN.1);
+    assert!(device.tabulated_range().0.to_num::<f64>() > 0.0);
+    assert!(
+        device.max_error().unwrap().force > TableBound::PRODUCT.force,
+        "{:?}",
+        device.max_error()
+    );
+    let best = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("the tabulated tension end meets the bound");
+    assert!(best.tabulated_range().0.to_num::<f64>() <= DOMAIN.0);
+    let m = independent(&p, &best);
+    println!(
+        "TENSIONEND case=small_spring device_force={:.1e} force={:.1e} stiffness={:.1e}",
+        device.max_error().unwrap().force,
+        m.force,
+        m.stiffness
+    );
+    assert!(m.within(&TableBound {
+        force: 1.02 * TableBound::PRODUCT.force + 2.0 * FORCE_LSB / r.force(DOMAIN.1),
+        stiffness: 1.02 * TableBound::PRODUCT.stiffness
+            + 2.0 * STIFFNESS_LSB / smallest_stiffness(&r),
+    }));
 }
 
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device

@@ -56,13 +56,16 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// Builds the table for `law` over `[from, to]` on each grid placement the builder
-    /// knows (a knot on the inner corner `Δ(max(F_T, P))` or not, and where the grid then
-    /// ends against the solid point), measures each ([`measure`]), and keeps the one
-    /// with the least error relative to [`TableBound::PRODUCT`] (the larger of its two
-    /// ratios), measured. No placement is best for every spring: the knot on the corner
+    /// knows (a knot on the inner corner `Δ(max(F_T, P))` or not, where the grid then
+    /// ends against the solid point, and a grid from the domain's start instead of the
+    /// law's first kink), measures each ([`measure`]), and keeps the one with the least
+    /// error relative to [`TableBound::PRODUCT`] (the larger of its two ratios),
+    /// measured. No placement is best for every spring: the knot on the corner
     /// lengthens the step, and the grid may then end past `Δ(F_C)` with the solid
-    /// point's corner inside its last segment. Up to four builds and measurements: what
-    /// `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
+    /// point's corner inside its last segment; a grid from the domain's start spends
+    /// segments on the straight line, but a small spring's line slope in Q16 can cost
+    /// more than that. Up to five builds and measurements: what `mccs table` and
+    /// [`ForceTable::with_bound`] do, not for a device's start-up.
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
@@ -70,11 +73,15 @@ impl<const S: usize> ForceTable<S> {
         // Without an inner corner inside the table every placement is the same grid
         // (the same table: its range and index say where every knot is): each distinct
         // one is measured once.
-        let mut tried = [None; 4];
-        for (n, align) in [Align::Shortest, Align::NearSolid, Align::Off, Align::Plain]
-            .into_iter()
-            .enumerate()
-        {
+        const PLACEMENTS: [Align; 5] = [
+            Align::Shortest,
+            Align::NearSolid,
+            Align::Off,
+            Align::Plain,
+            Align::FromDomain,
+        ];
+        let mut tried = [None; PLACEMENTS.len()];
+        for (n, align) in PLACEMENTS.into_iter().enumerate() {
             match Self::on_grid(law, from, to, align) {
                 Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
                 Ok(t) => {
@@ -160,6 +167,14 @@ enum Align {
     Off,
     /// No knot on the inner corner: the grid uniform from the table's start to its end.
     Plain,
+    /// The table from the domain's start (when that is below the law's first kink), not
+    /// from the kink: the tension line inside the domain is tabulated (a cubic holds a
+    /// straight line to its coefficients' LSB) instead of being the line of slope `k`
+    /// in Q16, whose LSB, over the half strain of the default domain's tension end, is
+    /// 7.6e-6 N: more than the force bound of a spring below 0.38 N at `F(0.95)`. The
+    /// grid puts a knot on the preload's `Δ(P)` (on `Δ(F_T)` without one), the law's
+    /// slope kink, with a whole number of segments below it.
+    FromDomain,
 }
 
 /// Where the knots are: `lo + i · step`, `i = 0 … S`, with the grid's index in the
@@ -169,7 +184,8 @@ struct Grid {
     /// ends at the solid point `Δ(F_C)` (the exact line above).
     at_kink: bool,
     at_solid: bool,
-    /// The knot on the preload's slope kink `Δ(P)`, if inside the table.
+    /// The knot on the preload's slope kink `Δ(P)` (or, on a grid from the domain's
+    /// start without a preload, on `Δ(F_T)`, where `P = F_T`), if inside the table.
     kink_knot: Option<usize>,
     /// Whether the first knot moved below the table's start to put a knot on `Δ(P)`.
     grid_moved: bool,
@@ -203,7 +219,8 @@ impl Grid {
         let (e_t, e_c) = (law.strain_t(), law.strain_c());
         // Whether the table starts at the kink and ends at the solid point (exact lines
         // beyond), decided before the ends are rounded to the strain format.
-        let (at_kink, at_solid) = (from <= e_t, to >= e_c);
+        let from_domain = align == Align::FromDomain && from < e_t;
+        let (at_kink, at_solid) = (from <= e_t && !from_domain, to >= e_c);
         let lo = if at_kink { e_t } else { from };
         let hi = if at_solid { e_c } else { to };
         if hi <= lo {
@@ -234,7 +251,25 @@ impl Grid {
         let mut lo_grid = lo;
         let mut width = hi - lo;
         let mut aligned = false;
-        if align != Align::Plain && kink_force > law.first_kink() && e_p > lo && e_p < hi {
+        // The strain the aligned knot sits on: Δ(P) (Δ(F_T) without a preload, where
+        // P = F_T) from the domain's start, else the inner corner.
+        let mut knot_at = e_p;
+        if from_domain {
+            // j segments from the domain's start to the slope kink, the most that still
+            // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
+            knot_at = law.delta(law.preload);
+            let most = libm::floor(S as f64 * (knot_at - lo) / (hi - lo));
+            if !(most >= 1.0 && knot_at < hi) {
+                return Err(TableError::TooNarrow);
+            }
+            width = S as f64 * (knot_at - lo) / most;
+            kink_knot = Some(most as usize);
+            aligned = true;
+        } else if !matches!(align, Align::Plain | Align::FromDomain)
+            && kink_force > law.first_kink()
+            && e_p > lo
+            && e_p < hi
+        {
             let most = libm::floor(S as f64 * (e_p - lo) / (hi - lo));
             if align != Align::Off && most >= 1.0 {
                 let fit = if at_solid && align == Align::NearSolid {
@@ -283,9 +318,10 @@ impl Grid {
         // That step is a little longer than the one asked for (the scale's low bits are
         // cut, up to 6e-5 of it): with a kink, the first knot is placed from this step so
         // that the kink's knot stays on Δ(P), to a strain LSB (the table still reaches
-        // `hi`: the step only grew).
+        // `hi`: the step only grew); from the domain's start the same, so the first knot
+        // lies at or a little below the domain's start.
         let first = match kink_knot {
-            Some(j) if slope_kink => e_p - j as f64 * step,
+            Some(j) if slope_kink || from_domain => knot_at - j as f64 * step,
             _ => lo_grid,
         };
         let strain_lo = checked_from_f64(first, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
@@ -308,7 +344,7 @@ impl Grid {
         Ok(Self {
             at_kink,
             at_solid,
-            kink_knot: kink_knot.filter(|_| slope_kink),
+            kink_knot: kink_knot.filter(|_| slope_kink || from_domain),
             grid_moved,
             used,
             lo,
