@@ -82,7 +82,14 @@ impl<const S: usize> ForceTable<S> {
         ];
         let mut tried = [None; PLACEMENTS.len()];
         for (n, align) in PLACEMENTS.into_iter().enumerate() {
-            match Self::on_grid(law, from, to, align) {
+            // The placement from the domain's start is its own instance of the builder,
+            // so that a device's (`from_law`, which never takes it) carries no code for it.
+            let built = if align == Align::FromDomain {
+                Self::on_grid::<true>(law, from, to, align)
+            } else {
+                Self::on_grid::<false>(law, from, to, align)
+            };
+            match built {
                 Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
                 Ok(t) => {
                     tried[n] = Some(grid_of(&t.raw));
@@ -116,7 +123,7 @@ impl<const S: usize> ForceTable<S> {
         // the solid point, then the grid on Δ(P) alone.
         let mut built = Err(TableError::OutOfRange);
         for align in [Align::Shortest, Align::NearSolid, Align::Off] {
-            built = Self::on_grid(law, from, to, align);
+            built = Self::on_grid::<false>(law, from, to, align);
             if !matches!(built, Err(TableError::OutOfRange)) {
                 break;
             }
@@ -125,10 +132,16 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// The table on the grid [`Grid::place`] puts over `[from, to]` (one copy of the
-    /// builder in flash, however many placements are tried).
+    /// builder in flash, however many placements are tried; `TENSION`: `align` is
+    /// [`Align::FromDomain`]).
     #[inline(never)]
-    fn on_grid(law: &Law, from: f64, to: f64, align: Align) -> Result<Self, TableError> {
-        let grid = Grid::place::<S>(law, from, to, align)?;
+    fn on_grid<const TENSION: bool>(
+        law: &Law,
+        from: f64,
+        to: f64,
+        align: Align,
+    ) -> Result<Self, TableError> {
+        let grid = Grid::place::<S, TENSION>(law, from, to, align)?;
         let shift = coefficient_shift::<S>(law, &grid)?;
         let segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
@@ -203,8 +216,9 @@ struct Grid {
 }
 
 impl Grid {
-    /// Places `S` segments over the law's curved part inside `[from, to]`.
-    fn place<const S: usize>(
+    /// Places `S` segments over the law's curved part inside `[from, to]` (with
+    /// `TENSION` and [`Align::FromDomain`], from `from` instead).
+    fn place<const S: usize, const TENSION: bool>(
         law: &Law,
         from: f64,
         to: f64,
@@ -219,7 +233,7 @@ impl Grid {
         let (e_t, e_c) = (law.strain_t(), law.strain_c());
         // Whether the table starts at the kink and ends at the solid point (exact lines
         // beyond), decided before the ends are rounded to the strain format.
-        let from_domain = align == Align::FromDomain && from < e_t;
+        let from_domain = TENSION && align == Align::FromDomain && from < e_t;
         let (at_kink, at_solid) = (from <= e_t && !from_domain, to >= e_c);
         let lo = if at_kink { e_t } else { from };
         let hi = if at_solid { e_c } else { to };
