@@ -185,8 +185,8 @@ enum Align {
     /// straight line to its coefficients' LSB) instead of being the line of slope `k`
     /// in Q16, whose LSB, over the half strain of the default domain's tension end, is
     /// 7.6e-6 N: more than the force bound of a spring below 0.38 N at `F(0.95)`. The
-    /// grid puts a knot on the preload's `Δ(P)` (on `Δ(F_T)` without one), the law's
-    /// slope kink, with a whole number of segments below it.
+    /// grid puts a knot on the preload's `Δ(P)`, the law's slope kink (on the cone's
+    /// transition `Δ(F_T)` without one), with a whole number of segments below it.
     FromDomain,
 }
 
@@ -269,7 +269,7 @@ impl Grid {
         // P = F_T) from the domain's start, else the inner corner.
         let mut knot_at = e_p;
         if from_domain {
-            // j segments from the domain's start to the slope kink, the most that still
+            // j segments from the domain's start to that knot, the most that still
             // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
             knot_at = law.delta(law.preload);
             let most = libm::floor(S as f64 * (knot_at - lo) / (hi - lo));

@@ -13,9 +13,9 @@
 //! and, where that is at least a segment above it, on the table's start too (the step
 //! then grows a little, and the range may end before the last segment:
 //! [`ForceTable::segments_used`]). [`ForceTable::from_law_best`] builds each placement,
-//! and one more that tabulates the domain's tension end too (from the domain's start,
-//! a knot on the slope kink: for a small spring, the line's slope in Q16 costs more than
-//! the coarser grid), and keeps the one with the least measured error.
+//! and one more that tabulates the domain's tension end too (from the domain's start, a
+//! knot on the law's first corner: for a small spring, the line's slope in Q16 costs
+//! more than the coarser grid), and keeps the one with the least measured error.
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
