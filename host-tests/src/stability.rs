@@ -51,16 +51,19 @@ pub enum Scheme {
     Symplectic,
     /// Symplectic Euler with each node's own share of the damping implicit.
     SymplecticImplicitOwnDamping,
+    /// Symplectic Euler with one factor for every node: `D = (1 + h max diag(C)/m)⁻¹`.
+    SymplecticImplicitUniformDamping,
 }
 
 impl Scheme {
     /// Every scheme, the paper's first.
-    pub const ALL: [Scheme; 5] = [
+    pub const ALL: [Scheme; 6] = [
         Scheme::Paper,
         Scheme::ExactNodeDamping,
         Scheme::ImplicitOwnDamping,
         Scheme::Symplectic,
         Scheme::SymplecticImplicitOwnDamping,
+        Scheme::SymplecticImplicitUniformDamping,
     ];
 
     /// A short name for reports.
@@ -71,13 +74,16 @@ impl Scheme {
             Scheme::ImplicitOwnDamping => "implicit_own_damping",
             Scheme::Symplectic => "symplectic",
             Scheme::SymplecticImplicitOwnDamping => "symplectic_implicit_own_damping",
+            Scheme::SymplecticImplicitUniformDamping => "symplectic_implicit_uniform_damping",
         }
     }
 
     /// `x' = x + h (α v + β v')`: `(α, β)`.
     fn position_weights(self) -> (f64, f64) {
         match self {
-            Scheme::Symplectic | Scheme::SymplecticImplicitOwnDamping => (0.0, 1.0),
+            Scheme::Symplectic
+            | Scheme::SymplecticImplicitOwnDamping
+            | Scheme::SymplecticImplicitUniformDamping => (0.0, 1.0),
             _ => (0.5, 0.5),
         }
     }
@@ -211,6 +217,14 @@ impl Linear {
                     p: &id * (-h * bn).exp(),
                     b: &b - &id * bn,
                     d: id,
+                }
+            }
+            Scheme::SymplecticImplicitUniformDamping => {
+                let most = b.diagonal().max();
+                StepParts {
+                    d: &id / (1.0 + h * most),
+                    p: id,
+                    b,
                 }
             }
             Scheme::ImplicitOwnDamping | Scheme::SymplecticImplicitOwnDamping => StepParts {
