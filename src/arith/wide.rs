@@ -133,7 +133,7 @@ impl Arith for Wide {
         nodes: &mut [Node; NODES],
     ) {
         #[cfg(mccs_dsp)]
-        if super::wide_dsp::serves::<S>() {
+        if super::wide_dsp::serves::<S, NODES>() {
             super::wide_dsp::spring_forces(&table.table, c.damping, topo, warm, nodes);
             return;
         }

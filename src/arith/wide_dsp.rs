@@ -84,9 +84,10 @@ const fn header_fits<const S: usize>() -> bool {
     ok
 }
 
-/// Whether this loop serves tables of `S` segments.
-pub(super) const fn serves<const S: usize>() -> bool {
-    S.is_power_of_two() && S <= 1 << 16 && header_fits::<S>()
+/// Whether this loop serves tables of `S` segments and topologies of `NODES` node slots
+/// (the loop takes a node index as a signed halfword: below 2¹⁵).
+pub(super) const fn serves<const S: usize, const NODES: usize>() -> bool {
+    S.is_power_of_two() && S <= 1 << 16 && header_fits::<S>() && NODES <= 1 << 15
 }
 
 /// `asm!` with every register but r0, r6, r7, r13 and r15 declared written: the blocks
@@ -311,13 +312,14 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "20:",
             "ldm r12!, {{r0, r1, r2, r3, r4}}",
             "ldr r5, [sp]",
-            "uxth r6, r4",
-            "add r6, r6, r6, lsl #3",
-            "add r6, r5, r6, lsl #2",
-            "lsrs r4, r4, #16",
+            // a's address: base + 36 a, one multiply-accumulate of the low half (a node
+            // index below 2¹⁵, so the signed half is the index); then b's of the high
+            // half, unless b is the ground.
+            "mov r11, #36",
+            "smlabb r6, r4, r11, r5",
+            "lsrs lr, r4, #16",
             "beq 30f",
-            "add r4, r4, r4, lsl #3",
-            "add r4, r5, r4, lsl #2",
+            "smlatb r4, r4, r11, r5",
             "ldm r4, {{r5, r8, r9}}",
             "ldm r6, {{r10, r11, lr}}",
             "sub r5, r5, r10",
@@ -359,7 +361,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "90:",
             "add sp, sp, #20",
             "pop {{r6, r7}}",
-            log2s = const if serves::<S>() { S.trailing_zeros() } else { 1 },
+            log2s = const if serves::<S, NODES>() { S.trailing_zeros() } else { 1 },
             strain_lo = const header::<S>()[0],
             index_pre = const header::<S>()[2],
             anchor_lo = const header::<S>()[4],
