@@ -29,7 +29,7 @@ mutants=(
   "lower line's difference not saturating|\"qsub r3, r9, r3|\"sub r3, r9, r3"
   "upper line's difference not saturating|\"qsub r3, r9, r5|\"sub r3, r9, r5"
   "tau shifted arithmetically|\"lsr r3, r3, #1|\"asr r3, r3, #1"
-  "coefficients' shift not masked|\"ldr r3, [sp, #12]|\"ldr r3, [r11, #-24]"
+  "coefficients' shift not masked|\"ldr r3, [sp, #16]|\"ldr r3, [sp, #12]\\n\", \"ldr r3, [r3, #-20]"
   "push hold one bit narrower|#27, \", \$w|#26, \", \$w"
   "ground damping added, not subtracted|\"smmlsr \", \$w|\"smmlar \", \$w"
   "integrator velocity hold one bit narrower|ssat r8, #23, r8|ssat r8, #22, r8"

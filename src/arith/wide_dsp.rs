@@ -27,10 +27,13 @@ use crate::state::Node;
 use crate::table::{ForceTable, RawTable};
 use crate::topology::{Edge, Topology};
 
-/// What the loop reads at entry (`repr(C)`: one `ldm`).
+/// What the loop reads at entry (`repr(C)`: one `ldm`). The first six words become its
+/// frame: `nodes` and `stride` one `ldrd` (a node's address is `nodes + stride · i`).
 #[repr(C)]
 struct LoopArgs {
     nodes: *mut Node,
+    /// `size_of::<Node>()`, 36.
+    stride: u32,
     end: *const Edge,
     segments: *const [i32; 4],
     /// The coefficients' shift, masked as `wrapping_shr` masks it.
@@ -147,7 +150,7 @@ macro_rules! spring_body {
             "rsb r9, r9, #0x10000000\n",
             "asr r9, r9, #4\n",
             // The table: below, above, or in a segment.
-            "ldr r11, [sp, #8]\n",
+            "ldr r11, [sp, #12]\n",
             "ldrd r3, r5, [r11, #{strain_lo}]\n",
             "cmp r9, r3\n",
             "ble 51f\n",
@@ -167,7 +170,7 @@ macro_rules! spring_body {
             "smmla r11, lr, r3, r11\n",
             "smmla r8, r11, r3, r8\n",
             "smmla r5, r8, r3, r5\n",
-            "ldr r3, [sp, #12]\n",
+            "ldr r3, [sp, #16]\n",
             "asr r5, r5, r3\n",
             "b 53f\n",
             // Below: force_lo + (stiffness_lo · (e ⊖ anchor_lo)) >> 20, held.
@@ -199,7 +202,7 @@ macro_rules! spring_body {
             "smull r3, r8, r5, r10\n",
             "lsl r8, r8, #7\n",
             "orr r8, r8, r3, lsr #25\n",
-            "ldr r3, [sp, #16]\n",
+            "ldr r3, [sp, #20]\n",
         )
     };
 }
@@ -261,7 +264,7 @@ macro_rules! a_takes_p_and_loops {
             "add r9, r9, r1\n",
             "add r10, r10, r2\n",
             "stm r6, {{r5, r9, r10}}\n",
-            "ldr r5, [sp, #4]\n",
+            "ldr r5, [sp, #8]\n",
             "cmp r12, r5\n",
             "bne 20b\n",
         )
@@ -284,6 +287,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
     let raw = table.raw();
     let args = LoopArgs {
         nodes: nodes.as_mut_ptr(),
+        stride: core::mem::size_of::<Node>() as u32,
         end: edges.as_ptr().wrapping_add(n),
         segments: raw.segments.as_ptr(),
         shift: raw.shift & 31,
@@ -303,19 +307,19 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
     unsafe {
         asm_writing_all!(
             "push {{r6, r7}}",
-            "ldm r0, {{r1, r2, r3, r4, r5, r6, r7}}",
-            "push {{r1, r2, r3, r4, r5}}",
-            "mov r12, r6",
-            "cmp r12, r2",
+            "ldm r0, {{r1, r2, r3, r4, r5, r6, r7, r8}}",
+            "push {{r1, r2, r3, r4, r5, r6}}",
+            "mov r12, r7",
+            "mov r7, r8",
+            "cmp r12, r3",
             "beq 90f",
             // One spring: the edge (dir, 1/l0, a | b << 16) and its node addresses.
             "20:",
             "ldm r12!, {{r0, r1, r2, r3, r4}}",
-            "ldr r5, [sp]",
             // a's address: base + 36 a, one multiply-accumulate of the low half (a node
             // index below 2¹⁵, so the signed half is the index); then b's of the high
             // half, unless b is the ground.
-            "mov r11, #36",
+            "ldrd r5, r11, [sp]",
             "smlabb r6, r4, r11, r5",
             "lsrs lr, r4, #16",
             "beq 30f",
@@ -359,7 +363,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             axis_ground!("r2", "r10"),
             a_takes_p_and_loops!(),
             "90:",
-            "add sp, sp, #20",
+            "add sp, sp, #24",
             "pop {{r6, r7}}",
             log2s = const if serves::<S, NODES>() { S.trailing_zeros() } else { 1 },
             strain_lo = const header::<S>()[0],
