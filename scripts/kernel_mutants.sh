@@ -18,6 +18,8 @@ src="$work/src/arith/wide_dsp.rs"
 cp "$src" "$work/wide_dsp.rs.orig"
 
 # name | text to replace (its first occurrence) | replacement
+# (The unmasked shift is the table header's own, read through the segments pointer at
+# [sp, #12]: −20 is `RawTable::shift`'s offset from its first segment.)
 mutants=(
   "edge vector hold one bit narrower|ssat r0, #25, r0|ssat r0, #24, r0"
   "a r hold one bit narrower|usat r9, #25, r9|usat r9, #24, r9"

@@ -91,6 +91,7 @@ impl Scheme {
 
 /// One step of a [`Scheme`] as matrices: `v' = P v + h D (−A x − B' v + a_f)`.
 struct StepParts {
+    a: DMatrix<f64>,
     p: DMatrix<f64>,
     d: DMatrix<f64>,
     b: DMatrix<f64>,
@@ -201,12 +202,13 @@ impl Linear {
     /// The matrices of one step of `scheme` at `h` (s).
     fn parts(&self, scheme: Scheme, h: f64) -> StepParts {
         let n = self.k.nrows();
-        let (_, b) = self.rates();
+        let (a, b) = self.rates();
         let id = DMatrix::<f64>::identity(n, n);
         let own =
             |b: &DMatrix<f64>| DMatrix::from_diagonal(&b.diagonal().map(|x| 1.0 / (1.0 + h * x)));
         match scheme {
             Scheme::Paper | Scheme::Symplectic => StepParts {
+                a,
                 p: id.clone(),
                 d: id,
                 b,
@@ -214,6 +216,7 @@ impl Linear {
             Scheme::ExactNodeDamping => {
                 let bn = self.node_damping * 1000.0 / self.mass;
                 StepParts {
+                    a,
                     p: &id * (-h * bn).exp(),
                     b: &b - &id * bn,
                     d: id,
@@ -222,12 +225,14 @@ impl Linear {
             Scheme::SymplecticImplicitUniformDamping => {
                 let most = b.diagonal().max();
                 StepParts {
+                    a,
                     d: &id / (1.0 + h * most),
                     p: id,
                     b,
                 }
             }
             Scheme::ImplicitOwnDamping | Scheme::SymplecticImplicitOwnDamping => StepParts {
+                a,
                 p: id,
                 d: own(&b),
                 b,
@@ -235,16 +240,10 @@ impl Linear {
         }
     }
 
-    /// `G(h)` (mm, mm/s) of the paper's scheme.
-    pub fn step_matrix(&self, h: f64) -> DMatrix<f64> {
-        self.step_matrix_of(Scheme::Paper, h)
-    }
-
-    /// `G(h)` of `scheme`: `v' = V_x x + V_v v` and `x' = x + h (α v + β v')`.
+    /// `G(h)` of `scheme` (mm, mm/s): `v' = V_x x + V_v v` and `x' = x + h (α v + β v')`.
     pub fn step_matrix_of(&self, scheme: Scheme, h: f64) -> DMatrix<f64> {
         let n = self.k.nrows();
-        let (a, _) = self.rates();
-        let StepParts { p, d, b } = self.parts(scheme, h);
+        let StepParts { a, p, d, b } = self.parts(scheme, h);
         let (alpha, beta) = scheme.position_weights();
         let id = DMatrix::<f64>::identity(n, n);
         let vx = &d * &a * -h;
@@ -257,11 +256,6 @@ impl Linear {
         g.view_mut((n, 0), (n, n)).copy_from(&vx);
         g.view_mut((n, n), (n, n)).copy_from(&vv);
         g
-    }
-
-    /// `ρ(G(h))` of the paper's scheme.
-    pub fn spectral_radius(&self, h: f64) -> f64 {
-        self.spectral_radius_of(Scheme::Paper, h)
     }
 
     /// `ρ(G(h))` of `scheme`: the largest eigenvalue modulus, from a real Schur
@@ -296,17 +290,12 @@ impl Linear {
     /// The largest `h` (s) with `ρ(G(h)) ≤ 1` for the paper's scheme, to 1e-6 relative,
     /// searched up to `limit`.
     pub fn exact_bound(&self, limit: f64) -> f64 {
-        self.exact_bound_of(Scheme::Paper, limit)
+        self.exact_bound_within(Scheme::Paper, limit, 1e-6)
     }
 
-    /// [`Linear::exact_bound`] for `scheme`. (Between the bisection's ends the schemes
-    /// here are stable below a single bound: checked on the report's patches by
-    /// `the_integrator_variants_report`, which samples below it.)
-    pub fn exact_bound_of(&self, scheme: Scheme, limit: f64) -> f64 {
-        self.exact_bound_within(scheme, limit, 1e-6)
-    }
-
-    /// [`Linear::exact_bound_of`] to `rel` relative.
+    /// [`Linear::exact_bound`] for `scheme`, to `rel` relative. (Bisection assumes one
+    /// stable interval below the bound: `the_integrator_variants_report` samples below
+    /// it on the report's patches.)
     pub fn exact_bound_within(&self, scheme: Scheme, limit: f64, rel: f64) -> f64 {
         let stable = |h: f64| self.spectral_radius_of(scheme, h) <= 1.0 + 1e-12;
         let (mut lo, mut hi) = (0.0, limit);
@@ -326,9 +315,7 @@ impl Linear {
         }
         lo
     }
-}
 
-impl Linear {
     /// A step response's contact degree of freedom and its forcing `a_f`: a constant unit
     /// vertical acceleration on the contact node (any size: the patch is linear). `None`
     /// when it is fixed.
@@ -372,10 +359,9 @@ impl Linear {
     /// The same by `scheme` at `substeps` steps per tick.
     pub fn step_response(&self, scheme: Scheme, substeps: u32, ticks: u32) -> Option<Vec<f64>> {
         let (c, force) = self.forced()?;
-        let (a, _) = self.rates();
         let n = self.k.nrows();
         let h = 1e-3 / substeps as f64;
-        let StepParts { p, d, b } = self.parts(scheme, h);
+        let StepParts { a, p, d, b } = self.parts(scheme, h);
         let (alpha, beta) = scheme.position_weights();
         let (mut x, mut v) = (DVector::zeros(n), DVector::zeros(n));
         let mut out = Vec::new();
