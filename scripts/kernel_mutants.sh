@@ -37,6 +37,8 @@ mutants=(
   "integrator velocity hold one bit narrower|ssat r8, #23, r8|ssat r8, #22, r8"
   "integrator displacement hold one bit narrower|ssat r1, #31, r1|ssat r1, #30, r1"
   "accumulator cleared at the wrong offset|\"str r3, [lr, #8]\"|\"str r3, [lr, #4]\""
+  "symplectic position step from the old velocity|\"add r3, r6, r6\"|\"add r3, r3, r6\""
+  "paper's position step from the new velocity|\"add r4, r4, r8\"|\"add r4, r8, r8\""
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)

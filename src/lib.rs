@@ -39,7 +39,7 @@ pub mod window;
 #[cfg(feature = "defmt")]
 mod defmt;
 
-pub use arith::{Arith, DefaultArith, Narrow, Wide};
+pub use arith::{Arith, DefaultArith, Integrator, Narrow, Wide};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};

@@ -1,6 +1,7 @@
-//! The f64 twin of the core's patch solver: the standard patch of `docs/model.md`, the reference law,
-//! the paper's improved Euler (eqs. 21–22), and the same virtual coupling, written without
-//! the core's code so that tests can hold one against the other.
+//! The f64 twin of the core's patch solver: the standard patch of `docs/model.md`, the
+//! reference law, the paper's improved Euler (eqs. 21–22) or the symplectic option
+//! (`mccs::Integrator`), and the same virtual coupling, written without the core's code
+//! so that tests can hold one against the other.
 //!
 //! Nodes are stored as they are (fixed ones included); positions are absolute, in mm, in
 //! the patch frame (origin at the contact node's rest position, `z` up).
@@ -118,6 +119,8 @@ pub struct TwinConfig {
     pub node_damping: f64,
     /// Coupling stiffness N/mm, damping N·s/m, max force per axis N.
     pub coupling: (f64, f64, f64),
+    /// The integrator (the twin's own implementation of each, [`Twin`]).
+    pub integrator: mccs::Integrator,
 }
 
 impl TwinConfig {
@@ -134,6 +137,7 @@ impl TwinConfig {
                 cfg.coupling.damping,
                 cfg.coupling.max_force,
             ),
+            integrator: cfg.integrator,
         }
     }
 }
@@ -245,8 +249,35 @@ impl Twin {
         f
     }
 
+    /// The symplectic integrator's `γ` (1/s), computed here from the mesh: the largest
+    /// damping on one free node (its own, each of its springs', the coupling's at the
+    /// contact) over the node mass.
+    pub fn most_damping(&self) -> f64 {
+        let n = self.mesh.rest.len();
+        let mut diag = vec![self.cfg.node_damping; n];
+        for s in &self.mesh.springs {
+            diag[s.i] += self.cfg.spring_damping;
+            diag[s.j] += self.cfg.spring_damping;
+        }
+        diag[self.mesh.contact] += self.cfg.coupling.1;
+        (0..n)
+            .filter(|&i| !self.mesh.fixed[i])
+            .map(|i| diag[i])
+            .fold(0.0, f64::max)
+            / self.cfg.node_mass
+    }
+
+    /// One substep: the paper's improved Euler, `v' = v + h F/m`,
+    /// `x' = x + h (v + v')/2`; or symplectic Euler with one implicit damping factor,
+    /// `v' = v + h F/(m (1 + h γ))`, `x' = x + h v'`.
     fn substep(&mut self, probe: Option<(V, V)>, held: Option<(V, V)>) {
         let h = self.h();
+        let symplectic = self.cfg.integrator == mccs::Integrator::SymplecticDamped;
+        let d = if symplectic {
+            1.0 / (1.0 + h * self.most_damping())
+        } else {
+            1.0
+        };
         let mut f = self.spring_forces(&self.x, &self.v);
         let c = self.mesh.contact;
         self.reaction = f[c];
@@ -267,8 +298,12 @@ impl Twin {
             }
             for k in 0..3 {
                 let net = f[i][k] - self.cfg.node_damping / 1000.0 * self.v[i][k];
-                let v_new = self.v[i][k] + h * 1000.0 * net / self.cfg.node_mass;
-                self.x[i][k] += 0.5 * h * (self.v[i][k] + v_new);
+                let v_new = self.v[i][k] + h * d * 1000.0 * net / self.cfg.node_mass;
+                self.x[i][k] += if symplectic {
+                    h * v_new
+                } else {
+                    0.5 * h * (self.v[i][k] + v_new)
+                };
                 self.v[i][k] = v_new;
             }
         }

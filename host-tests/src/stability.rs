@@ -31,6 +31,8 @@ pub struct Linear {
     pub node_damping: f64,
     /// The contact node's vertical degree of freedom (`None`: the contact node is fixed).
     pub contact_z: Option<usize>,
+    /// The scheme of the configuration's integrator ([`Linear::exact_bound`]).
+    pub scheme: Scheme,
 }
 
 /// A one-step scheme for the linearised patch, `a(x, v) = M⁻¹(−K x − C v)`: the paper's
@@ -56,6 +58,14 @@ pub enum Scheme {
 }
 
 impl Scheme {
+    /// The scheme the core runs for `integrator`.
+    pub fn of(integrator: mccs::Integrator) -> Scheme {
+        match integrator {
+            mccs::Integrator::ImprovedEuler => Scheme::Paper,
+            mccs::Integrator::SymplecticDamped => Scheme::SymplecticImplicitUniformDamping,
+        }
+    }
+
     /// Every scheme, the paper's first.
     pub const ALL: [Scheme; 6] = [
         Scheme::Paper,
@@ -188,6 +198,7 @@ impl Linear {
             k,
             node_damping: cfg.node_damping / 1000.0,
             contact_z: idx[mesh.contact].map(|d| d + 2),
+            scheme: Scheme::of(cfg.integrator),
         }
     }
 
@@ -287,10 +298,10 @@ impl Linear {
         (log_norm / 16384.0).exp()
     }
 
-    /// The largest `h` (s) with `ρ(G(h)) ≤ 1` for the paper's scheme, to 1e-6 relative,
-    /// searched up to `limit`.
+    /// The largest `h` (s) with `ρ(G(h)) ≤ 1` for the configuration's scheme
+    /// ([`Linear::scheme`]), to 1e-6 relative, searched up to `limit`.
     pub fn exact_bound(&self, limit: f64) -> f64 {
-        self.exact_bound_within(Scheme::Paper, limit, 1e-6)
+        self.exact_bound_within(self.scheme, limit, 1e-6)
     }
 
     /// [`Linear::exact_bound`] for `scheme`, to `rel` relative. (Bisection assumes one

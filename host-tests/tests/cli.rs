@@ -961,3 +961,47 @@ fn replay_roams_in_the_core_as_in_the_reference() {
         }
     }
 }
+
+/// `--integrator symplectic-damped` runs the option in either backend: the settled force
+/// of an indentation is the paper's integrator's (the same equilibrium), and a name
+/// that is not an integrator is a usage error naming the argument.
+#[test]
+fn patch_runs_either_integrator_to_the_same_settled_force() {
+    let settled = |backend: &str, integrator: &str| -> f64 {
+        let out = mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1.2",
+            "--backend",
+            backend,
+            "--integrator",
+            integrator,
+        ]);
+        assert!(out.status.success(), "{backend} {integrator}: {out:?}");
+        let text = String::from_utf8(out.stdout).unwrap();
+        let last = text.lines().last().unwrap();
+        last.split(',').nth(1).unwrap().parse().unwrap()
+    };
+    for backend in ["reference", "fixed"] {
+        let paper = settled(backend, "improved-euler");
+        let option = settled(backend, "symplectic-damped");
+        assert!(
+            (paper - option).abs() <= 1e-5 * paper,
+            "{backend}: {paper} vs {option}"
+        );
+    }
+    assert_usage_error(
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--integrator",
+            "heun",
+        ]),
+        &["--integrator"],
+    );
+}

@@ -2,7 +2,8 @@
 //! equilibrium solve: steady state, dynamics, energy, robustness.
 
 use mccs::{
-    Arith, ForceTable64, Length, Narrow, Params, Solver, SolverConfig, SolverError, Topology, Wide,
+    Arith, ForceTable64, Integrator, Length, Narrow, Params, Solver, SolverConfig, SolverError,
+    Topology, Wide,
 };
 use mccs_firmware::indentation_path;
 use mccs_host::patch::{substeps, Mesh, Twin, TwinConfig, V};
@@ -90,7 +91,17 @@ fn indent<const N: usize, const E: usize, A: Arith>(
     d: f64,
     ticks: (usize, usize),
 ) -> (f64, f64, Twin) {
-    let cfg = SolverConfig::default();
+    indent_with::<N, E, A>(n, spacing, d, ticks, &SolverConfig::default())
+}
+
+fn indent_with<const N: usize, const E: usize, A: Arith>(
+    n: usize,
+    spacing: f64,
+    d: f64,
+    ticks: (usize, usize),
+    cfg: &SolverConfig,
+) -> (f64, f64, Twin) {
+    let cfg = *cfg;
     let mut f = fixed::<N, E, A>(n, spacing, &cfg);
     let mut t = twin(n, spacing, &cfg, f.substeps());
     let (mut rf, mut rt) = (0.0, 0.0);
@@ -185,6 +196,55 @@ fn steady_state<A: Arith>(name: &str) {
     }
 }
 
+/// The symplectic option settles to the same equilibrium: against the static solve and
+/// the twin as the paper's integrator, in both arithmetics.
+#[test]
+fn symplectic_steady_state_matches_static_equilibrium_and_twin() {
+    let cfg = SolverConfig {
+        integrator: Integrator::SymplecticDamped,
+        ..SolverConfig::default()
+    };
+    for (name, (rf, rt, tw)) in [
+        (
+            "wide",
+            indent_with::<10, 61, Wide>(5, 2.5, 0.8, (500, 1500), &cfg),
+        ),
+        (
+            "narrow",
+            indent_with::<10, 61, Narrow>(5, 2.5, 0.8, (500, 1500), &cfg),
+        ),
+    ] {
+        let rs = static_reaction(&tw, 0.8);
+        println!("{name}, symplectic: static {rs:.9} twin {rt:.9} fixed {rf:.9}");
+        assert!((rt - rs).abs() <= 1e-6 * rs, "twin {rt} vs static {rs}");
+        assert!(
+            (rf - rt).abs() <= 5e-3 * rt,
+            "{name}: fixed {rf} vs twin {rt}"
+        );
+    }
+}
+
+/// The symplectic option's dynamics against its twin, in both arithmetics: the default
+/// configuration (2 substeps per tick where the paper's takes 2–3), and the narrow
+/// arithmetic's other paths (little, no or the most spring damping).
+#[test]
+fn symplectic_dynamics_track_the_twin() {
+    let sd = |c: f64, cn: f64, m: f64| SolverConfig {
+        spring_damping: c,
+        node_damping: cn,
+        node_mass: m,
+        integrator: Integrator::SymplecticDamped,
+        ..SolverConfig::default()
+    };
+    let default = sd(1.0, 0.05, 0.005);
+    dynamics::<Wide>("wide, symplectic", default);
+    dynamics::<Narrow>("narrow, symplectic", default);
+    for (c, m) in [(0.05, 0.005), (0.0, 0.005), (30.0, 0.1)] {
+        dynamics::<Wide>(&format!("wide, symplectic, C = {c} N·s/m"), sd(c, 5.0, m));
+        dynamics::<Narrow>(&format!("narrow, symplectic, C = {c} N·s/m"), sd(c, 5.0, m));
+    }
+}
+
 #[test]
 fn dynamics_track_the_twin() {
     dynamics::<Wide>("wide", SolverConfig::default());
@@ -268,7 +328,19 @@ fn perturbation(i: usize) -> [f64; 3] {
 
 #[test]
 fn energy_never_increases_with_damping() {
-    let cfg = SolverConfig::default();
+    energy_never_increases_with(&SolverConfig::default());
+}
+
+#[test]
+fn symplectic_energy_never_increases_with_damping() {
+    energy_never_increases_with(&SolverConfig {
+        integrator: Integrator::SymplecticDamped,
+        ..SolverConfig::default()
+    });
+}
+
+fn energy_never_increases_with(cfg: &SolverConfig) {
+    let cfg = *cfg;
     let f = fixed::<10, 61, Wide>(5, 2.5, &cfg);
     let mut tw = twin(5, 2.5, &cfg, f.substeps());
     for i in 0..tw.x.len() {

@@ -129,6 +129,8 @@ fn sweep<A: Arith>(name: &str, lim: &Limits, states: usize, seed: u64) -> Sweep 
         node_mass: 0.005,
         node_damping: 0.05,
         spring_damping: 1.0,
+        integrator: mccs::Integrator::ImprovedEuler,
+        damping_factor: 1.0,
     });
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut out = Sweep {
@@ -256,6 +258,8 @@ fn both_springs_recover_from_rest_after_any_jump() {
             node_mass: 0.005,
             node_damping: 0.05,
             spring_damping: 1.0,
+            integrator: mccs::Integrator::ImprovedEuler,
+            damping_factor: 1.0,
         });
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for _ in 0..10_000 {

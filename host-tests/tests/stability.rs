@@ -4,7 +4,7 @@
 //! grows at 1.5 times the exact bound.
 
 use mccs::solver::stability::{bounds, CONSERVATIVE_FACTOR, ESTIMATE_MARGIN};
-use mccs::{Bound, Coupling, ForceTable64, Params, SolverConfig, Topology};
+use mccs::{Bound, Coupling, ForceTable64, Integrator, Params, SolverConfig, Topology};
 use mccs_host::patch::{Mesh, Twin, TwinConfig};
 use mccs_host::reference::Reference;
 use mccs_host::stability::{Linear, Stiffness};
@@ -52,10 +52,53 @@ fn old_rule(n: usize, spacing: f64, cfg: &SolverConfig, k_max: f64) -> f64 {
     0.5 * (cfg.node_mass / c_max).min(2.0 * tau)
 }
 
+/// The configuration's integrator as the report lines name it: nothing for the paper's
+/// (its lines keep their keys), `integrator=symplectic_damped ` for the option.
+fn tag(cfg: &SolverConfig) -> &'static str {
+    match cfg.integrator {
+        Integrator::ImprovedEuler => "",
+        Integrator::SymplecticDamped => "integrator=symplectic_damped ",
+    }
+}
+
+/// The default configuration with each integrator.
+fn with_each_integrator() -> [SolverConfig; 2] {
+    [Integrator::ImprovedEuler, Integrator::SymplecticDamped].map(|integrator| SolverConfig {
+        integrator,
+        ..SolverConfig::default()
+    })
+}
+
 #[test]
 fn the_default_patch_report() {
     let cfg = SolverConfig::default();
     let k_max = table().max_stiffness().to_num::<f64>();
+    // The symplectic option's exact bound and the core's estimate of it.
+    for n in [5, 8] {
+        let cfg = with_each_integrator()[1];
+        let (b, exact) = compare(n, 2.5, &cfg);
+        let subs = |h: f64| (1.0 / (1000.0 * h)).ceil() as u32;
+        let estimated = b.estimated.unwrap();
+        println!(
+            "STABILITY {}patch=n{n} exact_us={:.0} estimated_us={:.0} chosen_us={:.0} substeps_chosen={} substeps_exact={}",
+            tag(&cfg),
+            exact * 1e6,
+            estimated * 1e6,
+            b.chosen * 1e6,
+            subs(b.chosen),
+            subs(exact),
+        );
+        assert_eq!(
+            b.chosen,
+            ESTIMATE_MARGIN * estimated,
+            "the estimate is taken"
+        );
+        assert!(b.chosen <= exact, "{b:?} vs {exact}");
+        assert!(
+            (estimated - exact).abs() <= 0.1 * exact,
+            "estimate {estimated} vs exact {exact}"
+        );
+    }
     for n in [5, 8] {
         let (b, exact) = compare(n, 2.5, &cfg);
         let old = old_rule(n, 2.5, &cfg, k_max);
@@ -91,6 +134,15 @@ fn the_default_patch_report() {
 /// itself can be above it: the report says by how much.
 #[test]
 fn the_chosen_bound_is_never_optimistic() {
+    the_chosen_bound_is_never_optimistic_with(Integrator::ImprovedEuler);
+}
+
+#[test]
+fn the_chosen_bound_is_never_optimistic_symplectic() {
+    the_chosen_bound_is_never_optimistic_with(Integrator::SymplecticDamped);
+}
+
+fn the_chosen_bound_is_never_optimistic_with(integrator: Integrator) {
     let (mut worst_est, mut least_est) = (0.0f64, f64::INFINITY);
     let (mut tight, mut closed_over, mut cons_over) = (0.0f64, 0.0f64, 0.0f64);
     let (mut count, mut fallbacks) = (0, 0);
@@ -115,6 +167,7 @@ fn the_chosen_bound_is_never_optimistic() {
                                 damping: bc,
                                 max_force: 10.0,
                             },
+                            integrator,
                             ..SolverConfig::default()
                         };
                         let (b, exact) = compare(n, spacing, &cfg);
@@ -145,7 +198,11 @@ fn the_chosen_bound_is_never_optimistic() {
             }
         }
     }
-    println!("STABILITY case=sweep configurations={count} conservative_fallbacks={fallbacks} estimate_of_exact_min={least_est:.3} estimate_of_exact_max={worst_est:.3} max_chosen_of_exact={tight:.3} max_conservative_of_exact={cons_over:.3} max_closed_of_exact={closed_over:.4}");
+    let cfg = SolverConfig {
+        integrator,
+        ..SolverConfig::default()
+    };
+    println!("STABILITY {}case=sweep configurations={count} conservative_fallbacks={fallbacks} estimate_of_exact_min={least_est:.3} estimate_of_exact_max={worst_est:.3} max_chosen_of_exact={tight:.3} max_conservative_of_exact={cons_over:.3} max_closed_of_exact={closed_over:.4}", tag(&cfg));
     // The margin (0.75) covers an estimate up to 1.33 times the exact bound.
     assert!(
         worst_est <= 1.2,
@@ -158,7 +215,13 @@ fn the_chosen_bound_is_never_optimistic() {
 /// exact bounds.
 #[test]
 fn the_chosen_bound_holds_on_deformed_states() {
-    let cfg = SolverConfig::default();
+    for cfg in with_each_integrator() {
+        the_chosen_bound_holds_on_deformed_states_with(&cfg);
+    }
+}
+
+fn the_chosen_bound_holds_on_deformed_states_with(cfg: &SolverConfig) {
+    let cfg = *cfg;
     let law = Reference::new(&Params::TABLE2).unwrap();
     let mut closest = 0.0f64;
     for n in [5, 8] {
@@ -188,7 +251,10 @@ fn the_chosen_bound_holds_on_deformed_states() {
             );
         }
     }
-    println!("STABILITY case=deformed max_chosen_of_exact={closest:.3} margin={ESTIMATE_MARGIN}");
+    println!(
+        "STABILITY {}case=deformed max_chosen_of_exact={closest:.3} margin={ESTIMATE_MARGIN}",
+        tag(&cfg)
+    );
 }
 
 /// The twin with every spring at the table's largest stiffness (the linearisation the
@@ -196,7 +262,13 @@ fn the_chosen_bound_holds_on_deformed_states() {
 /// dies out; at 1.5 times the exact bound it grows.
 #[test]
 fn the_twin_decays_at_the_chosen_step_and_grows_beyond_the_exact_one() {
-    let cfg = SolverConfig::default();
+    for cfg in with_each_integrator() {
+        the_twin_decays_and_grows_with(&cfg);
+    }
+}
+
+fn the_twin_decays_and_grows_with(cfg: &SolverConfig) {
+    let cfg = *cfg;
     let k_max = table().max_stiffness().to_num::<f64>();
     let (b, _) = compare(5, 2.5, &cfg);
     // The probe stays away: the exact bound of the patch without the coupling.
@@ -234,7 +306,8 @@ fn the_twin_decays_at_the_chosen_step_and_grows_beyond_the_exact_one() {
     // An overflow prints as f64::MAX, so that the line stays all numbers.
     let shown = if beyond.is_finite() { beyond } else { f64::MAX };
     println!(
-        "STABILITY case=twin growth_at_chosen={at_chosen:.2e} growth_at_1.5x_exact={shown:.2e}"
+        "STABILITY {}case=twin growth_at_chosen={at_chosen:.2e} growth_at_1.5x_exact={shown:.2e}",
+        tag(&cfg)
     );
     assert!(at_chosen < 1e-3, "{at_chosen}");
     assert!(beyond > 1e3, "{beyond}");

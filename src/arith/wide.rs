@@ -72,6 +72,8 @@ pub struct WideCoeffs {
     keep: i32,
     /// `h/2`, s, Q40.
     half_h: i32,
+    /// [`super::Integrator::SymplecticDamped`]: `u' = u + h v'`.
+    symplectic: bool,
 }
 
 impl Arith for Wide {
@@ -88,18 +90,15 @@ impl Arith for Wide {
     }
 
     fn coeffs(spec: &StepSpec) -> WideCoeffs {
-        let StepSpec {
-            h,
-            node_mass: m,
-            node_damping: c,
-            spring_damping,
-        } = *spec;
+        let (h, hd) = (spec.h, spec.velocity_h());
+        let (m, c) = (spec.node_mass, spec.node_damping);
         // N·s/m → N·s/mm: / 1000. h/m: (s/kg = m/(s·N)) · 1000 → (mm/s)/N.
         WideCoeffs {
-            h_over_m: from_f64(1000.0 * h / m, HM_FRAC),
-            keep: from_f64(1.0 - h * c / m, KEEP_FRAC),
+            h_over_m: from_f64(1000.0 * hd / m, HM_FRAC),
+            keep: from_f64(1.0 - hd * c / m, KEEP_FRAC),
             half_h: from_f64(0.5 * h, HALF_H_FRAC),
-            damping: from_f64(spring_damping / 1000.0, DAMP_FRAC),
+            damping: from_f64(spec.spring_damping / 1000.0, DAMP_FRAC),
+            symplectic: spec.symplectic(),
         }
     }
 
@@ -144,7 +143,7 @@ impl Arith for Wide {
     fn integrate(c: &WideCoeffs, free: &mut [Node]) {
         #[cfg(mccs_dsp)]
         {
-            super::wide_dsp::integrate(c.keep, c.h_over_m, c.half_h, free);
+            super::wide_dsp::integrate(c.keep, c.h_over_m, c.half_h, c.symplectic, free);
         }
         #[cfg(not(mccs_dsp))]
         integrate_portable(c, free);
@@ -270,18 +269,24 @@ fn spring<const S: usize>(
     })
 }
 
-/// The paper's improved Euler on every node of `free`, in Rust: what [`Wide`] runs on
-/// every core but the Armv7E-M ones, whose loop is in assembly (`arith/wide_dsp.rs`)
-/// and must give the same bits (the bench firmware checks it on the M4F).
+/// The integrator on every node of `free`, in Rust: what [`Wide`] runs on every core but
+/// the Armv7E-M ones, whose loop is in assembly (`arith/wide_dsp.rs`) and must give the
+/// same bits (the bench firmware checks it on the M4F). The scheme is chosen once per
+/// substep, outside the loop.
 #[inline(always)]
 pub fn integrate_portable(c: &WideCoeffs, free: &mut [Node]) {
-    free.iter_mut().for_each(|n| integrate(c, n));
+    if c.symplectic {
+        free.iter_mut().for_each(|n| integrate::<true>(c, n));
+    } else {
+        free.iter_mut().for_each(|n| integrate::<false>(c, n));
+    }
 }
 
-/// Improved Euler for one node (eqs. 21, 22), and the node's force accumulator cleared
-/// for the next substep.
+/// One node's step, and its force accumulator cleared for the next substep: improved
+/// Euler (eqs. 21, 22), or with `SYMPLECTIC` the position from the new velocity alone
+/// (`h D/m` and `1 − h D c/m` are in the coefficients).
 #[inline(always)]
-fn integrate(c: &WideCoeffs, n: &mut Node) {
+fn integrate<const SYMPLECTIC: bool>(c: &WideCoeffs, n: &mut Node) {
     for j in 0..3 {
         let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
         // v' = (1 − h c/m) v + (h/m) f: Q16 · Q24 and Q20 · Q20, both Q40. Held within
@@ -289,9 +294,10 @@ fn integrate(c: &WideCoeffs, n: &mut Node) {
         // product's own (below 0.004 mm/s).
         let p = q::mul_wide(v, c.keep) + q::mul_wide(f, c.h_over_m);
         let v_new = q::shr_held::<{ FORCE_FRAC + HM_FRAC - VEL_FRAC }, 30>(p);
-        // u' = u + (v + v') h/2: |v + v'| < 2³¹ and h/2 < 2³¹ in Q40, so |du| < 2³⁰ and
-        // the sum cannot overflow before the clamp.
-        let du = q::mulhi(v.wrapping_add(v_new), c.half_h);
+        // u' = u + (v + v') h/2, or (v' + v') h/2 = h v': |v + v'| < 2³¹ and h/2 < 2³¹
+        // in Q40, so |du| < 2³⁰ and the sum cannot overflow before the clamp.
+        let from = if SYMPLECTIC { v_new } else { v };
+        let du = q::mulhi(from.wrapping_add(v_new), c.half_h);
         n.u[j] = u.wrapping_add(du).clamp(-DISP_LIMIT, DISP_LIMIT - 1);
         n.v[j] = v_new;
     }

@@ -3,6 +3,7 @@
 
 use super::stability::Bound;
 use super::SolverError;
+use crate::arith::Integrator;
 use crate::coupling::Coupling;
 
 /// Runtime configuration of a [`crate::Solver`].
@@ -22,11 +23,13 @@ pub struct SolverConfig {
     pub coupling: Coupling,
     /// Which stability bound sets the substeps ([`Bound::Estimated`] by default).
     pub bound: Bound,
+    /// The integrator ([`Integrator::ImprovedEuler`], the paper's, by default).
+    pub integrator: Integrator,
 }
 
 impl Default for SolverConfig {
     /// 1 kHz; 5 g nodes; 1 N·s/m per spring, 0.05 N·s/m per node; at most 64 substeps;
-    /// the default coupling.
+    /// the default coupling; the estimated bound; the paper's integrator.
     fn default() -> Self {
         Self {
             tick_hz: 1000.0,
@@ -36,6 +39,7 @@ impl Default for SolverConfig {
             max_substeps: 64,
             coupling: Coupling::default(),
             bound: Bound::Estimated,
+            integrator: Integrator::ImprovedEuler,
         }
     }
 }

@@ -92,6 +92,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 node_mass: config.node_mass,
                 node_damping: config.node_damping,
                 spring_damping: config.spring_damping,
+                integrator: config.integrator,
+                damping_factor: stability::damping_factor(topo, config, h),
             }),
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ::new(&config.coupling),

@@ -1,6 +1,6 @@
-//! The stability bound: the largest substep `h` at which the paper's improved Euler
-//! integrator is stable on a patch, and so the substeps per tick (start-up only; never
-//! per tick).
+//! The stability bound: the largest substep `h` at which the configured integrator (the
+//! paper's improved Euler by default) is stable on a patch, and so the substeps per tick
+//! (start-up only; never per tick).
 //!
 //! # The integrator's one-step matrix
 //! Linearised around a state, the patch is `M ẍ + C ẋ + K x = 0` (`M` the node masses,
@@ -44,11 +44,27 @@
 //!   About a quarter of the exact bound on the standard patch (it cannot use the
 //!   springs' being stiff along one direction only): twice the substeps or more.
 //!
+//! # The symplectic integrator
+//! [`Integrator::SymplecticDamped`] steps `v' = v + h D M⁻¹F`, `x' = x + h v'`, with
+//! `D = 1/(1 + h γ)` and `γ` the largest diagonal entry of `M⁻¹C` ([`most_damping`]):
+//!
+//! ```text
+//! G(h) = | I − h²DA   h (I − hDB) |
+//!        | −hDA       I − hDB     |
+//! ```
+//!
+//! The estimate runs this step instead ([`Linearised::growth`]), bisected up to 16 times
+//! the closed form. The closed form, and so [`Bound::Conservative`] and the fallback, is
+//! the paper's, and stays on the safe side per mode: for one mode (`ω²`, damping rate
+//! `β ≤ γ`) the step is stable while `h D β < 2` (always: `h D β < 1`) and
+//! `h² ω² + 2 h β < 4 (1 + h γ)`, which `h < 2β/ω²` (the paper's condition) implies. The
+//! host tests hold both bounds to the eigenvalues of this `G(h)` as for the paper's.
+//!
 //! The masses are haptic masses (a few grams per node), not the tissue's: they set how
 //! many substeps a tick needs, not the settled force.
 
 use super::{ConfigKey, SolverConfig, SolverError};
-use crate::arith::{MAX_H_OVER_M, MAX_SUBSTEP};
+use crate::arith::{Integrator, MAX_H_OVER_M, MAX_SUBSTEP};
 use crate::table::ForceTable;
 use crate::topology::{Topology, GROUND};
 use crate::units::{to_f64, DIR_FRAC};
@@ -122,6 +138,43 @@ fn substeps_of(h_max: f64, config: &SolverConfig) -> Result<u32, SolverError> {
     Ok(n)
 }
 
+/// The largest damping on one free node — its own, its springs' (each spring's `C` on
+/// both of its nodes), and at the contact the coupling's — over the node mass: `γ` of
+/// [`Integrator::SymplecticDamped`], 1/s (the largest diagonal entry of `M⁻¹C`).
+pub fn most_damping<const NODES: usize, const EDGES: usize>(
+    topo: &Topology<NODES, EDGES>,
+    config: &SolverConfig,
+) -> f64 {
+    let mut diag = [config.node_damping; NODES];
+    for e in topo.edges() {
+        for n in [e.a, e.b] {
+            if let Some(d) = diag.get_mut(n as usize).filter(|_| n != GROUND) {
+                *d += config.spring_damping;
+            }
+        }
+    }
+    if let Some(d) = diag.get_mut(topo.contact() as usize) {
+        *d += config.coupling.damping;
+    }
+    (1..topo.node_count().min(NODES))
+        .map(|i| diag[i])
+        .fold(0.0, f64::max)
+        / config.node_mass
+}
+
+/// The factor `D` on the velocity step at substep `h` (s): `1/(1 + h γ)` with `γ` from
+/// [`most_damping`] for [`Integrator::SymplecticDamped`], 1 for the paper's integrator.
+pub fn damping_factor<const NODES: usize, const EDGES: usize>(
+    topo: &Topology<NODES, EDGES>,
+    config: &SolverConfig,
+    h: f64,
+) -> f64 {
+    match config.integrator {
+        Integrator::ImprovedEuler => 1.0,
+        Integrator::SymplecticDamped => 1.0 / (1.0 + h * most_damping(topo, config)),
+    }
+}
+
 /// The closed-form and estimated bounds, and the substep the configuration chooses.
 pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
     topo: &Topology<NODES, EDGES>,
@@ -135,7 +188,7 @@ pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
         Bound::Conservative => (None, CONSERVATIVE_FACTOR * closed),
         Bound::Estimated => {
             let lin = Linearised::new(topo, k_max, config);
-            let e = estimate(&lin, closed);
+            let e = estimate(&lin, closed, config.integrator);
             let h = ESTIMATE_MARGIN * e;
             // Trusted where the motion visibly dies out at the step taken; a lightly
             // damped patch, whose growth near the edge is too slow to measure, falls back.
@@ -218,21 +271,27 @@ fn closed_form<const NODES: usize, const EDGES: usize>(
 }
 
 /// The largest `h` with the linearised step's growth at most 1, bisected geometrically
-/// between `closed / 4` and `4 closed` (7 steps: at most 2.2 % below the edge). Should
-/// even `closed / 4` grow, half of it.
+/// between `closed / 4` and `4 closed` (7 steps: at most 2.2 % below the edge), or for
+/// [`Integrator::SymplecticDamped`], whose bound grows as `1/√k` on stiff patches, up to
+/// `16 closed` (9 steps, the same resolution). Should even `closed / 4` grow, half of it.
 fn estimate<const NODES: usize, const EDGES: usize>(
     lin: &Linearised<'_, NODES, EDGES>,
     closed: f64,
+    integrator: Integrator,
 ) -> f64 {
     let stable = |h: f64| lin.growth(h) <= 1.0;
-    let (mut lo, mut hi) = (closed / 4.0, 4.0 * closed);
+    let (top, steps) = match integrator {
+        Integrator::ImprovedEuler => (4.0, 7),
+        Integrator::SymplecticDamped => (16.0, 9),
+    };
+    let (mut lo, mut hi) = (closed / 4.0, top * closed);
     if stable(hi) {
         return hi;
     }
     if !stable(lo) {
         return 0.5 * lo;
     }
-    for _ in 0..7 {
+    for _ in 0..steps {
         let mid = libm::sqrt(lo * hi);
         if stable(mid) {
             lo = mid;
@@ -256,6 +315,9 @@ struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     b_c: f32,
     /// 1000 / m: (mm/s²) per N.
     per_mass: f32,
+    integrator: Integrator,
+    /// [`most_damping`], 1/s.
+    most_damping: f32,
 }
 
 impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
@@ -276,6 +338,8 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             k_c: config.coupling.stiffness as f32,
             b_c: (config.coupling.damping / 1000.0) as f32,
             per_mass: (1000.0 / config.node_mass) as f32,
+            integrator: config.integrator,
+            most_damping: most_damping(topo, config) as f32,
         }
     }
 
@@ -331,7 +395,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         energy
     }
 
-    /// How much the improved Euler step `h` grows a perturbation: the ratio of its
+    /// How much the configured integrator's step `h` grows a perturbation: the ratio of its
     /// energy (kinetic and elastic, which an oscillation trades without changing their
     /// sum, so that the ratio does not depend on the phase it stops at) over the last 256
     /// of 768 steps (the first 512 let the decaying modes fall behind the growing one, as
@@ -340,7 +404,13 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         const STEPS: usize = 768;
         const WINDOW: usize = 256;
         let n = self.topo.node_count().min(NODES);
-        let (h, hm) = (h as f32, h as f32 * self.per_mass);
+        let symplectic = self.integrator == Integrator::SymplecticDamped;
+        let d = if symplectic {
+            1.0 / (1.0 + h as f32 * self.most_damping)
+        } else {
+            1.0
+        };
+        let (h, hm) = (h as f32, h as f32 * self.per_mass * d);
         let mut x = [[0.0f32; 3]; NODES];
         let mut v = [[0.0f32; 3]; NODES];
         let mut f = [[0.0f32; 3]; NODES];
@@ -372,7 +442,8 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             for i in 1..n {
                 for j in 0..3 {
                     let v_new = v[i][j] + hm * f[i][j];
-                    x[i][j] += 0.5 * h * (v[i][j] + v_new);
+                    let from = if symplectic { v_new } else { v[i][j] };
+                    x[i][j] += 0.5 * h * (from + v_new);
                     v[i][j] = v_new;
                 }
             }

@@ -102,6 +102,24 @@ pub enum ArithArg {
     Narrow,
 }
 
+/// The solver's integrator (`mccs::Integrator`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorArg {
+    /// The paper's improved Euler (eqs. 21–22).
+    ImprovedEuler,
+    /// Symplectic Euler with one implicit damping factor: a larger stable substep.
+    SymplecticDamped,
+}
+
+impl From<IntegratorArg> for mccs::Integrator {
+    fn from(a: IntegratorArg) -> Self {
+        match a {
+            IntegratorArg::ImprovedEuler => mccs::Integrator::ImprovedEuler,
+            IntegratorArg::SymplecticDamped => mccs::Integrator::SymplecticDamped,
+        }
+    }
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Print F(ε) and dF/dε as CSV `strain,force_n,stiffness_n` for ε = FROM, FROM+STEP, … ≤ TO.

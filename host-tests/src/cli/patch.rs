@@ -140,6 +140,7 @@ impl PatchRun {
     pub fn reactions(&self, p: &Params, file: &Path) -> Result<Vec<(f64, f64)>, CliError> {
         let cfg = SolverConfig {
             tick_hz: self.patch.rate,
+            integrator: self.patch.integrator.into(),
             ..SolverConfig::default()
         };
         match self.patch.engine() {

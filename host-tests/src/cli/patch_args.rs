@@ -1,7 +1,7 @@
 //! The arguments `patch` and `replay` share: the standard patch, the solver and its
 //! configuration, with the same defaults in both.
 
-use super::{arg_error, ArithArg, Backend, CliError};
+use super::{arg_error, ArithArg, Backend, CliError, IntegratorArg};
 use crate::replay::{Engine, MAX_GRID_FIXED};
 use mccs::{Coupling, SolverConfig};
 
@@ -26,6 +26,9 @@ pub(super) struct PatchArgs {
     /// Tick rate, Hz (a whole number, 1 … 100000).
     #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     pub rate: f64,
+    /// Integrator of either backend (docs/performance.md, "Integrator variants").
+    #[arg(long, value_enum, default_value_t = IntegratorArg::ImprovedEuler)]
+    pub integrator: IntegratorArg,
 }
 
 impl PatchArgs {

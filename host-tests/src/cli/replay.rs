@@ -8,7 +8,7 @@ use crate::paramfile;
 use crate::replay::{Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
 use crate::trajectory;
-use mccs::ProxyError;
+use mccs::{ProxyError, SolverConfig};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -113,7 +113,10 @@ impl Args {
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     a.patch.check()?;
-    let cfg = a.tuning.config(a.patch.rate)?;
+    let cfg = SolverConfig {
+        integrator: a.patch.integrator.into(),
+        ..a.tuning.config(a.patch.rate)?
+    };
     let roaming = a.roaming()?;
     let p = paramfile::read(&a.params)?;
     // The table is built (and its errors named) before the trajectory is read.

@@ -428,6 +428,13 @@ impl RoamTwin {
                 shifted: self.out.shifted,
             };
         }
+        // The twin's integrator (`Twin::substep`'s), on the window's mesh.
+        let symplectic = cfg.integrator == mccs::Integrator::SymplecticDamped;
+        let d = if symplectic {
+            1.0 / (1.0 + h * self.twin.most_damping())
+        } else {
+            1.0
+        };
         let mesh = &self.twin.mesh;
         for i in 0..self.twin.x.len() {
             if mesh.fixed[i] {
@@ -436,8 +443,12 @@ impl RoamTwin {
             for k in 0..3 {
                 let vi = self.twin.v[i][k];
                 let net = f[i][k] - cfg.node_damping / 1000.0 * vi;
-                let v_new = vi + h * 1000.0 * net / cfg.node_mass;
-                self.twin.x[i][k] += 0.5 * h * (vi + v_new);
+                let v_new = vi + h * d * 1000.0 * net / cfg.node_mass;
+                self.twin.x[i][k] += if symplectic {
+                    h * v_new
+                } else {
+                    0.5 * h * (vi + v_new)
+                };
                 self.twin.v[i][k] = v_new;
             }
         }

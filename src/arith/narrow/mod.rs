@@ -67,7 +67,8 @@ impl Arith for Narrow {
     }
 
     fn coeffs(spec: &StepSpec) -> NarrowCoeffs {
-        let g = NarrowDamping::velocity_frac(spec.spring_damping, spec.h / spec.node_mass);
+        let g =
+            NarrowDamping::velocity_frac(spec.spring_damping, spec.velocity_h() / spec.node_mass);
         NarrowCoeffs {
             damping: NarrowDamping::with_frac(spec.spring_damping, g),
             step: NarrowStep::new(spec),
@@ -118,10 +119,19 @@ impl Arith for Narrow {
     #[inline(always)]
     fn integrate(c: &NarrowCoeffs, free: &mut [Node]) {
         let s = &c.step;
-        if s.fast_path {
-            free.iter_mut().for_each(|n| step::integrate::<false>(s, n));
-        } else {
-            free.iter_mut().for_each(|n| step::integrate::<true>(s, n));
+        match (s.fast_path, s.symplectic) {
+            (true, false) => free
+                .iter_mut()
+                .for_each(|n| step::integrate::<false, false>(s, n)),
+            (false, false) => free
+                .iter_mut()
+                .for_each(|n| step::integrate::<true, false>(s, n)),
+            (true, true) => free
+                .iter_mut()
+                .for_each(|n| step::integrate::<false, true>(s, n)),
+            (false, true) => free
+                .iter_mut()
+                .for_each(|n| step::integrate::<true, true>(s, n)),
         }
     }
 }

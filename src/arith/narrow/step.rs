@@ -1,4 +1,4 @@
-//! [`NarrowStep`]: the improved Euler step with 16-bit coefficients on the stored
+//! [`NarrowStep`]: the integrator's step with 16-bit coefficients on the stored
 //! velocity `V = C_v v`.
 
 use super::NarrowDamping;
@@ -28,6 +28,8 @@ pub struct NarrowStep {
     /// `⌊f · fast / 2¹⁶⌋ >> fast_sh` and the position change as
     /// `⌊(V + V') · fast_hh / 2¹⁴⌋ >> fast_hh_sh`.
     pub(super) fast_path: bool,
+    /// [`crate::arith::Integrator::SymplecticDamped`]: `u' = u + h v'`.
+    pub(super) symplectic: bool,
     fast: i32,
     fast_sh: u8,
     fast_hh: i32,
@@ -55,18 +57,16 @@ impl NarrowStep {
     /// For `spec` (start-up).
     #[inline(never)]
     pub fn new(spec: &StepSpec) -> Self {
-        let StepSpec {
-            h,
-            node_mass,
-            node_damping,
-            spring_damping,
-        } = *spec;
+        // The velocity step's substep `h D` and the position step's `h`.
+        let (h, hd) = (spec.h, spec.velocity_h());
+        let (node_mass, node_damping, spring_damping) =
+            (spec.node_mass, spec.node_damping, spec.spring_damping);
         let cv = NarrowDamping::velocity_scale(spring_damping);
         // Stored velocities: Q(20 + g) N.
-        let vq = FORCE_FRAC + NarrowDamping::velocity_frac(spring_damping, h / node_mass);
-        let (damp, damp_sh) = q::norm16(h * node_damping / node_mass, 16, 30);
+        let vq = FORCE_FRAC + NarrowDamping::velocity_frac(spring_damping, hd / node_mass);
+        let (damp, damp_sh) = q::norm16(hd * node_damping / node_mass, 16, 30);
         // C_v h/m ≤ 0.03 · 2000 (checked), as Q(x): f · step / 2^(x + 20 − vq).
-        let (step, x) = q::norm16(cv * 1000.0 * h / node_mass, 0, 60);
+        let (step, x) = q::norm16(cv * 1000.0 * hd / node_mass, 0, 60);
         let (step_sh1, step_sh2) = split_shift((x + FORCE_FRAC).saturating_sub(vq));
         let f_hold = if step > 0 {
             ((1i64 << (30 + step_sh1)) / step as i64).min(i32::MAX as i64) as i32
@@ -76,7 +76,7 @@ impl NarrowStep {
         let v_limit = from_f64(VEL_LIMIT_MM_S * cv, vq);
         // Without the hold the step per unit force is ≤ ½ in stored units: one operand
         // and one right shift after a 16-bit product.
-        let factor = cv * 1000.0 * h / node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
+        let factor = cv * 1000.0 * hd / node_mass * libm::ldexp(1.0, vq as i32 - FORCE_FRAC as i32);
         let factor_hh = 0.5 * h / cv * libm::ldexp(1.0, LEN_FRAC as i32 - vq as i32);
         let fast_path = f_hold == i32::MAX && factor_hh < 2.0 - 1.0 / 16384.0 && v_limit <= 1 << 28;
         let ((fast, fast_sh), (fast_hh, fast_hh_sh)) = if fast_path {
@@ -100,6 +100,7 @@ impl NarrowStep {
             step_sh2: step_sh2 as u8,
             f_hold,
             fast_path,
+            symplectic: spec.symplectic(),
             fast,
             fast_sh: fast_sh as u8,
             fast_hh,
@@ -130,15 +131,16 @@ impl NarrowStep {
     }
 }
 
-/// The improved Euler step with 16-bit coefficients on the stored velocity `V = C_v v`
+/// The integrator's step with 16-bit coefficients on the stored velocity `V = C_v v`
 /// ([`NarrowStep`]): two 32-bit multiplies per product on the M0. With `HOLD` (the
 /// general path) the force is held at `f_hold` so that the velocity step fits (16384
 /// mm/s in one substep: never reached by a stable patch), and the shifts are run-time;
 /// without (`fast_path`: every force fits, the stored velocities' fraction bits being
 /// chosen for it where they can be, see [`NarrowDamping::velocity_frac`]), two
-/// fixed-shift products with one run-time shift each.
+/// fixed-shift products with one run-time shift each. With `SYMPLECTIC` the position
+/// advances by the new velocity alone (the velocity step's `h D` is in the coefficients).
 #[inline(always)]
-pub(super) fn integrate<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
+pub(super) fn integrate<const HOLD: bool, const SYMPLECTIC: bool>(c: &NarrowStep, n: &mut Node) {
     for j in 0..3 {
         let (u, v, f) = (n.u[j], n.v[j], n.f[j]);
         // V' = V − (h c/m) V + (C_v h/m) f: |V (1 − h c/m)| < 2³⁰ and the step ≤ 2³⁰,
@@ -155,10 +157,10 @@ pub(super) fn integrate<const HOLD: bool>(c: &NarrowStep, n: &mut Node) {
             .wrapping_add(step)
             .max(-c.v_limit)
             .min(c.v_limit);
-        // u' = u + (V + V') h/(2 C_v): to Q24 mm by the shifts, |du| < 2³⁰ (the fast
-        // path: |V + V'| ≤ 2²⁹ and the factor < 2, so its 16-bit pieces and its result
-        // stay within 2³⁰).
-        let vv = v.wrapping_add(v_new);
+        // u' = u + (V + V') h/(2 C_v), or (V' + V') h/(2 C_v) with `SYMPLECTIC`: to Q24
+        // mm by the shifts, |du| < 2³⁰ (the fast path: |V + V'| ≤ 2²⁹ and the factor
+        // < 2, so its 16-bit pieces and its result stay within 2³⁰).
+        let vv = if SYMPLECTIC { v_new } else { v }.wrapping_add(v_new);
         let du = if HOLD {
             q::mul_s_by(vv, c.hh, c.hh_sh1 as u32) >> c.hh_sh2
         } else {
@@ -180,6 +182,8 @@ mod tests {
             node_mass: m,
             node_damping: 0.05,
             spring_damping: c,
+            integrator: crate::arith::Integrator::ImprovedEuler,
+            damping_factor: 1.0,
         }
     }
 

@@ -66,6 +66,8 @@ fn spring_case() -> SpringCase {
             node_mass: cfg.node_mass,
             node_damping: cfg.node_damping,
             spring_damping: cfg.spring_damping,
+            integrator: mccs::Integrator::ImprovedEuler,
+            damping_factor: 1.0,
         }),
     }
 }

@@ -26,7 +26,7 @@ use super::fw_common::exit;
 use super::rng::Rng;
 use mccs::arith::{wide, ArithTable, StepSpec};
 use mccs::state::Node;
-use mccs::{Arith, End, ForceTable64, Topology, Wide};
+use mccs::{Arith, End, ForceTable64, Integrator, Topology, Wide};
 use mccs_firmware::target::{Core, CORE};
 
 /// States checked, per set.
@@ -112,6 +112,10 @@ fn run(table: &ForceTable64) {
             node_mass: 0.005,
             node_damping: 0.05,
             spring_damping: [0.0, 1.0, 30.0][(state % 3) as usize],
+            // Both integrators' loops, the symplectic one with a velocity factor.
+            integrator: [Integrator::ImprovedEuler, Integrator::SymplecticDamped]
+                [(state / 15 % 2) as usize],
+            damping_factor: [1.0, 0.6][(state / 15 % 2) as usize],
         });
         // The patch: displacement scales 2^12 … 2^31 Q24 mm.
         let disp_bits = 12 + state % 20;
