@@ -135,6 +135,7 @@ pub fn substep<const N: usize, const E: usize>(
     n: usize,
     table: &ForceTable64,
     probe: [Length; 3],
+    integrator: mccs::Integrator,
 ) -> u32 {
     let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
         exit(false)
@@ -143,6 +144,7 @@ pub fn substep<const N: usize, const E: usize>(
     // bound spares the bench the estimate's start-up time.
     let cfg = SolverConfig {
         bound: mccs::Bound::Conservative,
+        integrator,
         ..SolverConfig::default()
     };
     let Ok(mut s) = Solver::new(topo, *table, &cfg) else {

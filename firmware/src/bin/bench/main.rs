@@ -35,11 +35,11 @@ mod rng;
 mod firmware {
     use super::fw_common::exit;
     use super::harness::Harness;
-    use super::report::{check_budgets, fits, largest_patch, Figures, Steps};
+    use super::report::{check_budgets, fits, largest_patch, substep_case, Figures, Steps};
     use super::{cases, harness, hold_check, kernel_check};
     use core::hint::black_box;
     use cortex_m_rt::entry;
-    use mccs::{ForceTable64, Length, Solver};
+    use mccs::{ForceTable64, Integrator, Length, Solver};
     use mccs_firmware::target::{Core, CORE};
 
     static TABLE2: ForceTable64 = include!("../../../../tables/table2.rs");
@@ -67,24 +67,26 @@ mod firmware {
         );
         figs.report("spring", cases::spring(&h, &table));
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
-        let sub = |h: &Harness, n| match n {
-            3 => cases::substep::<2, 9>(h, 3, &table, probe),
-            4 => cases::substep::<5, 30>(h, 4, &table, probe),
-            5 => cases::substep::<10, 61>(h, 5, &table, probe),
-            6 => cases::substep::<17, 102>(h, 6, &table, probe),
-            7 => cases::substep::<26, 153>(h, 7, &table, probe),
-            _ => cases::substep::<37, 214>(h, 8, &table, probe),
+        let sub = |h: &Harness, n, i| match n {
+            3 => cases::substep::<2, 9>(h, 3, &table, probe, i),
+            4 => cases::substep::<5, 30>(h, 4, &table, probe, i),
+            5 => cases::substep::<10, 61>(h, 5, &table, probe, i),
+            6 => cases::substep::<17, 102>(h, 6, &table, probe, i),
+            7 => cases::substep::<26, 153>(h, 7, &table, probe, i),
+            _ => cases::substep::<37, 214>(h, 8, &table, probe, i),
         };
-        figs.report("substep_n3", sub(&h, 3) - empty);
-        figs.report("substep_n4", sub(&h, 4) - empty);
-        figs.report("substep_n5", sub(&h, 5) - empty);
-        // Not on the M0: its 16 KiB hold neither these patches nor their figures.
-        if CORE != Core::M0 {
-            figs.report("substep_n6", sub(&h, 6) - empty);
-            figs.report("substep_n7", sub(&h, 7) - empty);
-            figs.report("substep_n8", sub(&h, 8) - empty);
+        // Not on the M0 above N = 5: its 16 KiB hold neither these patches nor their
+        // figures. Each integrator's substep (the symplectic option's names end in
+        // `_symplectic`).
+        let largest = if CORE == Core::M0 { 5 } else { 8 };
+        for integrator in [Integrator::ImprovedEuler, Integrator::SymplecticDamped] {
+            for n in 3..=largest {
+                let name = substep_case(n, integrator).unwrap_or("substep");
+                figs.report(name, sub(&h, n, integrator) - empty);
+            }
         }
-        let steps = Steps::new(&table);
+        let steps = Steps::new(&table, Integrator::ImprovedEuler);
+        let steps_symplectic = Steps::new(&table, Integrator::SymplecticDamped);
         let sub5 = steps.substeps(5, 1000).unwrap_or(1);
         let sub8 = steps.substeps(8, 1000).unwrap_or(1);
         // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
@@ -170,6 +172,7 @@ mod firmware {
         }
         fits(&figs, &steps);
         largest_patch(&figs, &steps);
+        largest_patch(&figs, &steps_symplectic);
         let ok = check_budgets(&figs);
         exit(ok)
     }

@@ -2,7 +2,7 @@
 //! largest patch that fits a tick (`FIT`), and held to `bench/budgets.txt`.
 
 use mccs::solver::stability::bounds;
-use mccs::{ForceTable64, SolverConfig, Topology};
+use mccs::{ForceTable64, Integrator, SolverConfig, Topology};
 use mccs_firmware::target::{Core, CORE};
 
 /// Clock (MHz) and cycles per instruction (×100) assumed to turn instruction counts into
@@ -15,9 +15,9 @@ const CLOCK: (u32, u32) = match CORE {
     Core::M0 => (48, 150),
 };
 
-/// The figures measured in this run, by case name (32 at most; a full list only drops
+/// The figures measured in this run, by case name (48 at most; a full list only drops
 /// the budget check's view of the rest, which then reports them missing).
-pub struct Figures(heapless::Vec<(&'static str, u32), 32>);
+pub struct Figures(heapless::Vec<(&'static str, u32), 48>);
 
 impl Figures {
     /// None yet.
@@ -55,14 +55,32 @@ const SUBSTEP: [&str; 6] = [
     "substep_n8",
 ];
 
-/// The largest standard patch whose tick (substeps at `tick_hz` × the measured substep,
-/// default configuration) fits in `half_tick` instructions: `(n, substeps, tick)`, or
-/// `None` where none fits.
+const SUBSTEP_SYMPLECTIC: [&str; 6] = [
+    "substep_n3_symplectic",
+    "substep_n4_symplectic",
+    "substep_n5_symplectic",
+    "substep_n6_symplectic",
+    "substep_n7_symplectic",
+    "substep_n8_symplectic",
+];
+
+/// The case name of one substep of the N × N patch (N = 3 … 8) with `integrator`.
+pub fn substep_case(n: u32, integrator: Integrator) -> Option<&'static str> {
+    let names = match integrator {
+        Integrator::ImprovedEuler => &SUBSTEP,
+        Integrator::SymplecticDamped => &SUBSTEP_SYMPLECTIC,
+    };
+    names.get((n as usize).checked_sub(3)?).copied()
+}
+
+/// The largest standard patch whose tick (substeps at `tick_hz` × the measured substep
+/// of `steps`' integrator, default configuration otherwise) fits in `half_tick`
+/// instructions: `(n, substeps, tick)`, or `None` where none fits.
 fn largest(figs: &Figures, steps: &Steps, tick_hz: u32, half_tick: u32) -> Option<(u32, u32, u32)> {
     (3..=8u32)
         .filter_map(|n| {
             let substeps = steps.substeps(n, tick_hz)?;
-            let tick = substeps.saturating_mul(figs.get(SUBSTEP[n as usize - 3])?);
+            let tick = substeps.saturating_mul(figs.get(substep_case(n, steps.integrator)?)?);
             (tick <= half_tick).then_some((n, substeps, tick))
         })
         .next_back()
@@ -89,14 +107,20 @@ pub fn fits(figs: &Figures, steps: &Steps) {
 }
 
 /// The largest standard patch that fits in half a 1 kHz tick at the core's clock at one
-/// instruction per cycle (issue #17's yardstick), as a `BENCH` line:
-/// `case=largest_patch_1khz n= substeps= instructions=` (all 0 where none fits).
+/// instruction per cycle (issue #17's yardstick), with `steps`' integrator, as a `BENCH`
+/// line: `case=largest_patch_1khz n= substeps= instructions=` (all 0 where none fits);
+/// the symplectic option's case is `largest_patch_1khz_symplectic`.
 pub fn largest_patch(figs: &Figures, steps: &Steps) {
     let half_tick = CLOCK.0 * 1_000_000 / 2_000;
     let (n, substeps, tick) = largest(figs, steps, 1_000, half_tick).unwrap_or((0, 0, 0));
+    let case = match steps.integrator {
+        Integrator::ImprovedEuler => "largest_patch_1khz",
+        Integrator::SymplecticDamped => "largest_patch_1khz_symplectic",
+    };
     defmt::println!(
-        "BENCH core={=str} case=largest_patch_1khz n={=u32} substeps={=u32} instructions={=u32} half_tick_instructions={=u32}",
+        "BENCH core={=str} case={=str} n={=u32} substeps={=u32} instructions={=u32} half_tick_instructions={=u32}",
         CORE.name(),
+        case,
         n,
         substeps,
         tick,
@@ -108,21 +132,29 @@ pub fn largest_patch(figs: &Figures, steps: &Steps) {
 /// N × N patch, for N = 3 … 8 (`None` where the core cannot hold the patch): computed
 /// once, since it does not depend on the tick rate (the estimate is the start-up's
 /// longest job).
-pub struct Steps([Option<f64>; 6]);
+pub struct Steps {
+    steps: [Option<f64>; 6],
+    integrator: Integrator,
+}
 
 impl Steps {
-    /// Computes them (out of line: the M0's `main` must not carry these frames).
+    /// Computes them with `integrator` (out of line: the M0's `main` must not carry these
+    /// frames).
     #[inline(never)]
-    pub fn new(table: &ForceTable64) -> Self {
-        let cfg = SolverConfig::default();
-        Self(core::array::from_fn(|i| {
-            chosen_step(i as u32 + 3, table, &cfg)
-        }))
+    pub fn new(table: &ForceTable64, integrator: Integrator) -> Self {
+        let cfg = SolverConfig {
+            integrator,
+            ..SolverConfig::default()
+        };
+        Self {
+            steps: core::array::from_fn(|i| chosen_step(i as u32 + 3, table, &cfg)),
+            integrator,
+        }
     }
 
     /// Substeps per tick at `tick_hz` for the N × N patch.
     pub fn substeps(&self, n: u32, tick_hz: u32) -> Option<u32> {
-        let h = (*self.0.get((n as usize).checked_sub(3)?)?)?;
+        let h = (*self.steps.get((n as usize).checked_sub(3)?)?)?;
         let s = libm::ceil(1.0 / (tick_hz as f64 * h));
         (1.0..1e6).contains(&s).then_some(s as u32)
     }
