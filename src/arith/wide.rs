@@ -251,9 +251,10 @@ fn spring<const S: usize>(
     let strain = Strain::from_bits(((1 << AR_Q) - stretch) >> (AR_Q - LEN_FRAC));
     let f = table.force_within::<SPRING_FORCE_BITS>(strain);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
-    // −f r: Q20 · Q27 = Q47, Q22 is `>> 25`: |f| ≤ 64 N and r < 8 keep it within
-    // ±512 N, which Q22 holds.
-    let neg_fr = (q::mul_wide(-f, rn) >> (FORCE_FRAC + R_FRAC - FR_FRAC)) as i32;
+    // f r: Q20 · Q27 = Q47, Q22 is `>> 25`: |f| ≤ 64 N and r < 8 keep it within
+    // ±512 N, which Q22 holds (and its negation). Negated after the shift, so that the
+    // M4F's loop subtracts the product instead (`smmlsr`, one negation fewer).
+    let neg_fr = ((q::mul_wide(f, rn) >> (FORCE_FRAC + R_FRAC - FR_FRAC)) as i32).wrapping_neg();
     // The velocities are read only now (no instruction: it keeps the compiler from
     // loading them early and spilling them around the table lookup).
     core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);

@@ -28,10 +28,13 @@ use crate::table::{ForceTable, RawTable};
 use crate::topology::{Edge, Topology};
 
 /// What the loop reads at entry (`repr(C)`: one `ldm`). The first six words become its
-/// frame: `nodes` and `stride` one `ldrd` (a node's address is `nodes + stride · i`).
+/// frame: `velocities` and `stride` one `ldrd` (node `i`'s velocity is at
+/// `velocities + stride · i`; its displacement just before, one `ldmdb`, its
+/// accumulator just after).
 #[repr(C)]
 struct LoopArgs {
-    nodes: *mut Node,
+    /// The first node's velocity: the nodes' address plus 12.
+    velocities: *mut i32,
     /// `size_of::<Node>()`, 36.
     stride: u32,
     end: *const Edge,
@@ -116,7 +119,7 @@ macro_rules! asm_writing_all {
 
 /// The part of one spring both of its kinds share: from `dir + d/l0` (r0–r2, Q23) to
 /// the edge vector `w` (r0–r2, Q30), the advanced warm-start `l0/l` (r10, stored
-/// through r7, which moves on) and `−f l0/l` (r8, Q22); r3 is the damping. Keeps r4
+/// through r7, which moves on) and `f l0/l` (r8, Q22); r3 is the damping. Keeps r4
 /// (node b), r6 (node a), r7, r12.
 macro_rules! spring_body {
     () => {
@@ -195,10 +198,10 @@ macro_rules! spring_body {
             "orr r3, r5, r3, lsr #20\n",
             "ldr r5, [r11, #{force_hi}]\n",
             "qadd r5, r5, r3\n",
-            // f within ±64 N; −f r' >> 25 (Q22); the damping.
+            // f within ±64 N; f r' >> 25 (Q22; the law's product subtracts it); the
+            // damping.
             "53:\n",
             "ssat r5, #27, r5\n",
-            "rsb r5, r5, #0\n",
             "smull r3, r8, r5, r10\n",
             "lsl r8, r8, #7\n",
             "orr r8, r8, r3, lsr #25\n",
@@ -207,8 +210,9 @@ macro_rules! spring_body {
     };
 }
 
-/// One axis of a spring between two nodes: `p = round(C dv) + round(w (−f r))`, held
-/// within ±64 N, into the axis' `w` register. `$w`: w's register; `$vb`: the offset of
+/// One axis of a spring between two nodes: `p = round(C dv) + round(w (−f r))` (one
+/// `smmlsr`: `t − w (f r)` rounded is `t + round(w (−f r))`), held within ±64 N, into
+/// the axis' `w` register. `$w`: w's register; `$vb`: the offset of
 /// b's velocity component; `$va`: the register holding a's.
 macro_rules! axis_two {
     ($w:literal, $vb:literal, $va:literal) => {
@@ -226,7 +230,7 @@ macro_rules! axis_two {
             ", ",
             $va,
             ", r3\n",
-            "smmlar ",
+            "smmlsr ",
             $w,
             ", ",
             $w,
@@ -254,11 +258,12 @@ macro_rules! axis_ground {
     };
 }
 
-/// Node a's accumulator (r6) takes `p` (r0–r2); the next spring, until the end.
+/// Node a's accumulator (after its velocity, r6) takes `p` (r0–r2); the next spring,
+/// until the end.
 macro_rules! a_takes_p_and_loops {
     () => {
         concat!(
-            "add r6, r6, #24\n",
+            "add r6, r6, #12\n",
             "ldm r6, {{r5, r9, r10}}\n",
             "add r5, r5, r0\n",
             "add r9, r9, r1\n",
@@ -286,7 +291,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
     let n = edges.len().min(EDGES);
     let raw = table.raw();
     let args = LoopArgs {
-        nodes: nodes.as_mut_ptr(),
+        velocities: nodes.as_mut_ptr().cast::<i32>().wrapping_add(3),
         stride: core::mem::size_of::<Node>() as u32,
         end: edges.as_ptr().wrapping_add(n),
         segments: raw.segments.as_ptr(),
@@ -313,19 +318,20 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "mov r7, r8",
             "cmp r12, r3",
             "beq 90f",
-            // One spring: the edge (dir, 1/l0, a | b << 16) and its node addresses.
+            // One spring: the edge (dir, 1/l0, a | b << 16) and its nodes' velocity
+            // addresses.
             "20:",
             "ldm r12!, {{r0, r1, r2, r3, r4}}",
-            // a's address: base + 36 a, one multiply-accumulate of the low half (a node
-            // index below 2¹⁵, so the signed half is the index); then b's of the high
-            // half, unless b is the ground.
+            // a's: base + 36 a, one multiply-accumulate of the low half (a node index
+            // below 2¹⁵, so the signed half is the index); then b's of the high half,
+            // unless b is the ground. Their displacements: the three words before.
             "ldrd r5, r11, [sp]",
             "smlabb r6, r4, r11, r5",
             "lsrs lr, r4, #16",
             "beq 30f",
             "smlatb r4, r4, r11, r5",
-            "ldm r4, {{r5, r8, r9}}",
-            "ldm r6, {{r10, r11, lr}}",
+            "ldmdb r4, {{r5, r8, r9}}",
+            "ldmdb r6, {{r10, r11, lr}}",
             "sub r5, r5, r10",
             "sub r8, r8, r11",
             "sub r9, r9, lr",
@@ -334,13 +340,12 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "smmla r1, r8, r3, r1",
             "smmla r2, r9, r3, r2",
             spring_body!(),
-            "add r11, r6, #12",
-            "ldm r11, {{r5, r9, r10}}",
-            axis_two!("r0", "12", "r5"),
-            axis_two!("r1", "16", "r9"),
-            axis_two!("r2", "20", "r10"),
+            "ldm r6, {{r5, r9, r10}}",
+            axis_two!("r0", "0", "r5"),
+            axis_two!("r1", "4", "r9"),
+            axis_two!("r2", "8", "r10"),
             // b's accumulator takes −p, a's p.
-            "add r4, r4, #24",
+            "add r4, r4, #12",
             "ldm r4, {{r5, r9, r10}}",
             "sub r5, r5, r0",
             "sub r9, r9, r1",
@@ -351,13 +356,14 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             // A spring to the ground: b at rest, d = −u_a, so dir − hi(u_a / l0)
             // (`smmls`, exact: u_a is never i32::MIN).
             "30:",
-            "ldm r6, {{r10, r11, lr}}",
+            "ldmdb r6, {{r10, r11, lr}}",
             "smmls r0, r10, r3, r0",
             "smmls r1, r11, r3, r1",
             "smmls r2, lr, r3, r2",
             spring_body!(),
-            "add r11, r6, #12",
-            "ldm r11, {{r5, r9, r10}}",
+            // −f r' for the ground's axes.
+            "rsb r8, r8, #0",
+            "ldm r6, {{r5, r9, r10}}",
             axis_ground!("r0", "r5"),
             axis_ground!("r1", "r9"),
             axis_ground!("r2", "r10"),
