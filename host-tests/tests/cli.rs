@@ -925,8 +925,12 @@ fn replay_roams_in_the_core_as_in_the_reference() {
             .collect()
     };
     // Flat, and over a cap (R = 200 mm: the path's 1 mm below the top is 0.44 … 1 mm
-    // deep).
-    for shape in [&[][..], &["--cap-radius", "200"][..]] {
+    // deep); and flat with the symplectic integrator option in both backends.
+    for shape in [
+        &[][..],
+        &["--cap-radius", "200"][..],
+        &["--integrator", "symplectic-damped"][..],
+    ] {
         let reference = run(shape);
         for extra in [
             &["--backend", "fixed"][..],
