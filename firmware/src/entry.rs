@@ -3,10 +3,10 @@
 //! nothing but the call itself.
 
 use mccs::arith::ArithTable;
-use mccs::state::SpringEnds;
+use mccs::state::{Node, SpringEnds};
 use mccs::{
     Arith, DefaultArith, Edge, Force, ForceTable64, Length, Proxy, Solver, Stiffness, Strain,
-    Window,
+    Topology, Window,
 };
 
 /// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
@@ -33,6 +33,19 @@ pub fn spring(
     warm: &mut i32,
 ) -> [i32; 3] {
     DefaultArith::spring(table, coeffs, edge, ends, warm)
+}
+
+/// Every spring of a patch once ([`Arith::spring_forces`], the loop a substep runs: the
+/// M4F's in assembly), in this core's arithmetic, never inlined.
+#[inline(never)]
+pub fn spring_loop<const N: usize, const E: usize>(
+    table: &ArithTable<64, DefaultArith>,
+    coeffs: &<DefaultArith as Arith>::Coeffs,
+    topo: &Topology<N, E>,
+    warm: &mut [i32; E],
+    nodes: &mut [Node; N],
+) {
+    DefaultArith::spring_forces(table, coeffs, topo, warm, nodes)
 }
 
 /// One substep of a solver with the probe held at `probe`, never inlined.

@@ -156,6 +156,68 @@ pub fn substep<const N: usize, const E: usize>(
     h.measure(16, || e::substep(&mut s, black_box(probe)))
 }
 
+/// The spring loop alone ([`e::spring_loop`]) over the standard N × N patch pressed as
+/// [`substep`] presses it, per spring: the loop's instructions (averaged over 16 runs)
+/// over the patch's springs, rounded to the nearest. What one spring costs where the
+/// solver runs it (on the M4F, its assembly loop; the `spring` case is the portable
+/// kernel called alone).
+#[inline(never)]
+pub fn spring_in_loop<const N: usize, const E: usize>(
+    h: &Harness,
+    n: usize,
+    table: &ForceTable64,
+    probe: [Length; 3],
+    empty: u32,
+) -> u32 {
+    let Ok(topo) = Topology::<N, E>::standard_patch(n, 2.5) else {
+        exit(false)
+    };
+    let cfg = SolverConfig {
+        bound: mccs::Bound::Conservative,
+        ..SolverConfig::default()
+    };
+    let Ok(mut s) = Solver::new(topo, *table, &cfg) else {
+        exit(false)
+    };
+    for _ in 0..200 {
+        e::tick(&mut s, probe);
+    }
+    let coeffs = DefaultArith::coeffs(&mccs::arith::StepSpec {
+        h: 1.0 / (cfg.tick_hz * s.substeps() as f64),
+        node_mass: cfg.node_mass,
+        node_damping: cfg.node_damping,
+        spring_damping: cfg.spring_damping,
+        integrator: cfg.integrator,
+        damping_factor: 1.0,
+    });
+    // The solver's pressed state, node by node (its velocities as this arithmetic stores
+    // them).
+    let mut nodes = [mccs::state::Node::ZERO; N];
+    for (i, node) in nodes.iter_mut().enumerate().skip(1) {
+        let (Some(u), Some(v)) = (s.displacement(i as u16), s.velocity(i as u16)) else {
+            continue;
+        };
+        node.u = u.map(Length::to_bits);
+        node.v = v.map(|x| DefaultArith::store_velocity(&coeffs, x.to_bits()));
+    }
+    let table = ArithTable::<64, DefaultArith>::new(*table);
+    let mut warm = [DefaultArith::REST; E];
+    // One run first, so that the warm starts are the pressed state's.
+    let topo = s.topology();
+    e::spring_loop(&table, &coeffs, topo, &mut warm, &mut nodes);
+    let run = h.measure(16, || {
+        e::spring_loop(
+            black_box(&table),
+            &coeffs,
+            black_box(topo),
+            &mut warm,
+            &mut nodes,
+        )
+    });
+    let springs = topo.edges().len().max(1) as u32;
+    (run.saturating_sub(empty) + springs / 2) / springs
+}
+
 /// One floating-point substep of the standard N × N patch at `substeps` per tick (the
 /// fixed-point solver's), after 200 substeps pressed in, averaged over 4.
 #[inline(never)]

@@ -85,6 +85,18 @@ mod firmware {
                 figs.report(name, sub(&h, n, integrator) - empty);
             }
         }
+        // One spring where the solver runs it: the spring loop over a pressed patch, per
+        // spring.
+        figs.report(
+            "spring_in_loop_n5",
+            cases::spring_in_loop::<10, 61>(&h, 5, &table, probe, empty),
+        );
+        if CORE != Core::M0 {
+            figs.report(
+                "spring_in_loop_n8",
+                cases::spring_in_loop::<37, 214>(&h, 8, &table, probe, empty),
+            );
+        }
         let steps = Steps::new(&table, Integrator::ImprovedEuler);
         let steps_symplectic = Steps::new(&table, Integrator::SymplecticDamped);
         let sub5 = steps.substeps(5, 1000).unwrap_or(1);
