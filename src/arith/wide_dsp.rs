@@ -117,12 +117,36 @@ macro_rules! asm_writing_all {
     };
 }
 
+/// The lower line's product, `(stiffness_lo · d) >> 20` held to 32 bits, into r3 from
+/// the slope (r5) and `d = e ⊖ anchor_lo` (r3): any slope (a long product, its high
+/// word held, the two words joined).
+macro_rules! lower_any {
+    () => {
+        concat!(
+            "smull r3, r5, r5, r3\n",
+            "ssat r5, #20, r5\n",
+            "lsl r5, r5, #12\n",
+            "orr r3, r5, r3, lsr #20\n",
+        )
+    };
+}
+
+/// The same for a slope within ±2¹⁹ (Q16: below 8 N per unit strain, Table 2's is 2.3):
+/// `hi((stiffness_lo << 12) · d)`, the same bits (`|stiffness_lo · d| < 2⁵⁰`: the hold
+/// never acts), two instructions fewer.
+macro_rules! lower_gentle {
+    () => {
+        concat!("lsl r5, r5, #12\n", "smmul r3, r5, r3\n",)
+    };
+}
+
 /// The part of one spring both of its kinds share: from `dir + d/l0` (r0–r2, Q23) to
 /// the edge vector `w` (r0–r2, Q30), the advanced warm-start `l0/l` (r10, stored
 /// through r7, which moves on) and `f l0/l` (r8, Q22); r3 is the damping. Keeps r4
-/// (node b), r6 (node a), r7, r12.
+/// (node b), r6 (node a), r7, r12. `$lower`: the lower line's product
+/// ([`lower_any`] or [`lower_gentle`]).
 macro_rules! spring_body {
-    () => {
+    ($lower:ident) => {
         concat!(
             // w held within ±2 (Q23), then Q30.
             "ssat r0, #25, r0\n",
@@ -181,10 +205,7 @@ macro_rules! spring_body {
             "ldr r3, [r11, #{anchor_lo}]\n",
             "qsub r3, r9, r3\n",
             "ldr r5, [r11, #{stiffness_lo}]\n",
-            "smull r3, r5, r5, r3\n",
-            "ssat r5, #20, r5\n",
-            "lsl r5, r5, #12\n",
-            "orr r3, r5, r3, lsr #20\n",
+            $lower!(),
             "ldr r5, [r11, #{force_lo}]\n",
             "qadd r5, r5, r3\n",
             "b 53f\n",
@@ -276,40 +297,11 @@ macro_rules! a_takes_p_and_loops {
     };
 }
 
-/// Every spring's force, accumulated on its two nodes: [`super::wide`]'s loop, in
-/// assembly. Only for tables it [`serves`] (the caller's choice, a constant).
-#[inline(always)]
-#[allow(unsafe_code)]
-pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usize>(
-    table: &ForceTable<S>,
-    damping: i32,
-    topo: &Topology<NODES, EDGES>,
-    warm: &mut [i32; EDGES],
-    nodes: &mut [Node; NODES],
-) {
-    let edges = topo.edges();
-    let n = edges.len().min(EDGES);
-    let raw = table.raw();
-    let args = LoopArgs {
-        velocities: nodes.as_mut_ptr().cast::<i32>().wrapping_add(3),
-        stride: core::mem::size_of::<Node>() as u32,
-        end: edges.as_ptr().wrapping_add(n),
-        segments: raw.segments.as_ptr(),
-        shift: raw.shift & 31,
-        damping,
-        edges: edges.as_ptr(),
-        warm: warm.as_mut_ptr(),
-    };
-    // SAFETY: the loop reads the `n` edges of `topo` (`edges` up to `end`) and as many
-    // warm-start values (n ≤ EDGES), writes only those values and the nodes' force
-    // accumulators, and reads the table's header and segments. Every node index is in
-    // bounds of `nodes` and `a` is never the ground nor equal to `b`, as
-    // `Topology::add_edge`, the only way in, guarantees (see `state::for_each_spring`);
-    // the segment index is masked to `S − 1` and `S` is a power of two; the layouts it
-    // reads are asserted above. It saves and restores r6 and r7 itself (the registers
-    // the compiler reserves), declares every other register it writes, and leaves the
-    // stack as it found it.
-    unsafe {
+/// The spring loop over [`LoopArgs`] `$args`, with `$lower` the lower line's product
+/// ([`lower_any`] or [`lower_gentle`]); in `spring_forces`, whose generics the constants
+/// name.
+macro_rules! spring_loop {
+    ($args:ident, $lower:ident) => {
         asm_writing_all!(
             "push {{r6, r7}}",
             "ldm r0, {{r1, r2, r3, r4, r5, r6, r7, r8}}",
@@ -339,7 +331,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "smmla r0, r5, r3, r0",
             "smmla r1, r8, r3, r1",
             "smmla r2, r9, r3, r2",
-            spring_body!(),
+            spring_body!($lower),
             "ldm r6, {{r5, r9, r10}}",
             axis_two!("r0", "0", "r5"),
             axis_two!("r1", "4", "r9"),
@@ -360,7 +352,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             "smmls r0, r10, r3, r0",
             "smmls r1, r11, r3, r1",
             "smmls r2, lr, r3, r2",
-            spring_body!(),
+            spring_body!($lower),
             // −f r' for the ground's axes.
             "rsb r8, r8, #0",
             "ldm r6, {{r5, r9, r10}}",
@@ -379,8 +371,50 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
             stiffness_lo = const header::<S>()[6],
             force_hi = const header::<S>()[7],
             stiffness_hi = const header::<S>()[8],
-            inout("r0") core::ptr::addr_of!(args) => _,
-        );
+            inout("r0") core::ptr::addr_of!($args) => _,
+        )
+    };
+}
+
+/// Every spring's force, accumulated on its two nodes: [`super::wide`]'s loop, in
+/// assembly. Only for tables it [`serves`] (the caller's choice, a constant).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usize>(
+    table: &ForceTable<S>,
+    damping: i32,
+    topo: &Topology<NODES, EDGES>,
+    warm: &mut [i32; EDGES],
+    nodes: &mut [Node; NODES],
+) {
+    let edges = topo.edges();
+    let n = edges.len().min(EDGES);
+    let raw = table.raw();
+    let args = LoopArgs {
+        velocities: nodes.as_mut_ptr().cast::<i32>().wrapping_add(3),
+        stride: core::mem::size_of::<Node>() as u32,
+        end: edges.as_ptr().wrapping_add(n),
+        segments: raw.segments.as_ptr(),
+        shift: raw.shift & 31,
+        damping,
+        edges: edges.as_ptr(),
+        warm: warm.as_mut_ptr(),
+    };
+    // The lower line's product as its slope allows (a constant per call).
+    let gentle = (-(1 << 19)..1 << 19).contains(&raw.stiffness_lo);
+    // SAFETY (both loops): the loop reads the `n` edges of `topo` (`edges` up to `end`)
+    // and as many warm-start values (n ≤ EDGES), writes only those values and the nodes' force
+    // accumulators, and reads the table's header and segments. Every node index is in
+    // bounds of `nodes` and `a` is never the ground nor equal to `b`, as
+    // `Topology::add_edge`, the only way in, guarantees (see `state::for_each_spring`);
+    // the segment index is masked to `S − 1` and `S` is a power of two; the layouts it
+    // reads are asserted above. It saves and restores r6 and r7 itself (the registers
+    // the compiler reserves), declares every other register it writes, and leaves the
+    // stack as it found it.
+    if gentle {
+        unsafe { spring_loop!(args, lower_gentle) }
+    } else {
+        unsafe { spring_loop!(args, lower_any) }
     }
 }
 

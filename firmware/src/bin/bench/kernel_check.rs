@@ -179,8 +179,14 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 5] {
     steep.force_lo = i32::MIN + 1;
     steep.force_hi = i32::MAX - 1;
     steep.strain_hi = raw.strain_lo + (raw.strain_hi - raw.strain_lo) / 8;
+    // The lower line's slope at the two ends of the gentle loop's range (the M4F's
+    // assembly takes another product for a slope within ±2¹⁹): the largest within it,
+    // with the anchor past every strain (the product's largest magnitude), and the
+    // least beyond it.
+    large.stiffness_lo = -(1 << 19) - 1;
     let mut anchored = raw;
     anchored.anchor_lo = i32::MAX;
+    anchored.stiffness_lo = (1 << 19) - 1;
     let mut ends = raw;
     ends.strain_lo = i32::MIN;
     ends.strain_hi = i32::MIN + 1;
