@@ -267,10 +267,11 @@ impl Twin {
             / self.cfg.node_mass
     }
 
-    /// One substep: the paper's improved Euler, `v' = v + h F/m`,
+    /// Advances every free node by one substep under the forces `f` (N; the nodes' own
+    /// damping is added here): the paper's improved Euler, `v' = v + h F/m`,
     /// `x' = x + h (v + v')/2`; or symplectic Euler with one implicit damping factor,
     /// `v' = v + h F/(m (1 + h γ))`, `x' = x + h v'`.
-    fn substep(&mut self, probe: Option<(V, V)>, held: Option<(V, V)>) {
+    pub fn integrate(&mut self, f: &[V]) {
         let h = self.h();
         let symplectic = self.cfg.integrator == mccs::Integrator::SymplecticDamped;
         let d = if symplectic {
@@ -278,20 +279,6 @@ impl Twin {
         } else {
             1.0
         };
-        let mut f = self.spring_forces(&self.x, &self.v);
-        let c = self.mesh.contact;
-        self.reaction = f[c];
-        self.coupling_force = [0.0; 3];
-        if let Some((p, pv)) = probe {
-            let (kc, bc, fmax) = self.cfg.coupling;
-            if p[2] < self.x[c][2] {
-                for k in 0..3 {
-                    let fk = kc * (p[k] - self.x[c][k]) + bc / 1000.0 * (pv[k] - self.v[c][k]);
-                    self.coupling_force[k] = fk.clamp(-fmax, fmax);
-                    f[c][k] += self.coupling_force[k];
-                }
-            }
-        }
         for i in 0..self.x.len() {
             if self.mesh.fixed[i] {
                 continue;
@@ -307,6 +294,24 @@ impl Twin {
                 self.v[i][k] = v_new;
             }
         }
+    }
+
+    fn substep(&mut self, probe: Option<(V, V)>, held: Option<(V, V)>) {
+        let mut f = self.spring_forces(&self.x, &self.v);
+        let c = self.mesh.contact;
+        self.reaction = f[c];
+        self.coupling_force = [0.0; 3];
+        if let Some((p, pv)) = probe {
+            let (kc, bc, fmax) = self.cfg.coupling;
+            if p[2] < self.x[c][2] {
+                for k in 0..3 {
+                    let fk = kc * (p[k] - self.x[c][k]) + bc / 1000.0 * (pv[k] - self.v[c][k]);
+                    self.coupling_force[k] = fk.clamp(-fmax, fmax);
+                    f[c][k] += self.coupling_force[k];
+                }
+            }
+        }
+        self.integrate(&f);
         if let Some((pos, vel)) = held {
             self.x[c] = pos;
             self.v[c] = vel;

@@ -395,7 +395,6 @@ impl RoamTwin {
 
     fn substep(&mut self, p: V, pv: V) {
         let cfg = self.cfg.dynamics;
-        let h = 1.0 / (cfg.tick_hz * cfg.substeps as f64);
         let mut f = self.twin.spring_forces(&self.twin.x, &self.twin.v);
         self.out.force = [0.0; 3];
         self.out.proxy = p;
@@ -428,29 +427,7 @@ impl RoamTwin {
                 shifted: self.out.shifted,
             };
         }
-        // The twin's integrator (`Twin::substep`'s), on the window's mesh.
-        let symplectic = cfg.integrator == mccs::Integrator::SymplecticDamped;
-        let d = if symplectic {
-            1.0 / (1.0 + h * self.twin.most_damping())
-        } else {
-            1.0
-        };
-        let mesh = &self.twin.mesh;
-        for i in 0..self.twin.x.len() {
-            if mesh.fixed[i] {
-                continue;
-            }
-            for k in 0..3 {
-                let vi = self.twin.v[i][k];
-                let net = f[i][k] - cfg.node_damping / 1000.0 * vi;
-                let v_new = vi + h * d * 1000.0 * net / cfg.node_mass;
-                self.twin.x[i][k] += if symplectic {
-                    h * v_new
-                } else {
-                    0.5 * h * (vi + v_new)
-                };
-                self.twin.v[i][k] = v_new;
-            }
-        }
+        // The twin's integrator, on the window's mesh.
+        self.twin.integrate(&f);
     }
 }
