@@ -13,7 +13,7 @@ struct Input {
     from: f64,
     to: f64,
     knots: u8,
-    raw: ([i32; 9], [u32; 3], [[i32; 4]; 16]),
+    raw: ([i32; 9], [u32; 3], [[i32; 4]; 16], [i32; 6]),
     strains: Vec<i32>,
 }
 
@@ -55,7 +55,7 @@ fuzz_target!(|i: Input| {
         2 => build::<64>(&p, i.from, i.to, &i.strains),
         _ => build::<128>(&p, i.from, i.to, &i.strains),
     }
-    let (a, b, segments) = i.raw;
+    let (a, b, segments, c) = i.raw;
     let raw = RawTable {
         strain_lo: a[0],
         strain_hi: a[1],
@@ -69,6 +69,12 @@ fuzz_target!(|i: Input| {
         shift: b[2],
         stiff_scale: a[7],
         stiff_post: a[8],
+        corner_hi: c[0],
+        corner_anchor: c[1],
+        corner_pre: c[2] as u32,
+        corner_base: c[3] as u32,
+        corner_scale: c[4],
+        corner_post: c[5],
         err_force_ppb: b[0],
         err_stiffness_ppb: b[1],
         segments,

@@ -473,12 +473,40 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         "{err}"
     );
     // Table 2 with a cone 10× softer against a series spring 2000 times stiffer than it
-    // (the issue's spring).
+    // (issue 16's spring): refused before the graded corner, now within the bound, and
+    // the header says where the corner is.
     let stiff_series = TABLE2
         .replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e4")
         .replace("shear_modulus = 4.9151e5", "shear_modulus = 1.386e7");
     assert_ne!(stiff_series, TABLE2);
     let f = temp_file("stiff-series.toml", &stiff_series);
+    let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "129"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let src = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        src.lines()
+            .nth(1)
+            .unwrap()
+            .ends_with("within the product's bound (force 2e-5, stiffness 1e-3).")
+            && src
+                .lines()
+                .nth(3)
+                .unwrap()
+                .contains("then 32 graded toward the solid point"),
+        "{src}"
+    );
+    // Table 2 with its preload at 15 F_T, its slope kink Δ(P) just below the solid point:
+    // two corners closer than the grid resolves.
+    let kinked = TABLE2.replace(
+        "shear_modulus = 4.9151e5",
+        "shear_modulus = 4.9151e5\npreload = 8.1175",
+    );
+    assert_ne!(kinked, TABLE2);
+    let f = temp_file("kinked.toml", &kinked);
     let path = f.to_str().unwrap();
     for (knots, advice) in [
         ("65", "more knots (--knots 129)"),
@@ -488,9 +516,9 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         assert_one_line_error(
             &out,
             &[
-                "stiff-series.toml",
+                "kinked.toml",
                 "misses the bound",
-                "k_p/k = 2.01e3",
+                "k_p/k = 7.14e0",
                 advice,
                 "--accept-error",
             ],

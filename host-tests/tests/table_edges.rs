@@ -25,8 +25,18 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
         ),
         (any::<i32>(), any::<i32>()),
         prop::array::uniform16(prop::array::uniform4(any::<i32>())),
+        // The graded corner: half of the tables have one, with any contents.
+        (
+            any::<bool>(),
+            any::<i32>(),
+            any::<i32>(),
+            any::<u32>(),
+            any::<u32>(),
+            any::<i32>(),
+            any::<i32>(),
+        ),
     )
-        .prop_map(|(a, b, c, segments)| RawTable {
+        .prop_map(|(a, b, c, segments, g)| RawTable {
             strain_lo: a.0,
             strain_hi: a.1,
             index_pre: a.2,
@@ -39,6 +49,12 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             shift: b.4,
             stiff_scale: c.0,
             stiff_post: c.1,
+            corner_hi: if g.0 { g.1 } else { a.1 },
+            corner_anchor: g.2,
+            corner_pre: g.3,
+            corner_base: g.4,
+            corner_scale: g.5,
+            corner_post: g.6,
             err_force_ppb: c.0 as u32,
             err_stiffness_ppb: c.1 as u32,
             segments,
@@ -54,7 +70,8 @@ proptest! {
     fn any_raw_table_evaluates_without_panic(raw in any_raw(), strains in prop::array::uniform8(any::<i32>())) {
         let t = ForceTable::from_raw(raw);
         let narrow = ArithTable::<16, Narrow>::new(t);
-        for e in strains.into_iter().chain([i32::MIN, i32::MAX, raw.strain_lo, raw.strain_hi]) {
+        let ends = [i32::MIN, i32::MAX, raw.strain_lo, raw.strain_hi, raw.corner_hi, raw.corner_anchor];
+        for e in strains.into_iter().chain(ends) {
             let e = Strain::from_bits(e);
             let _ = t.force(e);
             let _ = t.force_and_stiffness(e);
@@ -84,6 +101,12 @@ fn a_table_of_no_segments_evaluates_without_panic() {
         shift: 0,
         stiff_scale: 1 << 20,
         stiff_post: 1,
+        corner_hi: 1 << 23,
+        corner_anchor: 0,
+        corner_pre: 0,
+        corner_base: 0,
+        corner_scale: 0,
+        corner_post: 1,
         err_force_ppb: 0,
         err_stiffness_ppb: 0,
         segments: [],

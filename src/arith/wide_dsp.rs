@@ -58,10 +58,12 @@ const _: () = {
     assert!(core::mem::offset_of!(Node, v) == 12);
     assert!(core::mem::offset_of!(Node, f) == 24);
     assert!(core::mem::size_of::<V3>() == 12);
+    // The graded corner's index takes two bits for the segment in an octave.
+    assert!(crate::table::CORNER_PER_OCTAVE == 4);
 };
 
 /// Offsets of the table's header fields from its first segment (bytes, negative).
-const fn header<const S: usize>() -> [i32; 9] {
+const fn header<const S: usize>() -> [i32; 13] {
     let seg = core::mem::offset_of!(RawTable<S>, segments) as i32;
     [
         core::mem::offset_of!(RawTable<S>, strain_lo) as i32 - seg,
@@ -73,16 +75,20 @@ const fn header<const S: usize>() -> [i32; 9] {
         core::mem::offset_of!(RawTable<S>, stiffness_lo) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, force_hi) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, stiffness_hi) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, corner_hi) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, corner_anchor) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, corner_pre) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, corner_base) as i32 - seg,
     ]
 }
 
-/// The header as the assembly addresses it: `ldrd` pairs (`strain_lo, strain_hi` and
-/// `index_pre, index_scale`) and `ldr`s, word-aligned within 255 bytes before the first
-/// segment.
+/// The header as the assembly addresses it: `ldrd` pairs (`strain_lo, strain_hi`,
+/// `index_pre, index_scale` and `corner_anchor, corner_pre`) and `ldr`s, word-aligned
+/// within 255 bytes before the first segment.
 const fn header_fits<const S: usize>() -> bool {
     let h = header::<S>();
     let mut i = 0;
-    let mut ok = h[1] == h[0] + 4 && h[3] == h[2] + 4;
+    let mut ok = h[1] == h[0] + 4 && h[3] == h[2] + 4 && h[11] == h[10] + 4;
     while i < h.len() {
         ok = ok && h[i] >= -252 && h[i] < 0 && h[i] % 4 == 0;
         i += 1;
@@ -194,12 +200,32 @@ macro_rules! spring_body {
             "lsl r3, r3, #17\n",
             "lsr r3, r3, #1\n",
             // Three halving Horner steps, then the coefficients' shift.
+            "55:\n",
             "smmla r11, lr, r3, r11\n",
             "smmla r8, r11, r3, r8\n",
             "smmla r5, r8, r3, r5\n",
             "ldr r3, [sp, #16]\n",
             "asr r5, r5, r3\n",
             "b 53f\n",
+            // The graded corner: d = (A − e) · pre, z = clz(d); the segment is
+            // corner_base + 4 z + the two bits after d's leading one (masked as the
+            // portable index is), τ the next 15; then the same Horner steps.
+            "54:\n",
+            "ldrd r3, r5, [r11, #{corner_anchor}]\n",
+            "sub r3, r3, r9\n",
+            "mul r3, r3, r5\n",
+            "clz r5, r3\n",
+            "lsl r3, r3, r5\n",
+            "ldr r8, [r11, #{corner_base}]\n",
+            "add r8, r8, r5, lsl #2\n",
+            "ubfx r5, r3, #29, #2\n",
+            "add r5, r8, r5\n",
+            "ubfx r5, r5, #0, #{log2s}\n",
+            "add r5, r11, r5, lsl #4\n",
+            "ldm r5, {{r5, r8, r11, lr}}\n",
+            "ubfx r3, r3, #14, #15\n",
+            "lsl r3, r3, #16\n",
+            "b 55b\n",
             // Below: force_lo + (stiffness_lo · (e ⊖ anchor_lo)) >> 20, held.
             "51:\n",
             "ldr r3, [r11, #{anchor_lo}]\n",
@@ -209,8 +235,12 @@ macro_rules! spring_body {
             "ldr r5, [r11, #{force_lo}]\n",
             "qadd r5, r5, r3\n",
             "b 53f\n",
-            // Above: force_hi + (stiffness_hi · (e ⊖ strain_hi)) >> 20, held.
+            // At or above strain_hi: the graded corner below corner_hi; above it
+            // force_hi + (stiffness_hi · (e ⊖ corner_hi)) >> 20, held.
             "52:\n",
+            "ldr r5, [r11, #{corner_hi}]\n",
+            "cmp r9, r5\n",
+            "blt 54b\n",
             "qsub r3, r9, r5\n",
             "ldr r5, [r11, #{stiffness_hi}]\n",
             "smull r3, r5, r5, r3\n",
@@ -371,6 +401,9 @@ macro_rules! spring_loop {
             stiffness_lo = const header::<S>()[6],
             force_hi = const header::<S>()[7],
             stiffness_hi = const header::<S>()[8],
+            corner_hi = const header::<S>()[9],
+            corner_anchor = const header::<S>()[10],
+            corner_base = const header::<S>()[12],
             inout("r0") core::ptr::addr_of!($args) => _,
         )
     };

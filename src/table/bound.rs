@@ -18,7 +18,7 @@
 //!
 //! `f64` and a loop over the segments: start-up or host, never per tick.
 
-use super::ForceTable;
+use super::{ForceTable, CORNER_SEGMENTS};
 use crate::law::Law;
 use crate::units::{Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
@@ -144,9 +144,10 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
     };
     let r = table.raw();
     let (lo, hi) = (r.strain_lo as f64 * u_strain, r.strain_hi as f64 * u_strain);
+    let top = r.corner_hi as f64 * u_strain;
     let n = POINTS_PER_SEGMENT;
-    // The lines beyond the table, then every segment.
-    for (a, b) in [(from, lo), (hi, to)] {
+    // The lines beyond the table, then every segment, then the graded corner's.
+    for (a, b) in [(from, lo), (top, to)] {
         if b > a {
             for j in 0..=n {
                 at(a + (b - a) * j as f64 / n as f64);
@@ -158,6 +159,14 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
     for i in 0..used {
         for j in 0..=n {
             at(lo + step * (i as f64 + j as f64 / n as f64));
+        }
+    }
+    if table.corner().is_some() {
+        for i in 0..CORNER_SEGMENTS {
+            let (a, b) = table.corner_segment_range(i);
+            for j in 0..=n {
+                at(a + (b - a) * j as f64 / n as f64);
+            }
         }
     }
     // At and round the cone's own transition Δ(F_T) (a jump in curvature, not in slope,

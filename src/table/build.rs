@@ -3,7 +3,10 @@
 //! ([`hermite`]), the coefficients' unit ([`coefficient_shift`]), the stiffness scale
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
-use super::{measure, ForceTable, RawTable, TableBound, TableError, DEFAULT_DOMAIN, UNMEASURED};
+use super::{
+    corner_strain, measure, ForceTable, RawTable, TableBound, TableError, CORNER_OCTAVES,
+    CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, UNMEASURED,
+};
 use crate::law::Law;
 use crate::params::Params;
 use crate::units::{checked_from_f64, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
@@ -85,9 +88,9 @@ impl<const S: usize> ForceTable<S> {
             // The placement from the domain's start is its own instance of the builder,
             // so that a device's (`from_law`, which never takes it) carries no code for it.
             let built = if align == Align::FromDomain {
-                Self::on_grid::<true>(law, from, to, align)
+                Self::on_grid::<true, false>(law, from, to, align, 0.0)
             } else {
-                Self::on_grid::<false>(law, from, to, align)
+                Self::on_grid::<false, false>(law, from, to, align, 0.0)
             };
             match built {
                 Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
@@ -103,6 +106,38 @@ impl<const S: usize> ForceTable<S> {
                 }
                 Err(e) => {
                     first_err.get_or_insert(e);
+                }
+            }
+        }
+        // Where no uniform grid meets the product's bound and the solid point is inside
+        // the domain: a graded corner toward it, over a fraction of the curved part,
+        // under each placement of the uniform grid below it.
+        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        let e_c = law.strain_c();
+        if missed && S >= 2 * CORNER_SEGMENTS && to >= e_c {
+            let curved = e_c - libm::fmax(law.strain_t(), from);
+            'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
+                for fraction in CORNER_FRACTIONS {
+                    let len = fraction * curved;
+                    let built = if align == Align::FromDomain {
+                        Self::on_grid::<true, true>(law, from, to, align, len)
+                    } else {
+                        Self::on_grid::<false, true>(law, from, to, align, len)
+                    };
+                    if let Ok(t) = built {
+                        let t = t.measured(law, from, to);
+                        let e = t
+                            .max_error()
+                            .map_or(f64::INFINITY, |e| e.ratio_to(&TableBound::PRODUCT));
+                        if best.as_ref().is_none_or(|(b, _)| e < *b) {
+                            best = Some((e, t));
+                        }
+                        // The first within the bound is kept (each try is a build and a
+                        // measurement).
+                        if e <= 1.0 {
+                            break 'graded;
+                        }
+                    }
                 }
             }
         }
@@ -123,7 +158,7 @@ impl<const S: usize> ForceTable<S> {
         // the solid point, then the grid on Δ(P) alone.
         let mut built = Err(TableError::OutOfRange);
         for align in [Align::Shortest, Align::NearSolid, Align::Off] {
-            built = Self::on_grid::<false>(law, from, to, align);
+            built = Self::on_grid::<false, false>(law, from, to, align, 0.0);
             if !matches!(built, Err(TableError::OutOfRange)) {
                 break;
             }
@@ -133,22 +168,38 @@ impl<const S: usize> ForceTable<S> {
 
     /// The table on the grid [`Grid::place`] puts over `[from, to]` (one copy of the
     /// builder in flash, however many placements are tried; `TENSION`: `align` is
-    /// [`Align::FromDomain`]).
+    /// [`Align::FromDomain`]). With `CORNER`, the last [`CORNER_SEGMENTS`] segments are a
+    /// graded corner of `corner_len` strain ending at the solid point ([`Corner`]), and
+    /// the uniform grid ends where it starts.
     #[inline(never)]
-    fn on_grid<const TENSION: bool>(
+    fn on_grid<const TENSION: bool, const CORNER: bool>(
         law: &Law,
         from: f64,
         to: f64,
         align: Align,
+        corner_len: f64,
     ) -> Result<Self, TableError> {
-        let grid = Grid::place::<S, TENSION>(law, from, to, align)?;
-        let shift = coefficient_shift::<S>(law, &grid)?;
-        let segs = segments::<S>(law, &grid, shift)?;
+        let corner = if CORNER {
+            if S < 2 * CORNER_SEGMENTS {
+                return Err(TableError::TooNarrow);
+            }
+            Some(Corner::place(law, to, corner_len)?)
+        } else {
+            None
+        };
+        let n = if CORNER { S - CORNER_SEGMENTS } else { S };
+        let grid = Grid::place::<TENSION>(law, from, to, align, n, corner.map(|c| c.start))?;
+        let magnitude = match &corner {
+            Some(c) => c.magnitude(law)?,
+            None => (0.0, 0.0),
+        };
+        let shift = coefficient_shift(law, &grid, magnitude)?;
+        let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
         // The lines are anchored on the end knots floored to Q20: the table's own values
         // floor the same way, so the curve stays monotone across the anchors.
-        let l = lines::<S>(law, &grid, segs.first >> shift)?;
-        Ok(Self::from_raw(RawTable {
+        let mut l = lines::<S>(law, &grid, segs.first >> shift)?;
+        let mut raw = RawTable {
             strain_lo: grid.strain_lo,
             strain_hi: grid.strain_hi,
             index_pre: 1 << grid.index_shift,
@@ -161,12 +212,165 @@ impl<const S: usize> ForceTable<S> {
             shift,
             stiff_scale,
             stiff_post,
+            corner_hi: grid.strain_hi,
+            corner_anchor: 0,
+            corner_pre: 0,
+            corner_base: 0,
+            corner_scale: 0,
+            corner_post: 1,
             err_force_ppb: UNMEASURED,
             err_stiffness_ppb: UNMEASURED,
-            segments: segs.coefficients,
-        }))
+            segments: [[0; 4]; S],
+        };
+        if let Some(c) = corner {
+            // The corner starts inside the uniform grid's last segment (its coordinate
+            // below 2³² there) and ends past it.
+            let d = (c.anchor as i64 - grid.strain_hi as i64) * c.pre as i64;
+            if !(d < 1 << 32 && grid.strain_hi < c.hi) {
+                return Err(TableError::TooNarrow);
+            }
+            let last = c.fill(law, shift, &mut segs.coefficients[n..])?;
+            l.stiffness_hi = checked_from_f64(law.k_p, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
+            let (scale, post) = corner_scale(c.pre, shift)?;
+            raw.corner_hi = c.hi;
+            raw.corner_anchor = c.anchor;
+            raw.corner_pre = c.pre;
+            raw.corner_base = n as u32;
+            raw.corner_scale = scale;
+            raw.corner_post = post;
+            raw.force_hi = last >> shift;
+            raw.stiffness_hi = l.stiffness_hi;
+        }
+        raw.segments = segs.coefficients;
+        Ok(Self::from_raw(raw))
     }
 }
+
+/// A graded corner: [`CORNER_SEGMENTS`] segments toward the solid point `Δ(F_C)`, each
+/// octave of distance from it ([`CORNER_OCTAVES`] of them, the nearest `len/256` wide)
+/// cut into [`CORNER_PER_OCTAVE`]: segments about a tenth of their distance from the
+/// corner, where a soft cone against a stiff series spring rises like a square root.
+#[derive(Clone, Copy)]
+struct Corner {
+    /// The anchor `A` (Q24): `Δ(F_C)` plus the nearest octave's inner end.
+    anchor: i32,
+    pre: u32,
+    /// One past the last strain of the corner (Q24): the last knot is `Δ(F_C)`.
+    hi: i32,
+    /// Where the uniform grid ends (a little past the corner's start), strain.
+    start: f64,
+}
+
+impl Corner {
+    /// The corner of `len` strain ending at the solid point, which must be inside the
+    /// domain.
+    fn place(law: &Law, to: f64, len: f64) -> Result<Self, TableError> {
+        let e_c = law.strain_c();
+        let unit = (1u64 << STRAIN_FRAC) as f64;
+        let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
+        // The nearest octave's inner end at least a strain LSB from the anchor.
+        if !(to >= e_c && pre >= 1.0 && pre <= (1u64 << 24) as f64) {
+            return Err(TableError::TooNarrow);
+        }
+        let inner = libm::ldexp(1.0, 24) / pre;
+        let anchor =
+            checked_from_f64(e_c + inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        // The last strain e with (A − e) · pre ≥ 2²⁴, plus one.
+        let hi = libm::floor(anchor as f64 - inner) + 1.0;
+        let start = (anchor as f64 - libm::ldexp(1.0, 32) / pre + 2.0) / unit;
+        Ok(Self {
+            anchor,
+            pre: pre as u32,
+            hi: hi as i32,
+            start,
+        })
+    }
+
+    /// The strain of coordinate `(z, jj)` ([`corner_strain`]).
+    fn strain(&self, z: usize, jj: usize) -> f64 {
+        corner_strain(self.anchor, self.pre, z, jj)
+    }
+
+    /// The force and stiffness at `(z, jj)`, in Q20 N and N per unit strain: at the
+    /// solid point (the last knot) the law's own `F_C` and slope from below.
+    fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
+        let f = if z == CORNER_OCTAVES - 1 && jj == 0 {
+            law.f_c
+        } else {
+            law.force(self.strain(z, jj))
+        };
+        let k = 1.0 / law.compliance(f);
+        let unit = (1u64 << FORCE_FRAC) as f64;
+        if !(libm::fabs(f * unit) < (1u64 << 30) as f64 && k.is_finite()) {
+            return Err(TableError::OutOfRange);
+        }
+        Ok((f * unit, k * unit))
+    }
+
+    /// Segment `(z, j)`'s ends `(a0, a1)` and slopes per `τ` `(m0, m1)` in Q20 N units:
+    /// `τ` runs from `(z, j)` down in strain to `(z, j + 1)`.
+    fn ends(&self, law: &Law, z: usize, j: usize) -> Result<[f64; 4], TableError> {
+        let (x0, x1) = (self.strain(z, j), self.strain(z, j + 1));
+        let ((a0, k0), (a1, k1)) = (self.knot(law, z, j)?, self.knot(law, z, j + 1)?);
+        let w = x0 - x1;
+        Ok([a0, a1, -k0 * w, -k1 * w])
+    }
+
+    /// The largest knot and `|C1| + |C2| + |C3|` in Q20 N units (for the coefficients'
+    /// shift).
+    fn magnitude(&self, law: &Law) -> Result<(f64, f64), TableError> {
+        let (mut value, mut poly) = (0.0f64, 0.0f64);
+        for i in 0..CORNER_SEGMENTS {
+            let [a0, a1, m0, m1] = self.ends(law, i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE)?;
+            let c = hermite(a0, a1, m0, m1);
+            value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
+            poly = libm::fmax(poly, libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]));
+        }
+        Ok((value, poly))
+    }
+
+    /// The corner's coefficients in the unit of `shift`, as [`segments`] rounds them;
+    /// returns the last knot (at the solid point) in that unit.
+    fn fill(&self, law: &Law, shift: u32, out: &mut [[i32; 4]]) -> Result<i32, TableError> {
+        let scale = (1u64 << shift) as f64;
+        for (i, c) in out.iter_mut().enumerate().take(CORNER_SEGMENTS) {
+            let [a0, a1, m0, m1] = self.ends(law, i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE)?;
+            let (a0, a1) = (libm::round(a0 * scale), libm::round(a1 * scale));
+            let [c1, c2, _] = hermite(a0, a1, m0 * scale, m1 * scale);
+            let (c1, c2) = (libm::round(c1), libm::round(c2));
+            let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+            if libm::fabs(a0) >= (1u64 << 30) as f64
+                || libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3) > (1u64 << 29) as f64
+            {
+                return Err(TableError::OutOfRange);
+            }
+            *c = [a0 as i32, c1 as i32, c2 as i32, c3 as i32];
+        }
+        let (last, _) = self.knot(law, CORNER_OCTAVES - 1, 0)?;
+        Ok(libm::round(last * scale) as i32)
+    }
+}
+
+/// The corner's stiffness scale `(corner_scale, corner_post)`: in octave `z`,
+/// `dτ/dε = −pre · 2^(z − 5)`, so dF/dε (Q16) `= −D · pre · 2^(z − 10 − shift)` `=
+/// (D · scale) >> (32 − z)` with `scale = −pre · 2^(22 − shift)`, a power of two moved
+/// into the post-factor while it would not fit.
+fn corner_scale(pre: u32, shift: u32) -> Result<(i32, i32), TableError> {
+    let mut v = libm::ldexp(pre as f64, 22 - shift as i32);
+    let mut post = 0u32;
+    while v >= (1u64 << 31) as f64 - 1.0 && post < 30 {
+        v /= 2.0;
+        post += 1;
+    }
+    if v >= (1u64 << 31) as f64 - 1.0 {
+        return Err(TableError::OutOfRange);
+    }
+    Ok((-(libm::round(v) as i32), 1i32 << post))
+}
+
+/// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
+/// law's curved part.
+const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
 
 /// Whether and how a grid with a preload's kink inside it is aligned on both `Δ(F_T)`
 /// and `Δ(P)` ([`Grid::place`]).
@@ -218,13 +422,15 @@ struct Grid {
 impl Grid {
     /// Places `S` segments over the law's curved part inside `[from, to]` (with
     /// `TENSION` and [`Align::FromDomain`], from `from` instead).
-    fn place<const S: usize, const TENSION: bool>(
+    fn place<const TENSION: bool>(
         law: &Law,
         from: f64,
         to: f64,
         align: Align,
+        n: usize,
+        end: Option<f64>,
     ) -> Result<Self, TableError> {
-        if S == 0 {
+        if n == 0 {
             return Err(TableError::NoSegments);
         }
         if !(from.is_finite() && to.is_finite() && from < to && from > -127.0 && to < 127.0) {
@@ -234,9 +440,14 @@ impl Grid {
         // Whether the table starts at the kink and ends at the solid point (exact lines
         // beyond), decided before the ends are rounded to the strain format.
         let from_domain = TENSION && align == Align::FromDomain && from < e_t;
-        let (at_kink, at_solid) = (from <= e_t && !from_domain, to >= e_c);
+        // With a graded corner (`end`), the uniform grid ends where the corner starts.
+        let (at_kink, at_solid) = (from <= e_t && !from_domain, to >= e_c && end.is_none());
         let lo = if at_kink { e_t } else { from };
-        let hi = if at_solid { e_c } else { to };
+        let hi = match end {
+            Some(x) => x,
+            None if at_solid => e_c,
+            None => to,
+        };
         if hi <= lo {
             return Err(TableError::NoNonlinearPhase);
         }
@@ -272,11 +483,11 @@ impl Grid {
             // j segments from the domain's start to that knot, the most that still
             // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
             knot_at = law.delta(law.preload);
-            let most = libm::floor(S as f64 * (knot_at - lo) / (hi - lo));
+            let most = libm::floor(n as f64 * (knot_at - lo) / (hi - lo));
             if !(most >= 1.0 && knot_at < hi) {
                 return Err(TableError::TooNarrow);
             }
-            width = S as f64 * (knot_at - lo) / most;
+            width = n as f64 * (knot_at - lo) / most;
             kink_knot = Some(most as usize);
             aligned = true;
         } else if !matches!(align, Align::Plain | Align::FromDomain)
@@ -284,23 +495,23 @@ impl Grid {
             && e_p > lo
             && e_p < hi
         {
-            let most = libm::floor(S as f64 * (e_p - lo) / (hi - lo));
+            let most = libm::floor(n as f64 * (e_p - lo) / (hi - lo));
             if align != Align::Off && most >= 1.0 {
                 let fit = if at_solid && align == Align::NearSolid {
                     aligned_on_solid(e_p - lo, hi - lo, most)
                 } else {
                     most
                 };
-                width = S as f64 * (e_p - lo) / fit;
+                width = n as f64 * (e_p - lo) / fit;
                 kink_knot = Some(fit as usize);
                 aligned = true;
             } else if slope_kink {
-                let mut step = width / S as f64;
+                let mut step = width / n as f64;
                 let j = libm::ceil((e_p - lo) / step);
-                if j < S as f64 {
-                    step = libm::fmax(step, (hi - e_p) / (S as f64 - j));
+                if j < n as f64 {
+                    step = libm::fmax(step, (hi - e_p) / (n as f64 - j));
                     lo_grid = e_p - j * step;
-                    width = S as f64 * step;
+                    width = n as f64 * step;
                     kink_knot = Some(j as usize);
                 }
             }
@@ -317,11 +528,11 @@ impl Grid {
         while index_shift < 31 && span * (2u64 << index_shift) as f64 <= (1u64 << 32) as f64 {
             index_shift += 1;
         }
-        let scale = libm::floor(S as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
+        let scale = libm::floor(n as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
         // At most 31 significant bits (the narrow index keeps 15 of them), and each segment
         // at least one strain LSB wide (below that the knots are not strains the format
         // holds).
-        if !(scale >= 1.0 && scale < (1u64 << 31) as f64) || span - 2.0 < S as f64 {
+        if !(scale >= 1.0 && scale < (1u64 << 31) as f64) || span - 2.0 < n as f64 {
             return Err(TableError::TooNarrow);
         }
         // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index
@@ -345,9 +556,9 @@ impl Grid {
         // ends at the first knot at or above `hi`; the segments above stay zero and are
         // never reached).
         let used = if aligned {
-            (libm::ceil((hi - lo) / step) as usize).clamp(1, S)
+            (libm::ceil((hi - lo) / step) as usize).clamp(1, n)
         } else {
-            S
+            n
         };
         // Strains below strain_lo + d (in Q24 LSBs) have coordinates below used·2¹⁵.
         let num = (used as u128) << 47;
@@ -428,7 +639,7 @@ struct Knot {
 fn hermite(a0: f64, a1: f64, m0: f64, m1: f64) -> [f64; 3] {
     let secant = a1 - a0;
     let (mut s0, mut s1) = (m0, m1);
-    if secant > 0.0 {
+    if secant != 0.0 {
         let (al, be) = (s0 / secant, s1 / secant);
         let r2 = al * al + be * be;
         if r2 > 9.0 {
@@ -444,8 +655,8 @@ fn hermite(a0: f64, a1: f64, m0: f64, m1: f64) -> [f64; 3] {
 /// The coefficients' unit, Q(20 + shift) N: the largest shift (≤ 12) that keeps every knot
 /// within 2³⁰ and every segment's |C1| + |C2| + |C3| within 2²⁹, so that no Horner step
 /// of the value or the stiffness can overflow.
-fn coefficient_shift<const S: usize>(law: &Law, grid: &Grid) -> Result<u32, TableError> {
-    let (mut big_value, mut big_poly) = (1e-30f64, 1e-30f64);
+fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64)) -> Result<u32, TableError> {
+    let (mut big_value, mut big_poly) = (libm::fmax(1e-30, corner.0), libm::fmax(1e-30, corner.1));
     let mut prev = grid.knot(law, 0)?;
     big_value = libm::fmax(big_value, libm::fabs(prev.value));
     for i in 1..=grid.used {

@@ -62,6 +62,15 @@ mod error;
 pub use bound::{format_floor, measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
 pub use error::TableError;
 
+/// Octaves of the graded corner ([`RawTable::corner_anchor`]).
+pub const CORNER_OCTAVES: usize = 8;
+/// Segments in each octave of the graded corner (a power of two).
+pub const CORNER_PER_OCTAVE: usize = 4;
+/// Segments of the graded corner.
+pub const CORNER_SEGMENTS: usize = CORNER_OCTAVES * CORNER_PER_OCTAVE;
+/// `log2(CORNER_PER_OCTAVE)`.
+const CORNER_BITS: u32 = CORNER_PER_OCTAVE.trailing_zeros();
+
 /// The default strain domain `[ε_min, ε_max]`.
 pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
 
@@ -100,6 +109,24 @@ pub struct RawTable<const S: usize> {
     pub stiff_scale: i32,
     /// See `stiff_scale`.
     pub stiff_post: i32,
+    /// The end of the graded corner (Q24), exclusive: the line above starts here.
+    /// `strain_hi` when the table has no graded corner (see [`ForceTable::corner`]).
+    pub corner_hi: i32,
+    /// The graded corner's anchor `A` (Q24), just past `corner_hi`: a strain `e` in
+    /// `[strain_hi, corner_hi)` has the coordinate `d = (A − e) · corner_pre` (`u32`) in
+    /// `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
+    pub corner_anchor: i32,
+    /// See `corner_anchor`.
+    pub corner_pre: u32,
+    /// The corner's first segment: `corner_base + 4 z + j` (`j` the two bits after `d`'s
+    /// leading one).
+    pub corner_base: u32,
+    /// The stiffness in the corner, in Q16: `⌊(D · corner_scale) / 2^(32 − z)⌋ ·
+    /// corner_post` for `D = 2 dF/dτ` in the coefficients' unit (`τ` runs down in strain,
+    /// so the scale is negative; `corner_post` a power of two).
+    pub corner_scale: i32,
+    /// See `corner_scale`.
+    pub corner_post: i32,
     /// The largest force error against the `f64` law over the domain, measured when the
     /// table was built: parts per 10⁹ of `F(to)` ([`ForceTable::max_error`]);
     /// [`UNMEASURED`] in both fields when it was not measured.
@@ -157,7 +184,9 @@ impl<const S: usize> ForceTable<S> {
             && (r.stiff_post as u32).is_power_of_two()
             && r.stiff_scale >= 0
             && r.stiffness_lo >= 0
-            && r.stiffness_hi >= 0;
+            && r.stiffness_hi >= 0
+            && r.corner_hi >= r.strain_hi
+            && (r.corner_hi == r.strain_hi || self.corner_fits());
         if ok {
             Ok(())
         } else {
@@ -185,11 +214,50 @@ impl<const S: usize> ForceTable<S> {
     /// Size of the table in bytes.
     pub const SIZE_BYTES: usize = core::mem::size_of::<RawTable<S>>();
 
-    /// The tabulated strain range `[lo, hi]`.
+    /// The tabulated strain range `[lo, hi]` (with the graded corner, if any).
     pub fn tabulated_range(&self) -> (Strain, Strain) {
         (
             Strain::from_bits(self.raw.strain_lo),
-            Strain::from_bits(self.raw.strain_hi),
+            Strain::from_bits(self.raw.corner_hi),
+        )
+    }
+
+    /// The graded corner's range `[strain_hi, corner_hi)`, if the table has one: knots
+    /// graded geometrically toward its anchor (the solid point `Δ(F_C)`), where a stiff
+    /// series spring's law bends hardest (see the module docs).
+    pub fn corner(&self) -> Option<(Strain, Strain)> {
+        let r = &self.raw;
+        (r.corner_hi > r.strain_hi).then(|| {
+            (
+                Strain::from_bits(r.strain_hi),
+                Strain::from_bits(r.corner_hi),
+            )
+        })
+    }
+
+    /// Whether the graded corner's coordinate stays in `[2²⁴, 2³²)` over its range and
+    /// its segments are inside the table.
+    fn corner_fits(&self) -> bool {
+        let r = &self.raw;
+        let d = |e: i32| (r.corner_anchor as i64 - e as i64) * r.corner_pre as i64;
+        S >= CORNER_SEGMENTS
+            && r.corner_base as usize <= S - CORNER_SEGMENTS
+            && d(r.strain_hi) < 1 << 32
+            && d(r.corner_hi - 1) >= 1 << 24
+            && r.corner_post > 0
+            && (r.corner_post as u32).is_power_of_two()
+            && r.corner_scale <= 0
+    }
+
+    /// The strain range of the graded corner's segment `i` (`4 z + j`, octave `z`,
+    /// segment `j` in it): `(lower, upper)`; `τ` runs from the upper end (nearer the
+    /// anchor) down. For measuring; `f64`.
+    pub fn corner_segment_range(&self, i: usize) -> (f64, f64) {
+        let r = &self.raw;
+        let (z, j) = (i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE);
+        (
+            corner_strain(r.corner_anchor, r.corner_pre, z, j + 1),
+            corner_strain(r.corner_anchor, r.corner_pre, z, j),
         )
     }
 
@@ -205,6 +273,17 @@ impl<const S: usize> ForceTable<S> {
             let e = r.strain_lo as i64 + span * i / (2 * used);
             let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
             max = max.max(k.to_bits());
+        }
+        if self.corner().is_some() {
+            for i in 0..CORNER_SEGMENTS {
+                let (a, b) = self.corner_segment_range(i);
+                for x in [a, (a + b) / 2.0, b] {
+                    let e = libm::round(x * (1u64 << STRAIN_FRAC) as f64) as i64;
+                    let e = e.clamp(r.strain_hi as i64, r.corner_hi as i64 - 1);
+                    let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
+                    max = max.max(k.to_bits());
+                }
+            }
         }
         Stiffness::from_bits(max)
     }
@@ -230,7 +309,10 @@ impl<const S: usize> ForceTable<S> {
             return Force::from_bits(line(r.force_lo, r.stiffness_lo, e, r.anchor_lo));
         }
         if e >= r.strain_hi {
-            return Force::from_bits(line(r.force_hi, r.stiffness_hi, e, r.strain_hi));
+            if e >= r.corner_hi {
+                return Force::from_bits(line(r.force_hi, r.stiffness_hi, e, r.corner_hi));
+            }
+            return Force::from_bits(self.corner_force(e));
         }
         let (c, t) = self.segment(e);
         Force::from_bits(cubic_value(r, c, t))
@@ -247,7 +329,7 @@ impl<const S: usize> ForceTable<S> {
         let f = if e <= r.strain_lo {
             line_held(r.force_lo, r.stiffness_lo, e, r.anchor_lo)
         } else if e >= r.strain_hi {
-            line_held(r.force_hi, r.stiffness_hi, e, r.strain_hi)
+            self.above_within(e)
         } else {
             let (c, t) = self.segment(e);
             cubic_value(r, c, t)
@@ -268,17 +350,82 @@ impl<const S: usize> ForceTable<S> {
             return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_lo));
         }
         if e >= r.strain_hi {
-            let f = line(r.force_hi, r.stiffness_hi, e, r.strain_hi);
-            return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_hi));
+            if e >= r.corner_hi {
+                let f = line(r.force_hi, r.stiffness_hi, e, r.corner_hi);
+                return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_hi));
+            }
+            return self.corner_force_and_stiffness(e);
         }
         let (c, t) = self.segment(e);
         let f = cubic_value(r, c, t);
-        // D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ², in the same halving Horner form.
-        let c3x3 = c[3].wrapping_mul(3);
-        let c2x2 = c[2].wrapping_mul(2);
-        let d = c[1].wrapping_add(mul_t(c2x2.wrapping_add(mul_t(c3x3, t)), t));
-        let k = mulhi(d, r.stiff_scale).wrapping_mul(r.stiff_post);
+        let k = mulhi(slope(c, t), r.stiff_scale).wrapping_mul(r.stiff_post);
         (Force::from_bits(f), Stiffness::from_bits(k))
+    }
+
+    /// [`ForceTable::force_within`] at or above `strain_hi` (before its clamp): the
+    /// graded corner or the line above, out of line (past the solid point: rare).
+    #[inline(never)]
+    fn above_within(&self, e: i32) -> i32 {
+        let r = &self.raw;
+        if e >= r.corner_hi {
+            line_held(r.force_hi, r.stiffness_hi, e, r.corner_hi)
+        } else {
+            self.corner_force(e)
+        }
+    }
+
+    /// The force (Q20 N) in the graded corner (`strain_hi ≤ e < corner_hi`), out of line
+    /// and cold: the solver's loops keep the uniform part's registers.
+    #[inline(never)]
+    #[cold]
+    pub(crate) fn corner_force(&self, e: i32) -> i32 {
+        let (c, t) = self.corner_segment(e);
+        cubic_value(&self.raw, c, t)
+    }
+
+    /// [`ForceTable::force_and_stiffness`] in the graded corner (`strain_hi ≤ e <
+    /// corner_hi`), out of line: the other pieces' paths stay as short.
+    #[inline(never)]
+    fn corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
+        let r = &self.raw;
+        let (c, t, z) = self.corner_segment_octave(e);
+        let f = cubic_value(r, c, t);
+        // (D · scale) >> (32 − z): z ≤ 7 on a valid table, and at most 32 on any.
+        let k = ((slope(c, t) as i64 * r.corner_scale as i64) >> (32 - z.min(32))) as i32;
+        (
+            Force::from_bits(f),
+            Stiffness::from_bits(k.wrapping_mul(r.corner_post)),
+        )
+    }
+
+    /// The graded corner's segment holding `e` (`strain_hi ≤ e < corner_hi`), the Q15
+    /// position in it and the octave: `d = (A − e) · pre`, `z = clz(d)`; the two bits
+    /// after `d`'s leading one are the segment in the octave, the next 15 `τ`. On a
+    /// table that fails [`ForceTable::validate`] the segment is any (masked), never out
+    /// of bounds.
+    #[inline(always)]
+    fn corner_segment(&self, e: i32) -> (&[i32; 4], u32) {
+        let (c, t, _) = self.corner_segment_octave(e);
+        (c, t)
+    }
+
+    /// [`ForceTable::corner_segment`] and the octave `z`.
+    #[inline(always)]
+    fn corner_segment_octave(&self, e: i32) -> (&[i32; 4], u32, u32) {
+        let r = &self.raw;
+        let d = (r.corner_anchor.wrapping_sub(e) as u32).wrapping_mul(r.corner_pre);
+        let z = d.leading_zeros();
+        let pos = (d.wrapping_shl(z) << 1) >> (17 - CORNER_BITS);
+        let i = r
+            .corner_base
+            .wrapping_add(z << CORNER_BITS)
+            .wrapping_add(pos >> 15) as usize;
+        let i = if S.is_power_of_two() {
+            i & (S - 1)
+        } else {
+            i.min(S.saturating_sub(1))
+        };
+        (r.segments.get(i).unwrap_or(&NO_SEGMENT), pos & 0x7FFF, z)
     }
 
     /// The position of `e` (`strain_lo < e < strain_hi`) in Q15 segments from `strain_lo`.
@@ -306,6 +453,23 @@ impl<const S: usize> ForceTable<S> {
         // segments (only from `from_raw`) reads zeros instead of panicking.
         (r.segments.get(i).unwrap_or(&NO_SEGMENT), pos & 0x7FFF)
     }
+}
+
+/// The strain (`f64`) of the graded corner's coordinate `d = 2^(31 − z) (1 + jj/4)`
+/// (`jj` ≤ 4: `jj = 4` is the next octave's start), for a corner anchored at `anchor`
+/// (Q24) with `pre`.
+pub(crate) fn corner_strain(anchor: i32, pre: u32, z: usize, jj: usize) -> f64 {
+    let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
+    (anchor as f64 - d / pre as f64) / (1u64 << STRAIN_FRAC) as f64
+}
+
+/// `D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ²` in the coefficients' unit, in the same halving
+/// Horner form as the value.
+#[inline(always)]
+fn slope(c: &[i32; 4], t: u32) -> i32 {
+    let c3x3 = c[3].wrapping_mul(3);
+    let c2x2 = c[2].wrapping_mul(2);
+    c[1].wrapping_add(mul_t(c2x2.wrapping_add(mul_t(c3x3, t)), t))
 }
 
 /// What a table with no segments evaluates to between its ends.

@@ -231,6 +231,18 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
     let r = t.raw();
     let mut s = String::from(header);
     s.push_str("// Formats: strains Q24, forces Q20 N, stiffnesses Q16 N per unit strain.\n");
+    let (lo, hi) = t.tabulated_range();
+    match t.corner() {
+        Some((a, b)) => s.push_str(&format!(
+            "// Layout: {} segments uniform over [{lo}, {a}), then {} graded toward the solid point over [{a}, {b}).\n",
+            t.segments_used(),
+            mccs::table::CORNER_SEGMENTS
+        )),
+        None => s.push_str(&format!(
+            "// Layout: {} segments uniform over [{lo}, {hi}).\n",
+            t.segments_used()
+        )),
+    }
     s.push_str(&format!(
         "mccs::ForceTable::<{S}>::from_raw(mccs::RawTable {{\n"
     ));
@@ -247,6 +259,12 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
         ("shift", r.shift as i64),
         ("stiff_scale", r.stiff_scale as i64),
         ("stiff_post", r.stiff_post as i64),
+        ("corner_hi", r.corner_hi as i64),
+        ("corner_anchor", r.corner_anchor as i64),
+        ("corner_pre", r.corner_pre as i64),
+        ("corner_base", r.corner_base as i64),
+        ("corner_scale", r.corner_scale as i64),
+        ("corner_post", r.corner_post as i64),
         ("err_force_ppb", r.err_force_ppb as i64),
         ("err_stiffness_ppb", r.err_stiffness_ppb as i64),
     ] {

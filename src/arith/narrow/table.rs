@@ -102,7 +102,8 @@ impl NarrowLine {
 }
 
 /// [`ForceTable::force_within::<26>`](crate::table::ForceTable::force_within) for the
-/// narrow spring: the same segment, position and cubic (the index scale has 15
+/// narrow spring: the same segment, position and cubic (in the graded corner the same
+/// index, whose only product is a 32-bit multiply; the uniform index scale has 15
 /// significant bits, so its product is two 32-bit multiplies), and the straight lines
 /// with their slopes to 15 bits (2⁻¹⁵ relative), held at ±1024 N. Raw Q24 strain in, within ±8 (a spring's strain is within (−2.5, 1));
 /// raw Q20 N out, within ±64 N.
@@ -114,7 +115,11 @@ pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain
     let f = if e <= r.strain_lo {
         n.lo.below(r.force_lo, e, r.anchor_lo)
     } else if e >= r.strain_hi {
-        n.hi.above(r.force_hi, e, r.strain_hi)
+        if e >= r.corner_hi {
+            n.hi.above(r.force_hi, e, r.corner_hi)
+        } else {
+            table.table.corner_force(e)
+        }
     } else {
         let de = (e.wrapping_sub(r.strain_lo) as u32).wrapping_mul(r.index_pre);
         // ⌊de · scale / 2¹⁶⌋ from 16-bit pieces (< 2³¹), then to Q15 segments.

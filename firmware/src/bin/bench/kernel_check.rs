@@ -8,12 +8,15 @@
 //!   stretched past the table's lower end and past the `±2 l0` hold, on its segments,
 //!   crushed past its upper end, below `l0/8` (the held `l0/l`) and through zero length.
 //!
-//! Each state takes one of five tables: Table 2's; the same with its coefficients 64
+//! Each state takes one of six tables: Table 2's; the same with its coefficients 64
 //! times larger (forces past the ±64 N hold) and a shift past 31 (which wraps, as
-//! `wrapping_shr` does); one with the steepest slopes, the largest end forces and its
-//! upper line from an eighth of its range (the lines' products held, their sums
-//! saturated); one with its lower line's anchor at `i32::MAX` (the strain difference
-//! saturates); and one whose range ends at `i32::MIN + 1` (the upper line's does).
+//! `wrapping_shr` does), and a graded corner of any contents above its uniform part
+//! (an index past the table, masked); one with the steepest slopes, the largest end
+//! forces and its upper line from an eighth of its range (the lines' products held,
+//! their sums saturated); one with its lower line's anchor at `i32::MAX` (the strain
+//! difference saturates); one whose range ends at `i32::MIN + 1` (the upper line's
+//! does); and the stiff series spring's (`tables/stiff_series.rs`), whose last 32
+//! segments are a graded corner, where a quarter of the single springs are put.
 //!
 //! Warm-start values, velocities and force accumulators (which wrap) are random, and each
 //! state runs a few loops in a row with the integrator between them (its velocity and
@@ -106,7 +109,12 @@ fn run(table: &ForceTable64) {
         exit(false)
     };
     for state in 0..STATES {
-        let table = &tables[((state / 3) % 5) as usize];
+        let table = &tables[((state / 3) % 6) as usize];
+        // The graded corner's range (of the stiff series spring's table), in strain.
+        let corner = table
+            .table
+            .corner()
+            .map(|(a, b)| (a.to_num::<f64>(), b.to_num::<f64>()));
         let coeffs = Wide::coeffs(&StepSpec {
             h: 1.0 / 6000.0,
             node_mass: 0.005,
@@ -133,7 +141,10 @@ fn run(table: &ForceTable64) {
             let e = match rng.next() % 4 {
                 0 => rng.uniform(-3.0, -0.4),
                 1 => rng.uniform(-0.6, 1.0),
-                2 => rng.uniform(0.85, 1.0),
+                2 => match corner {
+                    Some((a, b)) => rng.uniform(a - 0.01, b + 0.01),
+                    None => rng.uniform(0.85, 1.0),
+                },
                 _ => rng.uniform(0.9, 2.5),
             };
             let side = rng.uniform(-1.0, 1.0) * [0.0, 0.01, 0.3, 1.0][(state % 4) as usize];
@@ -165,11 +176,19 @@ fn run(table: &ForceTable64) {
     }
 }
 
-/// Table 2's table, and the four variants that reach the holds and saturations (module
-/// docs).
-fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 5] {
+/// Table 2's table, the four variants that reach the holds and saturations, and the
+/// stiff series spring's (module docs).
+fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
+    static STIFF_SERIES: ForceTable64 = include!("../../../../tables/stiff_series.rs");
     let raw = *table.raw();
     let mut large = raw;
+    // A corner over the top eighth of the range with an anchor and scale of any
+    // contents: indices past the last segment, and through zero.
+    large.corner_hi = raw.strain_hi;
+    large.strain_hi = raw.strain_hi - (raw.strain_hi - raw.strain_lo) / 8;
+    large.corner_anchor = raw.strain_hi + 12_345;
+    large.corner_pre = 0x9E37_79B9;
+    large.corner_base = 61;
     large.shift = raw.shift.saturating_sub(6) + 32;
     large.force_lo = raw.force_lo.saturating_mul(64);
     large.force_hi = raw.force_hi.saturating_mul(64);
@@ -179,6 +198,7 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 5] {
     steep.force_lo = i32::MIN + 1;
     steep.force_hi = i32::MAX - 1;
     steep.strain_hi = raw.strain_lo + (raw.strain_hi - raw.strain_lo) / 8;
+    steep.corner_hi = steep.strain_hi;
     // The lower line's slope at the two ends of the gentle loop's range (the M4F's
     // assembly takes another product for a slope within ±2¹⁹): the largest within it,
     // with the anchor past every strain (the product's largest magnitude), and the
@@ -190,7 +210,9 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 5] {
     let mut ends = raw;
     ends.strain_lo = i32::MIN;
     ends.strain_hi = i32::MIN + 1;
-    [raw, large, steep, anchored, ends].map(|r| ArithTable::new(ForceTable64::from_raw(r)))
+    ends.corner_hi = i32::MIN + 1;
+    [raw, large, steep, anchored, ends, *STIFF_SERIES.raw()]
+        .map(|r| ArithTable::new(ForceTable64::from_raw(r)))
 }
 
 /// One spring of the single set: its nodes, rest length (mm), rest direction and a unit
