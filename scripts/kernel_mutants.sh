@@ -41,6 +41,11 @@ mutants=(
   "accumulator cleared at the wrong offset|\"str r3, [lr, #8]\"|\"str r3, [lr, #4]\""
   "symplectic position step from the old velocity|\"add r3, r6, r6\"|\"add r3, r3, r6\""
   "paper's position step from the new velocity|\"add r4, r4, r8\"|\"add r4, r8, r8\""
+  "graded corner's segment bits one lower|ubfx r5, r3, #29, #2|ubfx r5, r3, #28, #2"
+  "graded corner's tau one bit lower|ubfx r3, r3, #14, #15|ubfx r3, r3, #13, #15"
+  "graded corner's octave not in the index|add r8, r8, r5, lsl #2|add r8, r8, r5, lsl #3"
+  "graded corner's strain difference reversed|sub r3, r3, r9\\n|sub r3, r9, r3\\n"
+  "graded corner's line above never taken|blt 54b|b 54b"
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)

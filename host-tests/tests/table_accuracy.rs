@@ -429,12 +429,17 @@ fn table2_scaled(k: f64) -> Params {
     p
 }
 
+/// The committed stiff series spring's table (`k_p/k` = 2100): its last 32 segments are
+/// the graded corner.
+static STIFF_SERIES: ForceTable<64> = include!("../../tables/stiff_series.rs");
+
 /// The solver's `force_within` is `force` clamped, over the whole strain range, on the
-/// Table 2 spring and on springs with large forces (whose lines saturate).
+/// Table 2 spring, on springs with large forces (whose lines saturate) and on the stiff
+/// series spring's graded corner.
 #[test]
 fn force_within_is_force_clamped() {
-    for p in [Params::TABLE2, table2_scaled(30.0)] {
-        let t = ForceTable::<64>::new(&p).unwrap();
+    let built = [Params::TABLE2, table2_scaled(30.0)].map(|p| ForceTable::<64>::new(&p).unwrap());
+    for t in built.into_iter().chain([STIFF_SERIES]) {
         let mut bits = i32::MIN;
         loop {
             let e = Strain::from_bits(bits);
@@ -450,17 +455,29 @@ fn force_within_is_force_clamped() {
     }
 }
 
-/// The M0's table lookup (`mccs::arith::narrow::table_force`): on the cubic part the same bits as `force_within::<26>`; on
-/// the straight lines within 2⁻¹⁵ of the line's rise plus 1 LSB; over the whole strain
-/// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring.
+/// The M0's table lookup (`mccs::arith::narrow::table_force`): on the cubic parts (the
+/// uniform grid and the graded corner) the same bits as `force_within::<26>`; on the
+/// straight lines within 2⁻¹⁵ of the line's rise plus 1 LSB; over the whole strain
+/// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring, and
+/// the stiff series spring (its corner every 7 strain LSBs).
 #[test]
 fn force_narrow_is_force_within_to_a_slope_lsb() {
     let mut worst = 0.0f64;
-    for p in [Params::TABLE2, table2_scaled(30.0), table2_scaled(0.02)] {
-        let t = ForceTable::<64>::new(&p).unwrap();
+    let built = [Params::TABLE2, table2_scaled(30.0), table2_scaled(0.02)]
+        .map(|p| ForceTable::<64>::new(&p).unwrap());
+    for t in built.into_iter().chain([STIFF_SERIES]) {
         let narrow = ArithTable::<64, Narrow>::new(t);
         let (lo, hi) = t.tabulated_range();
         let (f_lo, f_hi) = (t.raw().force_lo as f64, t.raw().force_hi as f64);
+        let corner = t.corner().map(|(a, b)| (a.to_bits(), b.to_bits()));
+        if let Some((a, b)) = corner {
+            for bits in (a - 100..b + 100).step_by(7) {
+                let e = Strain::from_bits(bits);
+                if e > lo && e < hi {
+                    assert_eq!(table_force(&narrow, e), t.force_within::<26>(e), "{bits}");
+                }
+            }
+        }
         let mut bits = -(8 << 24);
         while bits < 8 << 24 {
             let e = Strain::from_bits(bits);
@@ -484,6 +501,36 @@ fn force_narrow_is_force_within_to_a_slope_lsb() {
         }
     }
     println!("narrow table_force: lines within {worst:.2e} of their rise (rises ≥ 1/16 N)");
+}
+
+/// The graded corner, every strain LSB from below its start to past its end: the force
+/// never decreases (across its own knots and octaves, and where it meets the uniform
+/// grid below and the line above), and it stays within the bound of the law, with its
+/// stiffness, as the builder measured.
+#[test]
+fn a_graded_corner_is_continuous_and_monotone() {
+    let t = STIFF_SERIES;
+    let (a, b) = t.corner().unwrap();
+    let (a, b) = (a.to_bits(), b.to_bits());
+    let mut p = Params::TABLE2;
+    p.linear.shear_modulus = 1.4460e8;
+    let r = Reference::new(&p).unwrap();
+    let scale = r.force(DOMAIN.1);
+    let mut prev = t.force(Strain::from_bits(a - (1 << 16)));
+    let (mut worst, mut steps) = (0.0f64, 0u32);
+    for bits in a - (1 << 16)..b + (1 << 16) {
+        let e = Strain::from_bits(bits);
+        let f = t.force(e);
+        assert!(f >= prev, "{bits}: {f} after {prev}");
+        prev = f;
+        if bits % 97 == 0 {
+            let err = (f.to_num::<f64>() - r.force(e.to_num::<f64>())).abs() / scale;
+            worst = worst.max(err);
+            steps += 1;
+        }
+    }
+    println!("graded corner: monotone over {} strains; force within {worst:.1e} of F(0.95) ({steps} compared)", b - a + (2 << 16));
+    assert!(worst <= 2e-5);
 }
 
 proptest! {

@@ -25,20 +25,25 @@ fn included_table_is_bit_identical_to_the_runtime_build() {
 }
 
 #[test]
-fn committed_table_is_what_the_cli_emits() {
+fn committed_tables_are_what_the_cli_emits() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
-    let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
-        .args(["table", "--params", "params/table2.toml"])
-        .current_dir(root)
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let committed = std::fs::read_to_string(format!("{root}/tables/table2.rs")).unwrap();
-    assert_eq!(
-        String::from_utf8(out.stdout).unwrap(),
-        committed,
-        "tables/table2.rs is stale: run `mccs table --params params/table2.toml --out tables/table2.rs`"
-    );
+    for (params, knots, table) in [
+        ("params/table2.toml", "65", "tables/table2.rs"),
+        ("params/stiff-series.toml", "65", "tables/stiff_series.rs"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(["table", "--params", params, "--knots", knots])
+            .current_dir(root)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let committed = std::fs::read_to_string(format!("{root}/{table}")).unwrap();
+        let emitted = String::from_utf8(out.stdout).unwrap();
+        assert!(
+            emitted == committed,
+            "{table} is stale: run `mccs table --params {params} --knots {knots} --out {table}`"
+        );
+    }
 }
 
 #[test]

@@ -316,15 +316,17 @@ impl Corner {
         Ok([a0, a1, -k0 * w, -k1 * w])
     }
 
-    /// The largest knot and `|C1| + |C2| + |C3|` in Q20 N units (for the coefficients'
-    /// shift).
+    /// The largest knot and `(|C1| + |C2| + |C3|) · 2^z` in Q20 N units (for the
+    /// coefficients' shift: the stiffness in octave `z` takes `D << z`).
     fn magnitude(&self, law: &Law) -> Result<(f64, f64), TableError> {
         let (mut value, mut poly) = (0.0f64, 0.0f64);
         for i in 0..CORNER_SEGMENTS {
-            let [a0, a1, m0, m1] = self.ends(law, i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE)?;
+            let z = i / CORNER_PER_OCTAVE;
+            let [a0, a1, m0, m1] = self.ends(law, z, i % CORNER_PER_OCTAVE)?;
             let c = hermite(a0, a1, m0, m1);
             value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
-            poly = libm::fmax(poly, libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]));
+            let sum = libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]);
+            poly = libm::fmax(poly, libm::ldexp(sum, z as i32));
         }
         Ok((value, poly))
     }
@@ -339,8 +341,10 @@ impl Corner {
             let [c1, c2, _] = hermite(a0, a1, m0 * scale, m1 * scale);
             let (c1, c2) = (libm::round(c1), libm::round(c2));
             let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+            let z = (i / CORNER_PER_OCTAVE) as i32;
             if libm::fabs(a0) >= (1u64 << 30) as f64
-                || libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3) > (1u64 << 29) as f64
+                || libm::ldexp(libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3), z)
+                    > (1u64 << 29) as f64
             {
                 return Err(TableError::OutOfRange);
             }

@@ -121,9 +121,10 @@ pub struct RawTable<const S: usize> {
     /// The corner's first segment: `corner_base + 4 z + j` (`j` the two bits after `d`'s
     /// leading one).
     pub corner_base: u32,
-    /// The stiffness in the corner, in Q16: `⌊(D · corner_scale) / 2^(32 − z)⌋ ·
-    /// corner_post` for `D = 2 dF/dτ` in the coefficients' unit (`τ` runs down in strain,
-    /// so the scale is negative; `corner_post` a power of two).
+    /// The stiffness in the corner, in Q16: `⌊(D · 2^z) · corner_scale / 2³²⌋ ·
+    /// corner_post` for `D = 2 dF/dτ` in the coefficients' unit, which the builder keeps
+    /// within ±2²⁹ times `2^−z` in octave `z` (`τ` runs down in strain, so the scale is
+    /// negative; `corner_post` a power of two).
     pub corner_scale: i32,
     /// See `corner_scale`.
     pub corner_post: i32,
@@ -384,14 +385,15 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// [`ForceTable::force_and_stiffness`] in the graded corner (`strain_hi ≤ e <
-    /// corner_hi`), out of line: the other pieces' paths stay as short.
-    #[inline(never)]
+    /// corner_hi`).
+    #[inline(always)]
     fn corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
         let r = &self.raw;
         let (c, t, z) = self.corner_segment_octave(e);
         let f = cubic_value(r, c, t);
-        // (D · scale) >> (32 − z): z ≤ 7 on a valid table, and at most 32 on any.
-        let k = ((slope(c, t) as i64 * r.corner_scale as i64) >> (32 - z.min(32))) as i32;
+        // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 7 on a
+        // valid table; the shift wraps at 32 on any other, without a panic).
+        let k = mulhi(slope(c, t).wrapping_shl(z), r.corner_scale);
         (
             Force::from_bits(f),
             Stiffness::from_bits(k.wrapping_mul(r.corner_post)),

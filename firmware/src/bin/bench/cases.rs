@@ -37,6 +37,30 @@ pub fn force_and_stiffness(h: &Harness, table: &ForceTable64) -> u32 {
     fs - harness
 }
 
+/// `force_and_stiffness` over strains sweeping a graded corner (`table` must have one:
+/// the stiff series spring's, `tables/stiff_series.rs`), harness taken off: what an
+/// evaluation costs there (its octave's `clz`, the stiffness's scale per octave).
+#[inline(never)]
+pub fn force_and_stiffness_corner(h: &Harness, table: &ForceTable64) -> u32 {
+    let Some((a, b)) = table.corner() else {
+        return 0;
+    };
+    let (lo, span) = (a.to_bits(), (b.to_bits() - a.to_bits()).max(1) as u32);
+    let mut k = 0u32;
+    let harness = h.measure(256, || {
+        k = k.wrapping_add(65_713);
+        let eps = Strain::from_bits(lo + (k % span) as i32);
+        black_box((black_box(table), eps));
+    });
+    let mut k = 0u32;
+    let fs = h.measure(256, || {
+        k = k.wrapping_add(65_713);
+        let eps = Strain::from_bits(lo + (k % span) as i32);
+        black_box(e::force_and_stiffness(black_box(table), eps));
+    });
+    fs - harness
+}
+
 /// The spring case's inputs (raw formats of `mccs::arith`).
 struct SpringCase {
     edge: Edge,

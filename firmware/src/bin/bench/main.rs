@@ -65,6 +65,11 @@ mod firmware {
             "force_and_stiffness",
             cases::force_and_stiffness(&h, &table),
         );
+        static STIFF_SERIES: ForceTable64 = include!("../../../../tables/stiff_series.rs");
+        figs.report(
+            "force_and_stiffness_corner",
+            cases::force_and_stiffness_corner(&h, black_box(&STIFF_SERIES)),
+        );
         figs.report("spring", cases::spring(&h, &table));
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
         let sub = |h: &Harness, n, i| match n {
