@@ -136,7 +136,9 @@ pub struct FloatPatch<T, const N: usize, const E: usize, const S: usize> {
 }
 
 impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E, S> {
-    /// From a topology, a table and a configuration at `substeps` per tick.
+    /// From a topology, a table and a configuration at `substeps` per tick. The table's
+    /// uniform part and lines only: a table with a graded corner (`ForceTable::corner`)
+    /// is not modelled (the bench runs Table 2's, which has none).
     pub fn new(
         topo: &Topology<N, E>,
         table: &ForceTable<S>,

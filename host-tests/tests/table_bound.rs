@@ -286,7 +286,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         all.other += d.other;
     }
     println!(
-        "TABLEBOUND kp_k=all springs={} met={} refused={} refused_pct={:.1} over_force={} over_stiffness={} format_limited={} other={} worst_met_force={:.1e} worst_met_stiffness={:.1e}",
+        "TABLEBOUND kp_k=all springs={} met={} refused={} refused_pct={:.1} over_force={} over_stiffness={} format_limited={} placement_limited={} placement_pct={:.1} other={} worst_met_force={:.1e} worst_met_stiffness={:.1e}",
         all.springs,
         all.met,
         all.refused,
@@ -294,6 +294,8 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         all.over_force,
         all.over_stiffness,
         all.format_limited,
+        all.refused - all.format_limited,
+        100.0 * (all.refused - all.format_limited) as f64 / all.springs as f64,
         all.other,
         worst_met.force,
         worst_met.stiffness
@@ -459,10 +461,10 @@ fn named_springs_report_their_bound() {
         );
         let m = independent(&p, &t129);
         let (t65, t129) = (t65.max_error().unwrap(), t129.max_error().unwrap());
-        let yes = |g: bool| if g { "yes" } else { "no" };
+        let segments = |g: bool| if g { mccs::table::CORNER_SEGMENTS } else { 0 };
         println!(
             "TABLEBOUND case={name} force_65={:.1e} stiffness_65={:.1e} force_129={:.1e} stiffness_129={:.1e} graded_65={} graded_129={}",
-            t65.force, t65.stiffness, t129.force, t129.stiffness, yes(graded.0), yes(graded.1)
+            t65.force, t65.stiffness, t129.force, t129.stiffness, segments(graded.0), segments(graded.1)
         );
         assert!(
             m.force <= 1.1 * t129.force + 1e-9 && m.stiffness <= 1.1 * t129.stiffness + 1e-9,

@@ -110,12 +110,15 @@ impl<const S: usize> ForceTable<S> {
             }
         }
         // Where no uniform grid meets the product's bound and the solid point is inside
-        // the domain: a graded corner toward it, over a fraction of the curved part,
-        // under each placement of the uniform grid below it.
+        // the domain or a little past its end: a graded corner toward it, over a
+        // fraction of the curved part, under each placement of the uniform grid below it.
         let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
         let e_c = law.strain_c();
-        if missed && S >= 2 * CORNER_SEGMENTS && to >= e_c {
-            let curved = e_c - libm::fmax(law.strain_t(), from);
+        // The solid point may lie a little past the domain's end: the rise toward it is
+        // then inside the domain.
+        let lo = libm::fmax(law.strain_t(), from);
+        if missed && S >= 2 * CORNER_SEGMENTS && e_c <= to + 0.5 * (to - lo) {
+            let curved = e_c - lo;
             'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
                 for fraction in CORNER_FRACTIONS {
                     let len = fraction * curved;
@@ -262,14 +265,14 @@ struct Corner {
 }
 
 impl Corner {
-    /// The corner of `len` strain ending at the solid point, which must be inside the
-    /// domain.
+    /// The corner of `len` strain ending at the solid point; it must start inside the
+    /// domain (which may end before the solid point).
     fn place(law: &Law, to: f64, len: f64) -> Result<Self, TableError> {
         let e_c = law.strain_c();
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
         // The nearest octave's inner end at least a strain LSB from the anchor.
-        if !(to >= e_c && pre >= 1.0 && pre <= (1u64 << 24) as f64) {
+        if !(pre >= 1.0 && pre <= (1u64 << 24) as f64) {
             return Err(TableError::TooNarrow);
         }
         let inner = libm::ldexp(1.0, 24) / pre;
@@ -278,6 +281,10 @@ impl Corner {
         // The last strain e with (A − e) · pre ≥ 2²⁴, plus one.
         let hi = libm::floor(anchor as f64 - inner) + 1.0;
         let start = (anchor as f64 - libm::ldexp(1.0, 32) / pre + 2.0) / unit;
+        // (Also when either is NaN.)
+        if start.partial_cmp(&to) != Some(core::cmp::Ordering::Less) {
+            return Err(TableError::TooNarrow);
+        }
         Ok(Self {
             anchor,
             pre: pre as u32,

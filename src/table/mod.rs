@@ -17,6 +17,13 @@
 //! knot on the law's first corner: for a small spring, the line's slope in Q16 costs
 //! more than the coarser grid), and keeps the one with the least measured error.
 //!
+//! Where none meets the product's bound and the solid point is inside the domain (a soft
+//! cone against a stiff series spring, whose law turns into `Δ(F_C)` like a square
+//! root), the last [`CORNER_SEGMENTS`] segments become a *graded corner* ending at
+//! `Δ(F_C)`: [`CORNER_OCTAVES`] octaves of distance from it, [`CORNER_PER_OCTAVE`]
+//! segments each, indexed by the leading zeros of `d = (A − e) · pre`
+//! ([`RawTable::corner_anchor`]), the uniform grid below it ([`ForceTable::corner`]).
+//!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
 //! the law bends harder than the grid resolves, so that the curve stays monotone), as
@@ -41,7 +48,8 @@
 //! The segment and `τ` come from one subtract, one multiply by a power of two and one
 //! unsigned high-word product (no search, no division); the value is three Horner steps
 //! (one `smmla` each on the M3/M4), the stiffness two more and one scaling product. No
-//! loop; the only branch is which of the three pieces the strain falls in. Every product
+//! loop; the only branch is which of the four pieces the strain falls in (the graded
+//! corner's index adds a `clz`, a multiply and its shifts). Every product
 //! has exact floor semantics, and the Cortex-M0 builds them from 16-bit pieces with the
 //! same bits ([`crate::q`]). Instruction counts per core: `docs/performance.md`.
 //!
