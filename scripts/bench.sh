@@ -7,6 +7,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:-check}
+# Whether a bench log ran to its end: the firmware's last act is its budget check.
+complete() { grep -q "^BUDGET core=$1 " "$2"; }
+# `scripts/bench.sh --check-log CORE LOG`: only that (the test command's check of it).
+if [ "$mode" = "--check-log" ]; then
+  complete "$2" "$3"
+  exit
+fi
 mkdir -p target/qemu
 out=target/qemu/bench.txt
 : > "$out"
@@ -27,6 +34,12 @@ for core in m4f m3 m0; do
   if [ "$rc" != 0 ]; then
     echo "bench: the $core firmware exited with status $rc (a budget breached, or a fault: see $log)" >&2
     grep -E "result=(OVER|missing)|malformed|panic" "$log" >&2 || true
+    status=1
+  elif ! complete "$core" "$log"; then
+    # Its last act is the budget check. A run that stops before it with status 0 is a
+    # fault QEMU did not report: a lockup (the M0's stack overflowing into a hard fault
+    # that cannot stack its frame ends QEMU with status 0).
+    echo "bench: the $core firmware stopped before its budget check, with status 0 (a lockup: see $log; its last line: $(tail -n 1 "$log"))" >&2
     status=1
   fi
 done

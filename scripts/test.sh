@@ -89,6 +89,21 @@ budget_test() {
   cargo build --release -p mccs-firmware --target "$t" --bin bench
 }
 
+# A bench run that stops before its budget check fails the bench, whatever QEMU's exit
+# status (the M0's stack once overflowed into a lockup that QEMU ended with status 0, and
+# a truncated run had passed): the M0's log of the bench stage passes the check, and the
+# same log cut before its budget lines does not.
+bench_truncated() {
+  local log=target/qemu/bench-m0.log cut=target/qemu/bench-m0-truncated.log
+  bash scripts/bench.sh --check-log m0 "$log" || { echo "the complete log fails"; return 1; }
+  grep -v "^BUDGET " "$log" > "$cut"
+  if bash scripts/bench.sh --check-log m0 "$cut"; then
+    echo "a bench log without its budget check passed"
+    return 1
+  fi
+  echo "a complete bench log passes, one cut before its budget check fails"
+}
+
 # Flash and static RAM of the demo firmware (defmt included), per core.
 # Flash budget: 96 KiB on every core (the roaming demo's tick, the window's start-up and
 # the main loop's table builder; a 128 KiB part holds it: the microbit's nRF51822 has
@@ -133,6 +148,7 @@ run_stage tick-path tick_path
 run_stage panic-exits-with-failure panic_test
 run_stage bench bash scripts/bench.sh
 run_stage budget-breach-fails budget_test
+run_stage bench-truncated-fails bench_truncated
 run_stage firmware-size sizes
 run_stage board-f405 board_f405
 run_stage host-tests host_tests

@@ -55,7 +55,7 @@ mod firmware {
         let empty = h.measure(64, || {
             black_box(0u32);
         });
-        let table = black_box(TABLE2);
+        let table: &ForceTable64 = black_box(&TABLE2);
         // The assembly against the Rust it replaces, before any figure: the M4F's spring
         // loop and integrator, the M0's holds.
         kernel_check::check(&table);
