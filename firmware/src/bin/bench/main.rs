@@ -58,27 +58,24 @@ mod firmware {
         let table: &ForceTable64 = black_box(&TABLE2);
         // The assembly against the Rust it replaces, before any figure: the M4F's spring
         // loop and integrator, the M0's holds.
-        kernel_check::check(&table);
+        kernel_check::check(table);
         hold_check::check();
         // These two take off their own harness (the empty call included).
-        figs.report(
-            "force_and_stiffness",
-            cases::force_and_stiffness(&h, &table),
-        );
+        figs.report("force_and_stiffness", cases::force_and_stiffness(&h, table));
         static STIFF_SERIES: ForceTable64 = include!("../../../../tables/stiff_series.rs");
         figs.report(
             "force_and_stiffness_corner",
             cases::force_and_stiffness_corner(&h, black_box(&STIFF_SERIES)),
         );
-        figs.report("spring", cases::spring(&h, &table));
+        figs.report("spring", cases::spring(&h, table));
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
         let sub = |h: &Harness, n, i| match n {
-            3 => cases::substep::<2, 9>(h, 3, &table, probe, i),
-            4 => cases::substep::<5, 30>(h, 4, &table, probe, i),
-            5 => cases::substep::<10, 61>(h, 5, &table, probe, i),
-            6 => cases::substep::<17, 102>(h, 6, &table, probe, i),
-            7 => cases::substep::<26, 153>(h, 7, &table, probe, i),
-            _ => cases::substep::<37, 214>(h, 8, &table, probe, i),
+            3 => cases::substep::<2, 9>(h, 3, table, probe, i),
+            4 => cases::substep::<5, 30>(h, 4, table, probe, i),
+            5 => cases::substep::<10, 61>(h, 5, table, probe, i),
+            6 => cases::substep::<17, 102>(h, 6, table, probe, i),
+            7 => cases::substep::<26, 153>(h, 7, table, probe, i),
+            _ => cases::substep::<37, 214>(h, 8, table, probe, i),
         };
         // Not on the M0 above N = 5: its 16 KiB hold neither these patches nor their
         // figures. Each integrator's substep (the symplectic option's names end in
@@ -94,45 +91,45 @@ mod firmware {
         // spring.
         figs.report(
             "spring_in_loop_n5",
-            cases::spring_in_loop::<10, 61>(&h, 5, &table, probe, empty),
+            cases::spring_in_loop::<10, 61>(&h, 5, table, probe, empty),
         );
         if CORE != Core::M0 {
             figs.report(
                 "spring_in_loop_n8",
-                cases::spring_in_loop::<37, 214>(&h, 8, &table, probe, empty),
+                cases::spring_in_loop::<37, 214>(&h, 8, table, probe, empty),
             );
         }
-        let steps = Steps::new(&table, Integrator::ImprovedEuler);
-        let steps_symplectic = Steps::new(&table, Integrator::SymplecticDamped);
+        let steps = Steps::new(table, Integrator::ImprovedEuler);
+        let steps_symplectic = Steps::new(table, Integrator::SymplecticDamped);
         let sub5 = steps.substeps(5, 1000).unwrap_or(1);
         let sub8 = steps.substeps(8, 1000).unwrap_or(1);
         // The comparators: the same substep in f32 (the M4F's FPU, software elsewhere) and
         // in f64 (software everywhere).
         figs.report(
             "substep_n5_f32",
-            cases::float::<f32, 10, 61>(&h, 5, sub5, &table) - empty,
+            cases::float::<f32, 10, 61>(&h, 5, sub5, table) - empty,
         );
         figs.report(
             "substep_n5_f64",
-            cases::float::<f64, 10, 61>(&h, 5, sub5, &table) - empty,
+            cases::float::<f64, 10, 61>(&h, 5, sub5, table) - empty,
         );
         if CORE != Core::M0 {
             figs.report(
                 "substep_n8_f32",
-                cases::float::<f32, 37, 214>(&h, 8, sub8, &table) - empty,
+                cases::float::<f32, 37, 214>(&h, 8, sub8, table) - empty,
             );
             figs.report(
                 "substep_n8_f64",
-                cases::float::<f64, 37, 214>(&h, 8, sub8, &table) - empty,
+                cases::float::<f64, 37, 214>(&h, 8, sub8, table) - empty,
             );
         }
         // One whole tick of this core's demo configuration, in contact.
-        figs.report("tick", cases::tick(&h, &table, probe) - empty);
+        figs.report("tick", cases::tick(&h, table, probe) - empty);
         // One tick of the demo's patch through a sliding proxy (issue #19).
-        figs.report("tick_proxy", cases::tick_proxy(&h, &table) - empty);
+        figs.report("tick_proxy", cases::tick_proxy(&h, table) - empty);
         // The demo's roaming: the longest tick without and with a window shift, and a
         // shift's own cost (the most a shift tick took over the tick before).
-        let roam = cases::roaming(&h, &table, empty);
+        let roam = cases::roaming(&h, table, empty);
         figs.report("tick_roaming", roam.steady);
         figs.report("tick_roaming_shift", roam.shift);
         figs.report("window_shift", roam.shift_extra);
@@ -144,7 +141,7 @@ mod firmware {
         );
         // The same over a spherical cap (R = 150 mm): the contact along its normals, and
         // a shift that also computes the entering rest heights and springs.
-        let cap = cases::roaming_cap(&h, &table, empty);
+        let cap = cases::roaming_cap(&h, table, empty);
         figs.report("tick_roaming_cap", cap.steady);
         figs.report("tick_roaming_cap_shift", cap.shift);
         figs.report("window_shift_cap", cap.shift_extra);
@@ -154,7 +151,7 @@ mod firmware {
         );
         // Issue #19's M4F configuration, N = 5, over the cap (the M4F's demo runs N = 8).
         if CORE == Core::M4F {
-            let cap5 = cases::roaming_cap_n5(&h, &table, empty);
+            let cap5 = cases::roaming_cap_n5(&h, table, empty);
             figs.report("tick_roaming_cap_n5", cap5.steady);
             figs.report("window_shift_cap_n5", cap5.shift_extra);
             figs.report(
