@@ -192,16 +192,19 @@ impl<const S: usize> ForceTable<S> {
         };
         let n = if CORNER { S - CORNER_SEGMENTS } else { S };
         let grid = Grid::place::<TENSION>(law, from, to, align, n, corner.map(|c| c.start))?;
-        let magnitude = match &corner {
-            Some(c) => c.magnitude(law)?,
-            None => (0.0, 0.0),
+        // The corner's segments' ends, from the law once (its shift, then its
+        // coefficients).
+        let corner_ends = match &corner {
+            Some(c) => Some(c.segment_ends(law)?),
+            None => None,
         };
+        let magnitude = corner_ends.as_ref().map_or((0.0, 0.0), magnitude);
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
         // The lines are anchored on the end knots floored to Q20: the table's own values
         // floor the same way, so the curve stays monotone across the anchors.
-        let mut l = lines::<S>(law, &grid, segs.first >> shift)?;
+        let l = lines::<S>(law, &grid, segs.first >> shift)?;
         let mut raw = RawTable {
             strain_lo: grid.strain_lo,
             strain_hi: grid.strain_hi,
@@ -225,15 +228,14 @@ impl<const S: usize> ForceTable<S> {
             err_stiffness_ppb: UNMEASURED,
             segments: [[0; 4]; S],
         };
-        if let Some(c) = corner {
+        if let (Some(c), Some(ends)) = (corner, corner_ends) {
             // The corner starts inside the uniform grid's last segment (its coordinate
             // below 2³² there) and ends past it.
             let d = (c.anchor as i64 - grid.strain_hi as i64) * c.pre as i64;
             if !(d < 1 << 32 && grid.strain_hi < c.hi) {
                 return Err(TableError::TooNarrow);
             }
-            let last = c.fill(law, shift, &mut segs.coefficients[n..])?;
-            l.stiffness_hi = checked_from_f64(law.k_p, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
+            let last = fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
             let (scale, post) = corner_scale(c.pre, shift)?;
             raw.corner_hi = c.hi;
             raw.corner_anchor = c.anchor;
@@ -242,7 +244,8 @@ impl<const S: usize> ForceTable<S> {
             raw.corner_scale = scale;
             raw.corner_post = post;
             raw.force_hi = last >> shift;
-            raw.stiffness_hi = l.stiffness_hi;
+            raw.stiffness_hi =
+                checked_from_f64(law.k_p, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
         }
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
@@ -314,52 +317,59 @@ impl Corner {
         Ok((f * unit, k * unit))
     }
 
-    /// Segment `(z, j)`'s ends `(a0, a1)` and slopes per `τ` `(m0, m1)` in Q20 N units:
-    /// `τ` runs from `(z, j)` down in strain to `(z, j + 1)`.
-    fn ends(&self, law: &Law, z: usize, j: usize) -> Result<[f64; 4], TableError> {
-        let (x0, x1) = (self.strain(z, j), self.strain(z, j + 1));
-        let ((a0, k0), (a1, k1)) = (self.knot(law, z, j)?, self.knot(law, z, j + 1)?);
-        let w = x0 - x1;
-        Ok([a0, a1, -k0 * w, -k1 * w])
-    }
-
-    /// The largest knot and `(|C1| + |C2| + |C3|) · 2^z` in Q20 N units (for the
-    /// coefficients' shift: the stiffness in octave `z` takes `D << z`).
-    fn magnitude(&self, law: &Law) -> Result<(f64, f64), TableError> {
-        let (mut value, mut poly) = (0.0f64, 0.0f64);
-        for i in 0..CORNER_SEGMENTS {
-            let z = i / CORNER_PER_OCTAVE;
-            let [a0, a1, m0, m1] = self.ends(law, z, i % CORNER_PER_OCTAVE)?;
-            let c = hermite(a0, a1, m0, m1);
-            value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
-            let sum = libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]);
-            poly = libm::fmax(poly, libm::ldexp(sum, z as i32));
-        }
-        Ok((value, poly))
-    }
-
-    /// The corner's coefficients in the unit of `shift`, as [`segments`] rounds them;
-    /// returns the last knot (at the solid point) in that unit.
-    fn fill(&self, law: &Law, shift: u32, out: &mut [[i32; 4]]) -> Result<i32, TableError> {
-        let scale = (1u64 << shift) as f64;
-        for (i, c) in out.iter_mut().enumerate().take(CORNER_SEGMENTS) {
-            let [a0, a1, m0, m1] = self.ends(law, i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE)?;
-            let (a0, a1) = (libm::round(a0 * scale), libm::round(a1 * scale));
-            let [c1, c2, _] = hermite(a0, a1, m0 * scale, m1 * scale);
-            let (c1, c2) = (libm::round(c1), libm::round(c2));
-            let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
-            let z = (i / CORNER_PER_OCTAVE) as i32;
-            if libm::fabs(a0) >= (1u64 << 30) as f64
-                || libm::ldexp(libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3), z)
-                    > (1u64 << 29) as f64
-            {
-                return Err(TableError::OutOfRange);
+    /// Every segment's ends `[a0, a1, m0, m1]`, in segment order (`4 z + j`): the values
+    /// `(a0, a1)` and slopes per `τ` `(m0, m1)` in Q20 N units, `τ` running from `(z, j)`
+    /// down in strain to `(z, j + 1)`. Each knot from the law once (`(z, 4)` is the next
+    /// octave's start, `(z − 1, 0)`).
+    fn segment_ends(&self, law: &Law) -> Result<[[f64; 4]; CORNER_SEGMENTS], TableError> {
+        let mut knots = [[(0.0, 0.0); CORNER_PER_OCTAVE + 1]; CORNER_OCTAVES];
+        for z in 0..CORNER_OCTAVES {
+            for jj in 0..CORNER_PER_OCTAVE {
+                knots[z][jj] = self.knot(law, z, jj)?;
             }
-            *c = [a0 as i32, c1 as i32, c2 as i32, c3 as i32];
+            knots[z][CORNER_PER_OCTAVE] = match z {
+                0 => self.knot(law, 0, CORNER_PER_OCTAVE)?,
+                _ => knots[z - 1][0],
+            };
         }
-        let (last, _) = self.knot(law, CORNER_OCTAVES - 1, 0)?;
-        Ok(libm::round(last * scale) as i32)
+        Ok(core::array::from_fn(|i| {
+            let (z, j) = (i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE);
+            let ((a0, k0), (a1, k1)) = (knots[z][j], knots[z][j + 1]);
+            let w = self.strain(z, j) - self.strain(z, j + 1);
+            [a0, a1, -k0 * w, -k1 * w]
+        }))
     }
+}
+
+/// The corner's largest knot and `(|C1| + |C2| + |C3|) · 2^z` in Q20 N units, from its
+/// segments' ends (for the coefficients' shift: the stiffness in octave `z` takes
+/// `D << z`).
+fn magnitude(ends: &[[f64; 4]; CORNER_SEGMENTS]) -> (f64, f64) {
+    let (mut value, mut poly) = (0.0f64, 0.0f64);
+    for (i, &[a0, a1, m0, m1]) in ends.iter().enumerate() {
+        let c = hermite(a0, a1, m0, m1);
+        value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
+        let sum = libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]);
+        poly = libm::fmax(poly, libm::ldexp(sum, (i / CORNER_PER_OCTAVE) as i32));
+    }
+    (value, poly)
+}
+
+/// The corner's coefficients in the unit of `shift`, rounded as [`segments`] rounds
+/// them ([`rounded_cubic`], with octave `z`'s `2^z`); returns the last knot (at the
+/// solid point: segment `(7, 0)`'s upper end) in that unit.
+fn fill_corner(
+    ends: &[[f64; 4]; CORNER_SEGMENTS],
+    shift: u32,
+    out: &mut [[i32; 4]],
+) -> Result<i32, TableError> {
+    let scale = (1u64 << shift) as f64;
+    for (i, (c, &[a0, a1, m0, m1])) in out.iter_mut().zip(ends).enumerate() {
+        let (a0, a1) = (libm::round(a0 * scale), libm::round(a1 * scale));
+        let z = (i / CORNER_PER_OCTAVE) as i32;
+        *c = rounded_cubic(a0, a1, m0 * scale, m1 * scale, z)?;
+    }
+    Ok(libm::round(ends[(CORNER_OCTAVES - 1) * CORNER_PER_OCTAVE][0] * scale) as i32)
 }
 
 /// The corner's stiffness scale `(corner_scale, corner_post)`: in octave `z`,
@@ -367,7 +377,13 @@ impl Corner {
 /// (D · scale) >> (32 − z)` with `scale = −pre · 2^(22 − shift)`, a power of two moved
 /// into the post-factor while it would not fit.
 fn corner_scale(pre: u32, shift: u32) -> Result<(i32, i32), TableError> {
-    let mut v = libm::ldexp(pre as f64, 22 - shift as i32);
+    let (v, post) = with_post(libm::ldexp(pre as f64, 22 - shift as i32))?;
+    Ok((-v, post))
+}
+
+/// A positive scale `v` as `(⌊v / 2^p⌉, 2^p)`, the least power `p` (< 30) that brings it
+/// below 2³¹ − 1.
+fn with_post(mut v: f64) -> Result<(i32, i32), TableError> {
     let mut post = 0u32;
     while v >= (1u64 << 31) as f64 - 1.0 && post < 30 {
         v /= 2.0;
@@ -376,7 +392,7 @@ fn corner_scale(pre: u32, shift: u32) -> Result<(i32, i32), TableError> {
     if v >= (1u64 << 31) as f64 - 1.0 {
         return Err(TableError::OutOfRange);
     }
-    Ok((-(libm::round(v) as i32), 1i32 << post))
+    Ok((libm::round(v) as i32, 1i32 << post))
 }
 
 /// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
@@ -716,20 +732,10 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
     for (i, c) in coefficients.iter_mut().enumerate().take(grid.used) {
         let k = grid.knot(law, i + 1)?;
         let a1 = libm::round(k.value * scale);
-        let [c1, c2, _] = hermite(a0, a1, m0 * scale, k.slope_below * scale);
-        let (c1, c2) = (libm::round(c1), libm::round(c2));
-        let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
-        if libm::fabs(a0) >= (1u64 << 30) as f64
-            || libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3) > (1u64 << 29) as f64
-        {
-            return Err(TableError::OutOfRange);
-        }
+        *c = rounded_cubic(a0, a1, m0 * scale, k.slope_below * scale, 0)?;
+        let [c1, c2, c3] = [c[1], c[2], c[3]].map(|x| libm::fabs(x as f64));
         // |dF/dτ| ≤ |c1| + 2|c2| + 3|c3|, in the unit.
-        slope_bound = libm::fmax(
-            slope_bound,
-            libm::fabs(c1) / 2.0 + libm::fabs(c2) / 2.0 + 3.0 * libm::fabs(c3) / 8.0,
-        );
-        *c = [a0 as i32, c1 as i32, c2 as i32, c3 as i32];
+        slope_bound = libm::fmax(slope_bound, c1 / 2.0 + c2 / 2.0 + 3.0 * c3 / 8.0);
         (a0, m0) = (a1, k.slope_above);
     }
     Ok(Segments {
@@ -738,6 +744,23 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
         last: a0 as i32,
         slope_bound,
     })
+}
+
+/// One segment's `[C0, C1, C2, C3]` from its rounded end values `a0, a1` and its end
+/// slopes `m0, m1` (the coefficients' unit): `C1`, `C2` rounded, `C3 = 8 (a1 − a0) − 4 C1
+/// − 2 C2` exact, so that the cubic ends on `a1`; refused unless `|a0| < 2³⁰` and
+/// `(|C1| + |C2| + |C3|) · 2^z ≤ 2²⁹` (`z` = 0 on the uniform grid, the octave in the
+/// graded corner, whose stiffness takes `D << z`).
+fn rounded_cubic(a0: f64, a1: f64, m0: f64, m1: f64, z: i32) -> Result<[i32; 4], TableError> {
+    let [c1, c2, _] = hermite(a0, a1, m0, m1);
+    let (c1, c2) = (libm::round(c1), libm::round(c2));
+    let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+    if libm::fabs(a0) >= (1u64 << 30) as f64
+        || libm::ldexp(libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3), z) > (1u64 << 29) as f64
+    {
+        return Err(TableError::OutOfRange);
+    }
+    Ok([a0 as i32, c1 as i32, c2 as i32, c3 as i32])
 }
 
 /// The stiffness scale `(stiff_scale, stiff_post)`: dF/dε (Q16) = (D / 2) · sps ·
@@ -751,16 +774,7 @@ fn stiffness_scale(grid: &Grid, shift: u32, slope_bound: f64) -> Result<(i32, i3
     if k_bound.is_nan() || k_bound > (1u64 << 30) as f64 {
         return Err(TableError::OutOfRange);
     }
-    let mut v = sps * libm::ldexp(1.0, 27 - shift as i32);
-    let mut post = 0u32;
-    while v >= (1u64 << 31) as f64 - 1.0 && post < 30 {
-        v /= 2.0;
-        post += 1;
-    }
-    if v >= (1u64 << 31) as f64 - 1.0 {
-        return Err(TableError::OutOfRange);
-    }
-    Ok((libm::round(v) as i32, 1i32 << post))
+    with_post(sps * libm::ldexp(1.0, 27 - shift as i32))
 }
 
 /// The straight lines beyond the table.

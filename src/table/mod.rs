@@ -388,7 +388,7 @@ impl<const S: usize> ForceTable<S> {
     #[inline(never)]
     #[cold]
     pub(crate) fn corner_force(&self, e: i32) -> i32 {
-        let (c, t) = self.corner_segment(e);
+        let (c, t, _) = self.corner_segment(e);
         cubic_value(&self.raw, c, t)
     }
 
@@ -397,7 +397,7 @@ impl<const S: usize> ForceTable<S> {
     #[inline(always)]
     fn corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
         let r = &self.raw;
-        let (c, t, z) = self.corner_segment_octave(e);
+        let (c, t, z) = self.corner_segment(e);
         let f = cubic_value(r, c, t);
         // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 7 on a
         // valid table; the shift wraps at 32 on any other, without a panic).
@@ -414,14 +414,7 @@ impl<const S: usize> ForceTable<S> {
     /// table that fails [`ForceTable::validate`] the segment is any (masked), never out
     /// of bounds.
     #[inline(always)]
-    fn corner_segment(&self, e: i32) -> (&[i32; 4], u32) {
-        let (c, t, _) = self.corner_segment_octave(e);
-        (c, t)
-    }
-
-    /// [`ForceTable::corner_segment`] and the octave `z`.
-    #[inline(always)]
-    fn corner_segment_octave(&self, e: i32) -> (&[i32; 4], u32, u32) {
+    fn corner_segment(&self, e: i32) -> (&[i32; 4], u32, u32) {
         let r = &self.raw;
         let d = (r.corner_anchor.wrapping_sub(e) as u32).wrapping_mul(r.corner_pre);
         let z = d.leading_zeros();
@@ -429,13 +422,8 @@ impl<const S: usize> ForceTable<S> {
         let i = r
             .corner_base
             .wrapping_add(z << CORNER_BITS)
-            .wrapping_add(pos >> 15) as usize;
-        let i = if S.is_power_of_two() {
-            i & (S - 1)
-        } else {
-            i.min(S.saturating_sub(1))
-        };
-        (r.segments.get(i).unwrap_or(&NO_SEGMENT), pos & 0x7FFF, z)
+            .wrapping_add(pos >> 15);
+        (segment_at(r, i as usize), pos & 0x7FFF, z)
     }
 
     /// The position of `e` (`strain_lo < e < strain_hi`) in Q15 segments from `strain_lo`.
@@ -453,16 +441,21 @@ impl<const S: usize> ForceTable<S> {
         let pos = self.position(e);
         // strain_hi is placed so that pos < S · 2¹⁵ here: the mask (or min) only keeps
         // the compiler from adding a bounds check.
-        let i = (pos >> 15) as usize;
-        let i = if S.is_power_of_two() {
-            i & (S - 1)
-        } else {
-            i.min(S.saturating_sub(1))
-        };
-        // Always a segment for S ≥ 1 (the compiler sees i < S: no code); a table of no
-        // segments (only from `from_raw`) reads zeros instead of panicking.
-        (r.segments.get(i).unwrap_or(&NO_SEGMENT), pos & 0x7FFF)
+        (segment_at(r, (pos >> 15) as usize), pos & 0x7FFF)
     }
+}
+
+/// Segment `i`, masked into the table (`S` a power of two) or held at its last: never
+/// out of bounds, with no bounds check once the compiler sees `i < S`; a table of no
+/// segments (only from `from_raw`) reads zeros instead of panicking.
+#[inline(always)]
+pub(crate) fn segment_at<const S: usize>(r: &RawTable<S>, i: usize) -> &[i32; 4] {
+    let i = if S.is_power_of_two() {
+        i & (S - 1)
+    } else {
+        i.min(S.saturating_sub(1))
+    };
+    r.segments.get(i).unwrap_or(&NO_SEGMENT)
 }
 
 /// The strain (`f64`) of the graded corner's coordinate `d = 2^(31 − z) (1 + jj/4)`
@@ -483,7 +476,7 @@ fn slope(c: &[i32; 4], t: u32) -> i32 {
 }
 
 /// What a table with no segments evaluates to between its ends.
-pub(crate) const NO_SEGMENT: [i32; 4] = [0; 4];
+const NO_SEGMENT: [i32; 4] = [0; 4];
 
 /// `C0 + C1 τ + … ` in Q20 N: three halving Horner steps, then the unit's shift.
 #[inline(always)]

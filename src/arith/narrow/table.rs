@@ -4,7 +4,7 @@
 use super::Narrow;
 use crate::arith::ArithTable;
 use crate::q;
-use crate::table::{cubic_value, RawTable, NO_SEGMENT};
+use crate::table::{cubic_value, segment_at, RawTable};
 use crate::units::Strain;
 
 /// What [`table_force`] needs beyond the raw table, derived from it: the index scale and
@@ -128,14 +128,7 @@ pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain
             .wrapping_mul(n.scale)
             .wrapping_add(d0.wrapping_mul(n.scale) >> 16);
         let pos = p >> n.scale_sh;
-        let i = (pos >> 15) as usize;
-        let i = if S.is_power_of_two() {
-            i & (S - 1)
-        } else {
-            i.min(S.saturating_sub(1))
-        };
-        let c = r.segments.get(i).unwrap_or(&NO_SEGMENT);
-        cubic_value(r, c, pos & 0x7FFF)
+        cubic_value(r, segment_at(r, (pos >> 15) as usize), pos & 0x7FFF)
     };
     q::hold::<26>(f)
 }
