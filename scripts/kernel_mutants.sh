@@ -35,7 +35,7 @@ mutants=(
   "push hold one bit narrower|#27, \", \$w|#26, \", \$w"
   "ground damping added, not subtracted|\"smmlsr \", \$w, \", \", \$va|\"smmlar \", \$w, \", \", \$va"
   "two-node law product added, not subtracted|\"smmlsr \",|\"smmlar \","
-  "gentle lower line's slope shifted one bit less|\"lsl r5, r5, #12\\n\", \"smmul|\"lsl r5, r5, #11\\n\", \"smmul"
+  "gentle lower line's product rounded|\"smmul r3, r5, r3\\n\",)|\"smmulr r3, r5, r3\\n\",)"
   "integrator velocity hold one bit narrower|ssat r8, #23, r8|ssat r8, #22, r8"
   "integrator displacement hold one bit narrower|ssat r1, #31, r1|ssat r1, #30, r1"
   "accumulator cleared at the wrong offset|\"str r3, [lr, #8]\"|\"str r3, [lr, #4]\""

@@ -149,8 +149,17 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         // C0 … C3 carry 1, 2, 4, 8 times c0 … c3, in Q(20 + shift) N.
         let unit = (1u64 << (FORCE_FRAC + raw.shift)) as f64;
         let mut seg = [[T::ZERO; 4]; S];
+        // C0 less the knots' rounding bias (`mccs::table::knot_bias`).
+        let bias = mccs::table::knot_bias(raw.shift) as f64;
         for (s, c) in seg.iter_mut().zip(raw.segments.iter()) {
-            *s = core::array::from_fn(|j| T::of(c[j] as f64 / unit / (1u32 << j) as f64));
+            *s = core::array::from_fn(|j| {
+                let v = if j == 0 {
+                    c[0] as f64 - bias
+                } else {
+                    c[j] as f64
+                };
+                T::of(v / unit / (1u32 << j) as f64)
+            });
         }
         let mut springs = [Spring {
             a: 0,
@@ -170,6 +179,12 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             };
         }
         let h = 1.0 / (cfg.tick_hz * substeps as f64);
+        // The line below's slope as its force uses it (`RawTable::slope_lo`).
+        let k_lo = if mccs::table::fine_lower_line(raw.stiffness_lo) {
+            to_f64(raw.slope_lo, 28)
+        } else {
+            to_f64(raw.slope_lo, STIFF_FRAC)
+        };
         Self {
             springs,
             n_springs: topo.edges().len(),
@@ -179,10 +194,9 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             strain_lo: T::of(to_f64(raw.strain_lo, STRAIN_FRAC)),
             strain_hi: T::of(to_f64(raw.strain_hi, STRAIN_FRAC)),
             per_strain: T::of(raw.index_scale as f64 * raw.index_pre as f64 / (1u64 << 23) as f64),
-            k_lo: T::of(to_f64(raw.stiffness_lo, STIFF_FRAC)),
+            k_lo: T::of(k_lo),
             f_lo: T::of(
-                to_f64(raw.force_lo, FORCE_FRAC)
-                    - to_f64(raw.stiffness_lo, STIFF_FRAC) * to_f64(raw.anchor_lo, STRAIN_FRAC),
+                to_f64(raw.force_lo, FORCE_FRAC) - k_lo * to_f64(raw.anchor_lo, STRAIN_FRAC),
             ),
             k_hi: T::of(to_f64(raw.stiffness_hi, STIFF_FRAC)),
             f_hi: T::of(

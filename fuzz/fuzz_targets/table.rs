@@ -13,7 +13,7 @@ struct Input {
     from: f64,
     to: f64,
     knots: u8,
-    raw: ([i32; 9], [u32; 3], [[i32; 4]; 16], [i32; 6]),
+    raw: ([i32; 10], [u32; 3], [[i32; 4]; 16], [i32; 6]),
     strains: Vec<i32>,
 }
 
@@ -64,6 +64,7 @@ fuzz_target!(|i: Input| {
         anchor_lo: a[2],
         force_lo: a[3],
         stiffness_lo: a[4],
+        slope_lo: a[9],
         force_hi: a[5],
         stiffness_hi: a[6],
         shift: b[2],

@@ -34,6 +34,7 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             any::<u32>(),
             any::<i32>(),
             any::<i32>(),
+            any::<i32>(),
         ),
     )
         .prop_map(|(a, b, c, segments, g)| RawTable {
@@ -43,7 +44,9 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             index_scale: a.3,
             anchor_lo: a.4,
             force_lo: b.0,
-            stiffness_lo: b.1,
+            // Half of them within ±2¹⁹, where the line below's slope is Q28.
+            stiffness_lo: if c.0 & 1 == 0 { b.1 >> 12 } else { b.1 },
+            slope_lo: g.7,
             force_hi: b.2,
             stiffness_hi: b.3,
             shift: b.4,
@@ -96,6 +99,7 @@ fn a_table_of_no_segments_evaluates_without_panic() {
         anchor_lo: 0,
         force_lo: 0,
         stiffness_lo: 1 << 16,
+        slope_lo: 1 << 28,
         force_hi: 1 << 20,
         stiffness_hi: 1 << 17,
         shift: 0,

@@ -72,7 +72,7 @@ const fn header<const S: usize>() -> [i32; 13] {
         core::mem::offset_of!(RawTable<S>, index_scale) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, anchor_lo) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, force_lo) as i32 - seg,
-        core::mem::offset_of!(RawTable<S>, stiffness_lo) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, slope_lo) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, force_hi) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, stiffness_hi) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, corner_hi) as i32 - seg,
@@ -123,8 +123,8 @@ macro_rules! asm_writing_all {
     };
 }
 
-/// The lower line's product, `(stiffness_lo · d) >> 20` held to 32 bits, into r3 from
-/// the slope (r5) and `d = e ⊖ anchor_lo` (r3): any slope (a long product, its high
+/// The lower line's product, `(slope_lo · d) >> 20` held to 32 bits, into r3 from
+/// the Q16 slope (r5) and `d = e ⊖ anchor_lo` (r3): any slope (a long product, its high
 /// word held, the two words joined).
 macro_rules! lower_any {
     () => {
@@ -137,12 +137,12 @@ macro_rules! lower_any {
     };
 }
 
-/// The same for a slope within ±2¹⁹ (Q16: below 8 N per unit strain, Table 2's is 2.3):
-/// `hi((stiffness_lo << 12) · d)`, the same bits (`|stiffness_lo · d| < 2⁵⁰`: the hold
-/// never acts), two instructions fewer.
+/// The same for a stiffness within ±2¹⁹ (Q16: below 8 N per unit strain, Table 2's is
+/// 2.3), whose `slope_lo` is Q28 ([`crate::table::fine_lower_line`]): `hi(slope_lo ·
+/// d)`, one instruction.
 macro_rules! lower_gentle {
     () => {
-        concat!("lsl r5, r5, #12\n", "smmul r3, r5, r3\n",)
+        concat!("smmul r3, r5, r3\n",)
     };
 }
 
@@ -226,11 +226,11 @@ macro_rules! spring_body {
             "ubfx r3, r3, #14, #15\n",
             "lsl r3, r3, #16\n",
             "b 55b\n",
-            // Below: force_lo + (stiffness_lo · (e ⊖ anchor_lo)) >> 20, held.
+            // Below: force_lo + the slope's product with e ⊖ anchor_lo.
             "51:\n",
             "ldr r3, [r11, #{anchor_lo}]\n",
             "qsub r3, r9, r3\n",
-            "ldr r5, [r11, #{stiffness_lo}]\n",
+            "ldr r5, [r11, #{slope_lo}]\n",
             $lower!(),
             "ldr r5, [r11, #{force_lo}]\n",
             "qadd r5, r5, r3\n",
@@ -398,7 +398,7 @@ macro_rules! spring_loop {
             index_pre = const header::<S>()[2],
             anchor_lo = const header::<S>()[4],
             force_lo = const header::<S>()[5],
-            stiffness_lo = const header::<S>()[6],
+            slope_lo = const header::<S>()[6],
             force_hi = const header::<S>()[7],
             stiffness_hi = const header::<S>()[8],
             corner_hi = const header::<S>()[9],
@@ -434,7 +434,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
         warm: warm.as_mut_ptr(),
     };
     // The lower line's product as its slope allows (a constant per call).
-    let gentle = (-(1 << 19)..1 << 19).contains(&raw.stiffness_lo);
+    let gentle = crate::table::fine_lower_line(raw.stiffness_lo);
     // SAFETY (both loops): the loop reads the `n` edges of `topo` (`edges` up to `end`)
     // and as many warm-start values (n ≤ EDGES), writes only those values and the nodes' force
     // accumulators, and reads the table's header and segments. Every node index is in

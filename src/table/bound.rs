@@ -90,8 +90,11 @@ fn ppb(x: f64) -> u32 {
 /// The least error the output formats allow a table of `law` over `[from, to]`, in the
 /// terms of [`measure`]: half a Q20 force LSB relative to `F(to)`, and half a Q16
 /// stiffness LSB relative to the law's least stiffness on the domain (sampled at 1,001
-/// strains). No placement of knots can bring a table's largest errors below these: a
-/// bound below them is out of the formats' reach.
+/// strains). No placement of knots can bring a table's largest force error below the
+/// first (the force runs continuously through many LSBs, and its rounding error reaches
+/// half of one), nor its stiffness error below the second unless the table happens to
+/// hold the least stiffness exactly (on a line, a constant): a bound below them is out of
+/// the formats' reach.
 pub fn format_floor(law: &Law, from: f64, to: f64) -> TableBound {
     let half_lsb = |frac: u32| 0.5 / (1u64 << frac) as f64;
     let mut least = f64::INFINITY;

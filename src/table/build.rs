@@ -4,8 +4,8 @@
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
 use super::{
-    corner_strain, measure, ForceTable, RawTable, TableBound, TableError, CORNER_OCTAVES,
-    CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, UNMEASURED,
+    corner_strain, fine_lower_line, knot_bias, measure, ForceTable, RawTable, TableBound,
+    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -213,6 +213,7 @@ impl<const S: usize> ForceTable<S> {
             anchor_lo: l.anchor_lo,
             force_lo: l.force_lo,
             stiffness_lo: l.stiffness_lo,
+            slope_lo: l.slope_lo,
             force_hi: segs.last >> shift,
             stiffness_hi: l.stiffness_hi,
             shift,
@@ -365,11 +366,18 @@ fn fill_corner(
 ) -> Result<i32, TableError> {
     let scale = (1u64 << shift) as f64;
     for (i, (c, &[a0, a1, m0, m1])) in out.iter_mut().zip(ends).enumerate() {
-        let (a0, a1) = (libm::round(a0 * scale), libm::round(a1 * scale));
+        let (a0, a1) = (knot_units(a0, shift), knot_units(a1, shift));
         let z = (i / CORNER_PER_OCTAVE) as i32;
         *c = rounded_cubic(a0, a1, m0 * scale, m1 * scale, z)?;
     }
-    Ok(libm::round(ends[(CORNER_OCTAVES - 1) * CORNER_PER_OCTAVE][0] * scale) as i32)
+    Ok(knot_units(ends[(CORNER_OCTAVES - 1) * CORNER_PER_OCTAVE][0], shift) as i32)
+}
+
+/// A knot's value (Q20 N, as an `f64`) in the coefficients' unit Q(20 + `shift`):
+/// rounded, plus [`knot_bias`], so that the evaluation's final `>> shift` rounds to the
+/// nearest Q20 N instead of flooring.
+fn knot_units(value: f64, shift: u32) -> f64 {
+    libm::round(libm::ldexp(value, shift as i32)) + knot_bias(shift) as f64
 }
 
 /// The corner's stiffness scale `(corner_scale, corner_post)`: in octave `z`,
@@ -698,7 +706,7 @@ fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64)) -> Result<u32, 
     }
     let fits = |shift: u32| {
         let x = (1u64 << shift) as f64;
-        big_value * x <= (1u64 << 30) as f64 - 64.0
+        big_value * x + knot_bias(shift) as f64 <= (1u64 << 30) as f64 - 64.0
             && 1.01 * big_poly * x <= (1u64 << 29) as f64 - 64.0
     };
     if !fits(0) {
@@ -726,12 +734,12 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
     let scale = (1u64 << shift) as f64;
     let first = grid.knot(law, 0)?;
     let mut coefficients = [[0i32; 4]; S];
-    let (mut a0, mut m0) = (libm::round(first.value * scale), first.slope_above);
+    let (mut a0, mut m0) = (knot_units(first.value, shift), first.slope_above);
     let a_first = a0;
     let mut slope_bound = 0.0f64;
     for (i, c) in coefficients.iter_mut().enumerate().take(grid.used) {
         let k = grid.knot(law, i + 1)?;
-        let a1 = libm::round(k.value * scale);
+        let a1 = knot_units(k.value, shift);
         *c = rounded_cubic(a0, a1, m0 * scale, k.slope_below * scale, 0)?;
         let [c1, c2, c3] = [c[1], c[2], c[3]].map(|x| libm::fabs(x as f64));
         // |dF/dτ| ≤ |c1| + 2|c2| + 3|c3|, in the unit.
@@ -782,26 +790,46 @@ struct Lines {
     anchor_lo: i32,
     force_lo: i32,
     stiffness_lo: i32,
+    slope_lo: i32,
     stiffness_hi: i32,
 }
 
 /// Below the table: at the kink, the exact line `k ε` through zero, with `k` rounded
 /// down so that the line never passes above the first knot (the curve stays monotone;
-/// the step up at the knot is `(k − k_q) ε_lo` ≤ 2^-16 ε_lo N); otherwise the tangent at
-/// the domain edge, through the first knot (`first_q20`). Above the table, the line
-/// through the last knot: `k_p` when the table ends at the solid point, else the tangent
-/// there.
+/// the step up at the knot is `(k − k_q) ε_lo`: at most 2⁻²⁸ ε_lo N with the Q28 slope
+/// of [`RawTable::slope_lo`], 2⁻¹⁶ ε_lo N without); otherwise the tangent at the domain
+/// edge, through the first knot (`first_q20`). Above the table, the line through the
+/// last knot: `k_p` when the table ends at the solid point, else the tangent there.
 fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines, TableError> {
-    let (stiffness_lo, anchor_lo, force_lo) = if grid.at_kink {
-        let kq = libm::floor(law.k * (1u64 << STIFF_FRAC) as f64);
-        if kq > i32::MAX as f64 {
-            return Err(TableError::OutOfRange);
-        }
-        (kq as i32, 0, 0)
+    let (k, round): (f64, fn(f64) -> f64) = if grid.at_kink {
+        (law.k, libm::floor)
     } else {
-        let kq = checked_from_f64(1.0 / law.compliance(law.force(grid.lo)), STIFF_FRAC)
-            .ok_or(TableError::OutOfRange)?;
-        (kq, grid.strain_lo, first_q20)
+        (1.0 / law.compliance(law.force(grid.lo)), libm::round)
+    };
+    let kq = round(k * (1u64 << STIFF_FRAC) as f64);
+    if !(kq >= 0.0 && kq <= i32::MAX as f64) {
+        return Err(TableError::OutOfRange);
+    }
+    // Q28 where it fits (below 8 N per unit strain: `k · 2²⁸` < 2³¹); the stiffness is
+    // then the nearest Q16 value (the force's slope is the Q28 one, rounded as above),
+    // within one LSB of it.
+    let (stiffness_lo, slope_lo) = if fine_lower_line(kq as i32) {
+        let fine = round(k * (1u64 << 28) as f64) as i32;
+        let nearest = libm::round(k * (1u64 << STIFF_FRAC) as f64) as i32;
+        // (Not rounded up out of the fine range, where the slope would read as Q16.)
+        let stiffness = if fine_lower_line(nearest) {
+            nearest
+        } else {
+            kq as i32
+        };
+        (stiffness, fine)
+    } else {
+        (kq as i32, kq as i32)
+    };
+    let (anchor_lo, force_lo) = if grid.at_kink {
+        (0, 0)
+    } else {
+        (grid.strain_lo, first_q20)
     };
     let e_hi = grid.lo + grid.used as f64 * grid.step;
     let above = if grid.at_solid {
@@ -813,6 +841,7 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
         anchor_lo,
         force_lo,
         stiffness_lo,
+        slope_lo,
         stiffness_hi: checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
     })
 }

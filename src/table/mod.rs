@@ -28,7 +28,7 @@
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
 //! the law bends harder than the grid resolves, so that the curve stays monotone), as
 //! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
-//! per segment, 1080 bytes in all for 65 knots with the header) so that each Horner step is one product
+//! per segment, 1108 bytes in all for 65 knots with the header) so that each Horner step is one product
 //! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
 //! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
 //! the kink, the line through zero with `k` rounded down), so the curve is continuous and
@@ -104,8 +104,15 @@ pub struct RawTable<const S: usize> {
     pub anchor_lo: i32,
     /// See `anchor_lo`.
     pub force_lo: i32,
-    /// Slope of the line below `strain_lo` (Q16 N per unit strain).
+    /// Slope of the line below `strain_lo` (Q16 N per unit strain): its stiffness.
     pub stiffness_lo: i32,
+    /// The same slope for the line's force, finer where it fits: Q28 N per unit strain
+    /// when `stiffness_lo` is within ±2¹⁹ (below 8 N per unit strain,
+    /// [`fine_lower_line`]), the force then `force_lo + hi(slope_lo · (e ⊖ anchor_lo))`;
+    /// else Q16, equal to `stiffness_lo`. A Q16 slope alone is off by up to 2⁻¹⁶ N per
+    /// unit strain, which over the tension end of the domain is up to 8 force LSBs: more
+    /// than the product's bound for a spring below 0.4 N at `F(0.95)`.
+    pub slope_lo: i32,
     /// The line above `strain_hi` passes through (`strain_hi`, `force_hi`) (Q20 N).
     pub force_hi: i32,
     /// Slope of the line above `strain_hi` (Q16 N per unit strain).
@@ -145,7 +152,7 @@ pub struct RawTable<const S: usize> {
     /// Per segment `[C0, C1, C2, C3] = [c0, 2 c1, 4 c2, 8 c3]` of the cubic
     /// `F(τ) = c0 + c1 τ + c2 τ² + c3 τ³`, `τ ∈ [0, 1)`: the degree-`j` coefficient carries
     /// `2^j` so that each Horner step is one product by `τ/2` ([`crate::q::mul_t`]).
-    /// `c0` is the knot value and `C3 = 8 (c0' − c0) − 4 C1 − 2 C2` makes the cubic end
+    /// `c0` is the knot value (plus [`knot_bias`], for rounding) and `C3 = 8 (c0' − c0) − 4 C1 − 2 C2` makes the cubic end
     /// on the next knot `c0'` exactly.
     pub segments: [[i32; 4]; S],
 }
@@ -193,6 +200,7 @@ impl<const S: usize> ForceTable<S> {
             && (r.stiff_post as u32).is_power_of_two()
             && r.stiff_scale >= 0
             && r.stiffness_lo >= 0
+            && self.slope_fits()
             && r.stiffness_hi >= 0
             && r.corner_hi >= r.strain_hi
             && (r.corner_hi == r.strain_hi || self.corner_fits());
@@ -242,6 +250,17 @@ impl<const S: usize> ForceTable<S> {
                 Strain::from_bits(r.corner_hi),
             )
         })
+    }
+
+    /// Whether the line below's force slope is its stiffness: to within one Q16 LSB in
+    /// Q28 ([`fine_lower_line`]), else the same.
+    fn slope_fits(&self) -> bool {
+        let r = &self.raw;
+        if fine_lower_line(r.stiffness_lo) {
+            r.slope_lo >= 0 && ((r.slope_lo >> 12) - r.stiffness_lo).abs() <= 1
+        } else {
+            r.slope_lo == r.stiffness_lo
+        }
     }
 
     /// Whether the graded corner's coordinate stays in `[2²⁴, 2³²)` over its range and
@@ -315,7 +334,7 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
-            return Force::from_bits(line(r.force_lo, r.stiffness_lo, e, r.anchor_lo));
+            return Force::from_bits(line_below::<false, S>(r, e));
         }
         if e >= r.strain_hi {
             if e >= r.corner_hi {
@@ -336,7 +355,7 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         let f = if e <= r.strain_lo {
-            line_held(r.force_lo, r.stiffness_lo, e, r.anchor_lo)
+            line_below::<true, S>(r, e)
         } else if e >= r.strain_hi {
             self.above_within(e)
         } else {
@@ -355,7 +374,7 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
-            let f = line(r.force_lo, r.stiffness_lo, e, r.anchor_lo);
+            let f = line_below::<false, S>(r, e);
             return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_lo));
         }
         if e >= r.strain_hi {
@@ -490,17 +509,79 @@ pub(crate) fn cubic_value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32)
 /// saturating exactly.
 #[inline(always)]
 fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
+    f0.saturating_add(line_product(mul_wide(k, e.saturating_sub(e0))))
+}
+
+/// `p >> 20` for the product `p` of a Q16 slope and a Q24 strain difference, saturated
+/// to `i32` exactly.
+#[inline(always)]
+fn line_product(p: i64) -> i32 {
     const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
-    let p = mul_wide(k, e.saturating_sub(e0));
     let hi = (p >> 32) as i32;
-    let df = if (hi >> (SH - 1)) == (hi >> 31) {
+    if (hi >> (SH - 1)) == (hi >> 31) {
         (hi << (32 - SH)) | ((p as u32) >> SH) as i32
     } else if hi < 0 {
         i32::MIN
     } else {
         i32::MAX
+    }
+}
+
+/// What every knot carries above its rounded value in the coefficients' unit Q(20 +
+/// `shift`): half a Q20 LSB, `2^(shift − 1)` (none for `shift` 0), so that the
+/// evaluation's final `>> shift` rounds a knot, and the cubic between, to the nearest
+/// Q20 N instead of flooring it (the output's share of the error half an LSB, not one).
+/// A constant on every knot: the cubics' differences, and so their ends, are unchanged.
+#[inline(always)]
+pub const fn knot_bias(shift: u32) -> i32 {
+    if shift == 0 || shift > 12 {
+        0
+    } else {
+        1 << (shift - 1)
+    }
+}
+
+/// Whether the line below a table with this `stiffness_lo` carries its force's slope in
+/// Q28 ([`RawTable::slope_lo`]): within ±2¹⁹ (below 8 N per unit strain in Q16), where
+/// the Q28 slope fits an `i32`.
+#[inline(always)]
+pub const fn fine_lower_line(stiffness_lo: i32) -> bool {
+    stiffness_lo >= -(1 << 19) && stiffness_lo < 1 << 19
+}
+
+/// The line below the table in Q20 N at a Q24 strain `e`: `force_lo + hi(slope_lo · (e ⊖
+/// anchor_lo))` with a Q28 slope (a product's high word always fits), else [`line`]'s
+/// product of the Q16 slope, saturated exactly, or with `HELD` held as [`line_held`]'s
+/// (the same values within ±1024 N). On the M4F one product and a select of its bits; on
+/// the other cores a branch between the two products (their loops keep their registers
+/// so: the M3's N = 5 substep 300 instructions fewer, the M0's `force_and_stiffness` 2,
+/// measured by the bench).
+#[inline(always)]
+fn line_below<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
+    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
+    let q16 = |p: i64| {
+        if HELD {
+            shr_held::<SH, 31>(p)
+        } else {
+            line_product(p)
+        }
     };
-    f0.saturating_add(df)
+    // (The sum in each branch: so the M3's loop keeps its registers; a sum after the
+    // branch took its N = 5 substep from 7,970 to 8,256.)
+    let d = || e.saturating_sub(r.anchor_lo);
+    if cfg!(mccs_dsp) {
+        let p = mul_wide(r.slope_lo, d());
+        let df = if fine_lower_line(r.stiffness_lo) {
+            (p >> 32) as i32
+        } else {
+            q16(p)
+        };
+        r.force_lo.saturating_add(df)
+    } else if fine_lower_line(r.stiffness_lo) {
+        r.force_lo.saturating_add(mulhi(r.slope_lo, d()))
+    } else {
+        r.force_lo.saturating_add(q16(mul_wide(r.slope_lo, d())))
+    }
 }
 
 /// [`line`] for callers that clamp the result to well inside ±2048 N: the product is held

@@ -254,6 +254,7 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
         ("anchor_lo", r.anchor_lo as i64),
         ("force_lo", r.force_lo as i64),
         ("stiffness_lo", r.stiffness_lo as i64),
+        ("slope_lo", r.slope_lo as i64),
         ("force_hi", r.force_hi as i64),
         ("stiffness_hi", r.stiffness_hi as i64),
         ("shift", r.shift as i64),

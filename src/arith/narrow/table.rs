@@ -4,7 +4,7 @@
 use super::Narrow;
 use crate::arith::ArithTable;
 use crate::q;
-use crate::table::{cubic_value, segment_at, RawTable};
+use crate::table::{cubic_value, fine_lower_line, segment_at, RawTable};
 use crate::units::Strain;
 
 /// What [`table_force`] needs beyond the raw table, derived from it: the index scale and
@@ -28,8 +28,16 @@ impl NarrowTable {
         Self {
             scale: raw.index_scale >> k,
             scale_sh: 16u32.saturating_sub(k),
-            lo: NarrowLine::new(raw.stiffness_lo, raw.force_lo),
-            hi: NarrowLine::new(raw.stiffness_hi, raw.force_hi),
+            lo: NarrowLine::new(
+                raw.slope_lo,
+                if fine_lower_line(raw.stiffness_lo) {
+                    28
+                } else {
+                    16
+                },
+                raw.force_lo,
+            ),
+            hi: NarrowLine::new(raw.stiffness_hi, 16, raw.force_hi),
         }
     }
 }
@@ -47,12 +55,12 @@ struct NarrowLine {
 }
 
 impl NarrowLine {
-    /// From a Q16 slope and the line's anchor force (Q20 N).
-    const fn new(k: i32, f0: i32) -> Self {
+    /// From a slope in Q`frac` (16 or 28) and the line's anchor force (Q20 N).
+    const fn new(k: i32, frac: u32, f0: i32) -> Self {
         let mag = k.unsigned_abs();
         let kn = (32 - mag.leading_zeros()).saturating_sub(15);
-        // Q24 · Q(16 − kn) / 2^(20 − kn) = Q20.
-        let sh = 20 - kn;
+        // Q24 · Q(frac − kn) / 2^(frac + 4 − kn) = Q20.
+        let sh = frac + 4 - kn;
         let (sh1, sh2) = if sh > 16 { (16, sh - 16) } else { (sh, 0) };
         // Rounded: within 2⁻¹⁵ of k, and at most 2¹⁵ in magnitude.
         let k16 = if kn == 0 {

@@ -194,19 +194,22 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
     large.force_hi = raw.force_hi.saturating_mul(64);
     let mut steep = raw;
     steep.stiffness_lo = i32::MAX;
+    steep.slope_lo = i32::MAX;
     steep.stiffness_hi = i32::MAX;
     steep.force_lo = i32::MIN + 1;
     steep.force_hi = i32::MAX - 1;
     steep.strain_hi = raw.strain_lo + (raw.strain_hi - raw.strain_lo) / 8;
     steep.corner_hi = steep.strain_hi;
     // The lower line's slope at the two ends of the gentle loop's range (the M4F's
-    // assembly takes another product for a slope within ±2¹⁹): the largest within it,
-    // with the anchor past every strain (the product's largest magnitude), and the
-    // least beyond it.
+    // assembly takes another product, with a Q28 slope, for a stiffness within ±2¹⁹):
+    // the largest within it, with the largest Q28 slope and the anchor past every strain
+    // (the product's largest magnitude), and the least beyond it (a Q16 slope).
     large.stiffness_lo = -(1 << 19) - 1;
+    large.slope_lo = -(1 << 19) - 1;
     let mut anchored = raw;
     anchored.anchor_lo = i32::MAX;
     anchored.stiffness_lo = (1 << 19) - 1;
+    anchored.slope_lo = i32::MAX;
     let mut ends = raw;
     ends.strain_lo = i32::MIN;
     ends.strain_hi = i32::MIN + 1;
