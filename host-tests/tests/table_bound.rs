@@ -409,14 +409,15 @@ fn a_small_springs_line_below_holds_the_bound() {
     assert!(m.within(&allowed));
 }
 
-/// The knots' rounding bias (`mccs::table::knot_bias`): the table's output rounds to the
-/// nearest Q20 N instead of flooring. On a small spring (Table 2 scaled to 0.2 N at
-/// `F(0.95)`, its coefficients at the largest shift, 12), 100,000 strains over the
-/// tabulated range against the independent reference: the mean error is within a tenth
-/// of an LSB of zero (flooring puts it near −½) and the largest within 0.6 LSB (flooring:
-/// up to 1).
+/// The table's outputs round to the nearest LSB instead of flooring: the force through
+/// the knots' bias (`mccs::table::knot_bias`), the stiffness through a rounded product
+/// (`q::mulhi_round`). On a small spring (Table 2 scaled to 0.2 N at `F(0.95)`, its
+/// coefficients at the largest shift, 12), 100,000 strains over the tabulated range
+/// against the independent reference: each mean error is within a tenth of an LSB of
+/// zero (flooring puts it near −½) and the largest force error within 0.6 LSB
+/// (flooring: up to 1).
 #[test]
-fn the_table_rounds_to_the_nearest_force_lsb() {
+fn the_table_rounds_to_the_nearest_lsb() {
     let mut p = Params::TABLE2;
     let scale = 0.2 / Reference::new(&p).unwrap().force(DOMAIN.1);
     p.cone.shear_modulus *= scale;
@@ -427,19 +428,23 @@ fn the_table_rounds_to_the_nearest_force_lsb() {
     assert_eq!(t.raw().shift, 12);
     let (lo, hi) = (t.raw().strain_lo, t.raw().strain_hi);
     let n = 100_000;
-    let (mut sum, mut worst) = (0.0f64, 0.0f64);
+    let (mut sum, mut worst, mut sum_k) = (0.0f64, 0.0f64, 0.0f64);
     for i in 0..n {
         let bits = lo + ((hi - lo) as i64 * i / n) as i32;
         let e = Strain::from_bits(bits);
-        let err = (t.force(e).to_num::<f64>() - r.force(e.to_num::<f64>())) / FORCE_LSB;
+        let (f, k) = t.force_and_stiffness(e);
+        let err = (f.to_num::<f64>() - r.force(e.to_num::<f64>())) / FORCE_LSB;
         sum += err;
         worst = worst.max(err.abs());
+        sum_k += (k.to_num::<f64>() - r.stiffness(e.to_num::<f64>())) / STIFFNESS_LSB;
     }
-    let mean = sum / n as f64;
-    println!("ROUNDING case=small_spring mean_lsb={mean:.3} max_lsb={worst:.3}");
+    let (mean, mean_k) = (sum / n as f64, sum_k / n as f64);
+    println!(
+        "ROUNDING case=small_spring mean_lsb={mean:.3} max_lsb={worst:.3} stiffness_mean_lsb={mean_k:.3}"
+    );
     assert!(
-        mean.abs() < 0.1 && worst < 0.6,
-        "mean {mean}, max {worst} LSB"
+        mean.abs() < 0.1 && worst < 0.6 && mean_k.abs() < 0.1,
+        "force mean {mean}, max {worst} LSB; stiffness mean {mean_k} LSB"
     );
 }
 

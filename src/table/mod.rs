@@ -60,7 +60,7 @@
 //! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound.rs`:
 //! `docs/accuracy.md`.
 
-use crate::q::{mul_t, mul_wide, mulhi, mulhi_u, shr_held};
+use crate::q::{mul_t, mul_wide, mulhi, mulhi_round, mulhi_u, shr_held};
 use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
 mod bound;
@@ -119,8 +119,8 @@ pub struct RawTable<const S: usize> {
     pub stiffness_hi: i32,
     /// The coefficients' unit: Q(20 + `shift`) N, `shift` ∈ 0 … 12.
     pub shift: u32,
-    /// The stiffness in Q16 is `⌊D · stiff_scale / 2³²⌋ · stiff_post` for `D = 2 dF/dτ` in
-    /// the coefficients' unit (`stiff_post` a power of two).
+    /// The stiffness in Q16 is `⌊(D · stiff_scale + 2³¹) / 2³²⌋ · stiff_post` (rounded)
+    /// for `D = 2 dF/dτ` in the coefficients' unit (`stiff_post` a power of two).
     pub stiff_scale: i32,
     /// See `stiff_scale`.
     pub stiff_post: i32,
@@ -386,7 +386,9 @@ impl<const S: usize> ForceTable<S> {
         }
         let (c, t) = self.segment(e);
         let f = cubic_value(r, c, t);
-        let k = mulhi(slope(c, t), r.stiff_scale).wrapping_mul(r.stiff_post);
+        // Rounded to the nearest Q16 value (one `smmulr` on the M4F; an instruction more
+        // on the M3, three on the M0): half an LSB where a small spring's bound needs it.
+        let k = mulhi_round(slope(c, t), r.stiff_scale).wrapping_mul(r.stiff_post);
         (Force::from_bits(f), Stiffness::from_bits(k))
     }
 
@@ -419,7 +421,9 @@ impl<const S: usize> ForceTable<S> {
         let (c, t, z) = self.corner_segment(e);
         let f = cubic_value(r, c, t);
         // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 7 on a
-        // valid table; the shift wraps at 32 on any other, without a panic).
+        // valid table; the shift wraps at 32 on any other, without a panic). Floored, not
+        // rounded as the uniform part's: a graded corner's stiffness (a stiff series
+        // spring's) is thousands of LSBs, and rounding costs the M0 nine instructions.
         let k = mulhi(slope(c, t).wrapping_shl(z), r.corner_scale);
         (
             Force::from_bits(f),
