@@ -53,7 +53,7 @@
 //!        | −hDA       I − hDB     |
 //! ```
 //!
-//! The estimate runs this step instead ([`Linearised::growth`]), bisected up to 16 times
+//! The estimate runs this step instead (`Linearised::growth`), bisected up to 16 times
 //! the closed form. The closed form, and so [`Bound::Conservative`] and the fallback, is
 //! the paper's, and stays on the safe side per mode: for one mode (`ω²`, damping rate
 //! `β ≤ γ`) the step is stable while `h D β < 2` (always: `h D β < 1`) and

@@ -31,7 +31,8 @@
 //! per segment, 1108 bytes in all for 65 knots with the header) so that each Horner step is one product
 //! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
 //! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
-//! the kink, the line through zero with `k` rounded down), so the curve is continuous and
+//! the kink, the line through zero with `k` rounded down, in Q28 where it fits:
+//! [`RawTable::slope_lo`]), so the curve is continuous and
 //! monotone.
 //!
 //! # Formats and ranges
@@ -40,7 +41,11 @@
 //! - stiffness: [`Stiffness`] = `I16F16` in N per unit strain, range ±32768, resolution 1.5e-5;
 //! - position in a segment `τ`: Q15;
 //! - coefficients: Q(20 + `shift`) N, the shift (0 … 12) chosen per table so that the
-//!   knots use most of an `i32` and no Horner step can overflow.
+//!   knots use most of an `i32` and no Horner step can overflow; every knot carries half
+//!   a Q20 LSB ([`knot_bias`]), so the force rounds to the nearest Q20 N;
+//! - the line below's slope for its force: Q28 below 8 N per unit strain, else Q16
+//!   ([`RawTable::slope_lo`]); the stiffness rounds to the nearest Q16 value (outside
+//!   the graded corner, which floors).
 //!
 //! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`).
 //!
@@ -104,7 +109,8 @@ pub struct RawTable<const S: usize> {
     pub anchor_lo: i32,
     /// See `anchor_lo`.
     pub force_lo: i32,
-    /// Slope of the line below `strain_lo` (Q16 N per unit strain): its stiffness.
+    /// Slope of the line below `strain_lo` (Q16 N per unit strain): its stiffness (the
+    /// nearest Q16 value where `slope_lo` is Q28).
     pub stiffness_lo: i32,
     /// The same slope for the line's force, finer where it fits: Q28 N per unit strain
     /// when `stiffness_lo` is within ±2¹⁹ (below 8 N per unit strain,
@@ -152,8 +158,8 @@ pub struct RawTable<const S: usize> {
     /// Per segment `[C0, C1, C2, C3] = [c0, 2 c1, 4 c2, 8 c3]` of the cubic
     /// `F(τ) = c0 + c1 τ + c2 τ² + c3 τ³`, `τ ∈ [0, 1)`: the degree-`j` coefficient carries
     /// `2^j` so that each Horner step is one product by `τ/2` ([`crate::q::mul_t`]).
-    /// `c0` is the knot value (plus [`knot_bias`], for rounding) and `C3 = 8 (c0' − c0) − 4 C1 − 2 C2` makes the cubic end
-    /// on the next knot `c0'` exactly.
+    /// `c0` is the knot value (plus [`knot_bias`], for rounding) and `C3 = 8 (c0' − c0) −
+    /// 4 C1 − 2 C2` makes the cubic end on the next knot `c0'` exactly.
     pub segments: [[i32; 4]; S],
 }
 
