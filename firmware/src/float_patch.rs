@@ -180,11 +180,7 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         }
         let h = 1.0 / (cfg.tick_hz * substeps as f64);
         // The line below's slope as its force uses it (`RawTable::slope_lo`).
-        let k_lo = if mccs::table::fine_lower_line(raw.stiffness_lo) {
-            to_f64(raw.slope_lo, 28)
-        } else {
-            to_f64(raw.slope_lo, STIFF_FRAC)
-        };
+        let k_lo = to_f64(raw.slope_lo, raw.slope_lo_frac());
         Self {
             springs,
             n_springs: topo.edges().len(),

@@ -5,7 +5,8 @@
 
 use super::{
     corner_strain, fine_lower_line, knot_bias, measure, ForceTable, RawTable, TableBound,
-    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, UNMEASURED,
+    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN,
+    FINE_SLOPE_FRAC, UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -814,7 +815,7 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
     // then the nearest Q16 value (the force's slope is the Q28 one, rounded as above),
     // within one LSB of it.
     let (stiffness_lo, slope_lo) = if fine_lower_line(kq as i32) {
-        let fine = round(k * (1u64 << 28) as f64) as i32;
+        let fine = round(libm::ldexp(k, FINE_SLOPE_FRAC as i32)) as i32;
         let nearest = libm::round(k * (1u64 << STIFF_FRAC) as f64) as i32;
         // (Not rounded up out of the fine range, where the slope would read as Q16.)
         let stiffness = if fine_lower_line(nearest) {

@@ -263,7 +263,8 @@ impl<const S: usize> ForceTable<S> {
     fn slope_fits(&self) -> bool {
         let r = &self.raw;
         if fine_lower_line(r.stiffness_lo) {
-            r.slope_lo >= 0 && ((r.slope_lo >> 12) - r.stiffness_lo).abs() <= 1
+            let q16 = r.slope_lo >> (FINE_SLOPE_FRAC - STIFF_FRAC);
+            r.slope_lo >= 0 && (q16 - r.stiffness_lo).abs() <= 1
         } else {
             r.slope_lo == r.stiffness_lo
         }
@@ -548,6 +549,21 @@ pub const fn knot_bias(shift: u32) -> i32 {
         0
     } else {
         1 << (shift - 1)
+    }
+}
+
+/// Fraction bits of the line below's force slope where it is fine ([`fine_lower_line`]).
+pub const FINE_SLOPE_FRAC: u32 = 28;
+
+impl<const S: usize> RawTable<S> {
+    /// Fraction bits of [`RawTable::slope_lo`]: [`FINE_SLOPE_FRAC`] where
+    /// [`fine_lower_line`], else `STIFF_FRAC` (16).
+    pub const fn slope_lo_frac(&self) -> u32 {
+        if fine_lower_line(self.stiffness_lo) {
+            FINE_SLOPE_FRAC
+        } else {
+            STIFF_FRAC
+        }
     }
 }
 

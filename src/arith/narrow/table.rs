@@ -4,8 +4,8 @@
 use super::Narrow;
 use crate::arith::ArithTable;
 use crate::q;
-use crate::table::{cubic_value, fine_lower_line, segment_at, RawTable};
-use crate::units::Strain;
+use crate::table::{cubic_value, segment_at, RawTable};
+use crate::units::{Strain, STIFF_FRAC};
 
 /// What [`table_force`] needs beyond the raw table, derived from it: the index scale and
 /// the straight lines' slopes as 16-bit operands.
@@ -28,16 +28,8 @@ impl NarrowTable {
         Self {
             scale: raw.index_scale >> k,
             scale_sh: 16u32.saturating_sub(k),
-            lo: NarrowLine::new(
-                raw.slope_lo,
-                if fine_lower_line(raw.stiffness_lo) {
-                    28
-                } else {
-                    16
-                },
-                raw.force_lo,
-            ),
-            hi: NarrowLine::new(raw.stiffness_hi, 16, raw.force_hi),
+            lo: NarrowLine::new(raw.slope_lo, raw.slope_lo_frac(), raw.force_lo),
+            hi: NarrowLine::new(raw.stiffness_hi, STIFF_FRAC, raw.force_hi),
         }
     }
 }
