@@ -479,28 +479,36 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         .replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e4")
         .replace("shear_modulus = 4.9151e5", "shear_modulus = 1.386e7");
     assert_ne!(stiff_series, TABLE2);
-    let f = temp_file("stiff-series.toml", &stiff_series);
-    let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "129"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let src = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        src.lines()
-            .nth(1)
-            .unwrap()
-            .ends_with("within the product's bound (force 2e-5, stiffness 1e-3).")
-            && src
-                .lines()
-                .nth(3)
-                .unwrap()
-                .contains("then 32 graded toward the solid point"),
-        "{src}"
-    );
-    // Table 2 with its preload at 15 F_T, its slope kink Δ(P) just below the solid point:
-    // two corners closer than the grid resolves.
+    // A near-cylindrical cone against a soft series spring preloaded to 0.9 F_C (a random
+    // spring of `table_bound.rs`): the graded corner takes the smooth part above the
+    // preload's kink, up to the domain's end (the solid point lies far past it).
+    let near_solid = "[cone]\nwire_diameter = 0.0630138115362447\nsmall_diameter = 0.3519773312502775\nlarge_diameter = 0.4222780483510128\nactive_coils = 1.6042596549155683\ncompressible_height = 0.35952497526300037\nshear_modulus = 248660.54999980563\n\n[linear]\nwire_diameter = 0.19740203691142258\nmean_diameter = 0.1616103995851277\nactive_coils = 7.837305368448284\nshear_modulus = 10.711463844770453\npreload = 2.2667975385647203\n";
+    for (name, params, toward) in [
+        (
+            "stiff-series.toml",
+            stiff_series.as_str(),
+            "the solid point",
+        ),
+        ("near-solid.toml", near_solid, "the domain's end"),
+    ] {
+        let f = temp_file(name, params);
+        let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "129"]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let src = String::from_utf8(out.stdout).unwrap();
+        let lines: Vec<&str> = src.lines().collect();
+        assert!(
+            lines[1].ends_with("within the product's bound (force 2e-5, stiffness 1e-3).")
+                && lines[3].contains(&format!("then 32 graded toward {toward}")),
+            "{name}: {src}"
+        );
+    }
+    // Table 2 with its preload at 15 F_T (0.79 F_C), its slope kink Δ(P) on the cone's
+    // steep rise toward its own solid point, far above Δ(F_T): no placement the builder
+    // knows meets the bound (docs/accuracy.md, "The grid below a preload's kink").
     let kinked = TABLE2.replace(
         "shear_modulus = 4.9151e5",
         "shear_modulus = 4.9151e5\npreload = 8.1175",

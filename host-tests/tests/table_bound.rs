@@ -207,6 +207,10 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         d.springs += 1;
         match ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound) {
             Ok(t) => {
+                // Whatever placement it took (a graded corner toward the solid point, or
+                // above a preload's kink toward the domain's end), it keeps the
+                // invariants the evaluation relies on.
+                assert_eq!(t.validate(), Ok(()), "{p:?}");
                 let m = independent(&p, &t);
                 // The two measurements sample different strains: they agree to 2 % of the
                 // bound and two LSBs of the output formats (one Q20 force LSB is 1e-5 of
@@ -504,6 +508,13 @@ fn named_springs_report_their_bound() {
         ("stiff_series_280", with_ratio(280.0)),
         ("stiff_series_2100", with_ratio(2100.0)),
         ("stiff_series_2000_soft_cone", soft_cone),
+        // Its kink Δ(P) on the cone's steep rise toward its own solid point, far above
+        // Δ(F_T): refused (docs/accuracy.md, "The grid below a preload's kink").
+        ("table2_preload_15", {
+            let mut p = t2;
+            p.linear.preload = Some(15.0 * Reference::new(&t2).unwrap().f_t);
+            p
+        }),
     ];
     for (name, p) in cases {
         assert!(p.validate().is_ok(), "{name}");
@@ -548,4 +559,133 @@ fn named_springs_report_their_bound() {
     // The committed table carries the same figures.
     static COMMITTED: ForceTable<64> = include!("../../tables/table2.rs");
     assert_eq!(COMMITTED.max_error(), table2.max_error());
+}
+
+/// A preload near `F_C` puts the law's slope kink `Δ(P)` where the cone rises steeply
+/// toward its own solid point (`F_C − F` like the root of the strain left to it), more
+/// steeply than a grid uniform up to the domain's end follows below the kink. The
+/// builder's last placement (`from_law_best`) gives the part above the kink, smooth, to
+/// a graded corner — ending at the solid point, or at the domain's end when the solid
+/// point lies well past it (a soft series spring) — so that the uniform grid's segments
+/// all go below a little past `Δ(P)`, with a knot on it. Three of the random springs of
+/// `every_table_meets_the_bound_or_is_refused_with_what_it_reached` (near-cylindrical
+/// cones: a short nonlinear phase below the kink) that were refused before: each now
+/// meets the bound, as the independent reference confirms, where the uniform grid
+/// alone (a device's table) does not.
+#[test]
+fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
+    let spring = |cone: [f64; 6], linear: [f64; 5]| Params {
+        cone: Cone {
+            wire_diameter: cone[0],
+            small_diameter: cone[1],
+            large_diameter: cone[2],
+            active_coils: cone[3],
+            compressible_height: cone[4],
+            shear_modulus: cone[5],
+        },
+        linear: Linear {
+            wire_diameter: linear[0],
+            mean_diameter: linear[1],
+            active_coils: linear[2],
+            shear_modulus: linear[3],
+            preload: Some(linear[4]),
+        },
+    };
+    // (name, spring, whether the corner ends at the domain's end, not the solid point.)
+    let cases = [
+        (
+            "kp1.2e-2_p0.9",
+            spring(
+                [
+                    0.0630138115362447,
+                    0.3519773312502775,
+                    0.4222780483510128,
+                    1.6042596549155683,
+                    0.35952497526300037,
+                    248660.54999980563,
+                ],
+                [
+                    0.19740203691142258,
+                    0.1616103995851277,
+                    7.837305368448284,
+                    10.711463844770453,
+                    2.2667975385647203,
+                ],
+            ),
+            true,
+        ),
+        (
+            "kp1.4e-3_p0.9",
+            spring(
+                [
+                    0.1838776985746176,
+                    0.22706386652202876,
+                    0.26706145378700147,
+                    15.08938917069261,
+                    0.42221479934327283,
+                    97162.57591227545,
+                ],
+                [
+                    0.061224666897616166,
+                    0.21362718032061612,
+                    3.3576956365614,
+                    1555.316249738117,
+                    29.866579401646245,
+                ],
+            ),
+            true,
+        ),
+        (
+            "kp2.4e-1_p0.82",
+            spring(
+                [
+                    0.16375711479469612,
+                    0.4796241629561431,
+                    0.7287588447786918,
+                    4.429151145745717,
+                    0.4099699974388194,
+                    65474.66460593195,
+                ],
+                [
+                    0.09011204367489943,
+                    0.15996730778861756,
+                    11.289350616745509,
+                    7658.25927501643,
+                    4.046141431912744,
+                ],
+            ),
+            false,
+        ),
+    ];
+    for (name, p, domain_end) in cases {
+        let r = Reference::new(&p).unwrap();
+        let s = r.series.unwrap();
+        let e_p = r.delta(s.preload);
+        assert!(s.preload > 0.8 * r.f_c && e_p < DOMAIN.1, "{name}");
+        // A device's table (the uniform grid alone) misses the bound.
+        let law = mccs::Law::new(&p).unwrap();
+        let plain = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1).unwrap();
+        let before = independent(&p, &plain);
+        assert!(!before.within(&TableBound::PRODUCT), "{name}: {before:?}");
+        let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(t.validate(), Ok(()));
+        let (a, b) = t.corner().expect("a graded corner above the kink");
+        let (a, b) = (a.to_num::<f64>(), b.to_num::<f64>());
+        assert!(
+            a > e_p && a - e_p < 0.4 * (b - e_p),
+            "{name}: [{a}, {b}) over Δ(P) {e_p}"
+        );
+        let end = if domain_end { DOMAIN.1 } else { r.strain_c() };
+        assert!(
+            (b - end).abs() < 1e-6,
+            "{name}: the corner ends at {b}, not {end}"
+        );
+        let m = independent(&p, &t);
+        println!(
+            "ABOVEKINK case={name} force_before={:.1e} stiffness_before={:.1e} force={:.1e} stiffness={:.1e}",
+            before.force, before.stiffness, m.force, m.stiffness
+        );
+        assert!(m.within(&TableBound::PRODUCT), "{name}: {m:?}");
+    }
 }

@@ -63,7 +63,7 @@ fn every_knot_count_renders_and_round_trips() {
     }
     // A table emitted to a file for another domain matches the runtime build too.
     let t = ForceTable::<32>::with_domain(&Params::TABLE2, -0.2, 1.5).unwrap();
-    let text = mccs_host::cli::render_table("", &t);
+    let text = mccs_host::cli::render_table("", &t, None);
     let last = t.raw().segments[31];
     assert!(text.contains(&format!(
         "[{}, {}, {}, {}],\n    ],",

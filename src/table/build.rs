@@ -89,21 +89,15 @@ impl<const S: usize> ForceTable<S> {
             // The placement from the domain's start is its own instance of the builder,
             // so that a device's (`from_law`, which never takes it) carries no code for it.
             let built = if align == Align::FromDomain {
-                Self::on_grid::<true, false>(law, from, to, align, 0.0)
+                Self::on_grid::<true, false>(law, from, to, align, 0.0, CornerEnd::Solid)
             } else {
-                Self::on_grid::<false, false>(law, from, to, align, 0.0)
+                Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid)
             };
             match built {
                 Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
                 Ok(t) => {
                     tried[n] = Some(grid_of(&t.raw));
-                    let t = t.measured(law, from, to);
-                    let e = t
-                        .max_error()
-                        .map_or(f64::INFINITY, |e| e.ratio_to(&TableBound::PRODUCT));
-                    if best.as_ref().is_none_or(|(b, _)| e < *b) {
-                        best = Some((e, t));
-                    }
+                    Self::keep_best(t, law, (from, to), &mut best);
                 }
                 Err(e) => {
                     first_err.get_or_insert(e);
@@ -124,22 +118,40 @@ impl<const S: usize> ForceTable<S> {
                 for fraction in CORNER_FRACTIONS {
                     let len = fraction * curved;
                     let built = if align == Align::FromDomain {
-                        Self::on_grid::<true, true>(law, from, to, align, len)
+                        Self::on_grid::<true, true>(law, from, to, align, len, CornerEnd::Solid)
                     } else {
-                        Self::on_grid::<false, true>(law, from, to, align, len)
+                        Self::on_grid::<false, true>(law, from, to, align, len, CornerEnd::Solid)
                     };
+                    // The first within the bound is kept (each try is a build and a
+                    // measurement).
                     if let Ok(t) = built {
-                        let t = t.measured(law, from, to);
-                        let e = t
-                            .max_error()
-                            .map_or(f64::INFINITY, |e| e.ratio_to(&TableBound::PRODUCT));
-                        if best.as_ref().is_none_or(|(b, _)| e < *b) {
-                            best = Some((e, t));
-                        }
-                        // The first within the bound is kept (each try is a build and a
-                        // measurement).
-                        if e <= 1.0 {
+                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                             break 'graded;
+                        }
+                    }
+                }
+            }
+        }
+        // Still missed, with a preload's slope kink Δ(P) inside the domain: a preload near
+        // F_C, below which the cone rises steeply toward its own solid point, which the
+        // corner above does not reach (its octaves grade toward Δ(F_C), past Δ(P)). The
+        // graded corner then takes the part above Δ(P), smooth up to the solid point (or
+        // the domain's end, when that comes first), and the uniform grid's segments all go
+        // below a little past Δ(P), with a knot on it.
+        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        let e_p = law.delta(law.preload);
+        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
+            let (end, e_end) = if e_c <= to + 0.5 * (to - lo) {
+                (CornerEnd::Solid, e_c)
+            } else {
+                (CornerEnd::DomainEnd, to)
+            };
+            'above_kink: for align in [Align::Shortest, Align::Off] {
+                for margin in ABOVE_KINK_MARGINS {
+                    let len = (e_end - e_p) * (1.0 - margin);
+                    if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
+                            break 'above_kink;
                         }
                     }
                 }
@@ -152,6 +164,19 @@ impl<const S: usize> ForceTable<S> {
         }
     }
 
+    /// Measures `t` over `domain` and keeps it in `best` if it is the least far from the
+    /// product's bound so far; returns its error relative to that bound (≤ 1 within it).
+    fn keep_best(t: Self, law: &Law, domain: (f64, f64), best: &mut Option<(f64, Self)>) -> f64 {
+        let t = t.measured(law, domain.0, domain.1);
+        let e = t
+            .max_error()
+            .map_or(f64::INFINITY, |e| e.ratio_to(&TableBound::PRODUCT));
+        if best.as_ref().is_none_or(|(b, _)| e < *b) {
+            *best = Some((e, t));
+        }
+        e
+    }
+
     /// Builds the table for an already derived law (not measured: see
     /// [`ForceTable::measured`]; [`ForceTable::from_law_best`] tries every placement).
     #[inline(never)]
@@ -162,7 +187,7 @@ impl<const S: usize> ForceTable<S> {
         // the solid point, then the grid on Δ(P) alone.
         let mut built = Err(TableError::OutOfRange);
         for align in [Align::Shortest, Align::NearSolid, Align::Off] {
-            built = Self::on_grid::<false, false>(law, from, to, align, 0.0);
+            built = Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid);
             if !matches!(built, Err(TableError::OutOfRange)) {
                 break;
             }
@@ -182,12 +207,13 @@ impl<const S: usize> ForceTable<S> {
         to: f64,
         align: Align,
         corner_len: f64,
+        corner_end: CornerEnd,
     ) -> Result<Self, TableError> {
         let corner = if CORNER {
             if S < 2 * CORNER_SEGMENTS {
                 return Err(TableError::TooNarrow);
             }
-            Some(Corner::place(law, to, corner_len)?)
+            Some(Corner::place(law, to, corner_len, corner_end)?)
         } else {
             None
         };
@@ -246,34 +272,60 @@ impl<const S: usize> ForceTable<S> {
             raw.corner_scale = scale;
             raw.corner_post = post;
             raw.force_hi = last >> shift;
-            raw.stiffness_hi =
-                checked_from_f64(law.k_p, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
+            // Past the solid point the law's own k_p line; past the domain's end the
+            // law's tangent at the last knot, as a grid that ends there has.
+            let above = match corner_end {
+                CornerEnd::Solid => law.k_p,
+                CornerEnd::DomainEnd => {
+                    1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0)))
+                }
+            };
+            raw.stiffness_hi = checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
         }
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
     }
 }
 
-/// A graded corner: [`CORNER_SEGMENTS`] segments toward the solid point `Δ(F_C)`, each
-/// octave of distance from it ([`CORNER_OCTAVES`] of them, the nearest `len/256` wide)
-/// cut into [`CORNER_PER_OCTAVE`]: segments about a tenth of their distance from the
-/// corner, where a soft cone against a stiff series spring rises like a square root.
+/// A graded corner: [`CORNER_SEGMENTS`] segments toward its end ([`CornerEnd`]: the
+/// solid point `Δ(F_C)`, or the domain's end), each octave of distance from it
+/// ([`CORNER_OCTAVES`] of them, the nearest `len/256` wide) cut into
+/// [`CORNER_PER_OCTAVE`]: segments about a tenth of their distance from the corner, where
+/// a soft cone against a stiff series spring rises like a square root.
 #[derive(Clone, Copy)]
 struct Corner {
-    /// The anchor `A` (Q24): `Δ(F_C)` plus the nearest octave's inner end.
+    /// The anchor `A` (Q24): the end plus the nearest octave's inner end.
     anchor: i32,
     pre: u32,
-    /// One past the last strain of the corner (Q24): the last knot is `Δ(F_C)`.
+    /// One past the last strain of the corner (Q24): the last knot is its end.
     hi: i32,
     /// Where the uniform grid ends (a little past the corner's start), strain.
     start: f64,
+    /// Whether the last knot is the solid point (its force `F_C` exactly).
+    solid: bool,
+}
+
+/// Where a graded corner ends: its last knot, where the line above starts.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum CornerEnd {
+    /// At the solid point `Δ(F_C)`: past it the law's own `k_p` line, exact.
+    Solid,
+    /// At the domain's end, the solid point lying past it: the corner then covers the
+    /// smooth part above a preload's kink `Δ(P)` near `F_C`, so that the uniform grid's
+    /// knots go below that kink, where the cone rises steeply toward its own solid
+    /// point. Past the domain's end the line above is the law's tangent there (as on a
+    /// grid that ends there).
+    DomainEnd,
 }
 
 impl Corner {
-    /// The corner of `len` strain ending at the solid point; it must start inside the
-    /// domain (which may end before the solid point).
-    fn place(law: &Law, to: f64, len: f64) -> Result<Self, TableError> {
-        let e_c = law.strain_c();
+    /// The corner of `len` strain ending at `end`; it must start inside the domain (which
+    /// may end before the solid point).
+    fn place(law: &Law, to: f64, len: f64, end: CornerEnd) -> Result<Self, TableError> {
+        let e_end = match end {
+            CornerEnd::Solid => law.strain_c(),
+            CornerEnd::DomainEnd => to,
+        };
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
         // The nearest octave's inner end at least a strain LSB from the anchor.
@@ -282,7 +334,7 @@ impl Corner {
         }
         let inner = libm::ldexp(1.0, 24) / pre;
         let anchor =
-            checked_from_f64(e_c + inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+            checked_from_f64(e_end + inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         // The last strain e with (A − e) · pre ≥ 2²⁴, plus one.
         let hi = libm::floor(anchor as f64 - inner) + 1.0;
         let start = (anchor as f64 - libm::ldexp(1.0, 32) / pre + 2.0) / unit;
@@ -295,6 +347,7 @@ impl Corner {
             pre: pre as u32,
             hi: hi as i32,
             start,
+            solid: end == CornerEnd::Solid,
         })
     }
 
@@ -304,9 +357,10 @@ impl Corner {
     }
 
     /// The force and stiffness at `(z, jj)`, in Q20 N and N per unit strain: at the
-    /// solid point (the last knot) the law's own `F_C` and slope from below.
+    /// solid point (the last knot of a corner ending there) the law's own `F_C` and
+    /// slope from below.
     fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
-        let f = if z == CORNER_OCTAVES - 1 && jj == 0 {
+        let f = if self.solid && z == CORNER_OCTAVES - 1 && jj == 0 {
             law.f_c
         } else {
             law.force(self.strain(z, jj))
@@ -407,6 +461,10 @@ fn with_post(mut v: f64) -> Result<(i32, i32), TableError> {
 /// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
 /// law's curved part.
 const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
+
+/// Where the graded corner above a preload's kink starts, as fractions of the way from
+/// `Δ(P)` to its end ([`ForceTable::from_law_best`]): the uniform grid ends there.
+const ABOVE_KINK_MARGINS: [f64; 5] = [0.02, 0.05, 0.1, 0.2, 0.35];
 
 /// Whether and how a grid with a preload's kink inside it is aligned on both `Δ(F_T)`
 /// and `Δ(P)` ([`Grid::place`]).

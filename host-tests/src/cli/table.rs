@@ -78,7 +78,12 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         } else {
             format!("OVER the product's bound ({promise}): emitted with --accept-error")
         };
-        render_table(&format!("{header}// Accuracy, {figures}: {verdict}.\n"), &t)
+        let solid = mccs::Law::new(&p).ok().map(|l| l.strain_c());
+        render_table(
+            &format!("{header}// Accuracy, {figures}: {verdict}.\n"),
+            &t,
+            solid,
+        )
     });
     match a.out {
         Some(path) => std::fs::write(&path, src)
@@ -226,18 +231,31 @@ fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable
     })
 }
 
-/// Renders a table as a Rust expression for `include!`, preceded by `header`.
-pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>) -> String {
+/// Renders a table as a Rust expression for `include!`, preceded by `header`; `solid`,
+/// the law's solid point `Δ(F_C)` if known, names where a graded corner ends (the solid
+/// point, or the domain's end).
+pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>, solid: Option<f64>) -> String {
     let r = t.raw();
     let mut s = String::from(header);
     s.push_str("// Formats: strains Q24, forces Q20 N, stiffnesses Q16 N per unit strain.\n");
     let (lo, hi) = t.tabulated_range();
     match t.corner() {
-        Some((a, b)) => s.push_str(&format!(
-            "// Layout: {} segments uniform over [{lo}, {a}), then {} graded toward the solid point over [{a}, {b}).\n",
-            t.segments_used(),
-            mccs::table::CORNER_SEGMENTS
-        )),
+        Some((a, b)) => {
+            // The corner's exclusive end is within a few strain LSBs of its last knot.
+            let end = b.to_num::<f64>();
+            let toward = match solid {
+                Some(e_c) if (end - e_c).abs() <= 4.0 * mccs::Strain::DELTA.to_num::<f64>() => {
+                    "the solid point"
+                }
+                Some(_) => "the domain's end",
+                None => "their end",
+            };
+            s.push_str(&format!(
+                "// Layout: {} segments uniform over [{lo}, {a}), then {} graded toward {toward} over [{a}, {b}).\n",
+                t.segments_used(),
+                mccs::table::CORNER_SEGMENTS
+            ))
+        }
         None => s.push_str(&format!(
             "// Layout: {} segments uniform over [{lo}, {hi}).\n",
             t.segments_used()
