@@ -68,8 +68,11 @@ impl<const S: usize> ForceTable<S> {
     /// lengthens the step, and the grid may then end past `Δ(F_C)` with the solid
     /// point's corner inside its last segment; a grid from the domain's start spends
     /// segments on the straight line, but a small spring's line slope in Q16 can cost
-    /// more than that. Up to five builds and measurements: what `mccs table` and
-    /// [`ForceTable::with_bound`] do, not for a device's start-up.
+    /// more than that. Where none meets the bound, a graded corner (the module docs):
+    /// toward the solid point under each placement (up to 24 more), then above a
+    /// preload's kink near `F_C` (up to 10 more), the first within the bound kept. Up to
+    /// 39 builds and measurements (5 for a spring the uniform grid serves): what
+    /// `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
