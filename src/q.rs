@@ -15,6 +15,51 @@ pub type V3 = [i32; 3];
 pub const HAS_LONG_MULTIPLY: bool =
     cfg!(not(all(target_arch = "arm", not(target_has_atomic = "32"))));
 
+/// Whether this target has a count-leading-zeros instruction (`clz`): the same targets
+/// as [`HAS_LONG_MULTIPLY`] (ARMv6-M has neither).
+pub const HAS_CLZ: bool = HAS_LONG_MULTIPLY;
+
+/// `d.leading_zeros()`: one `clz` where the core has one ([`HAS_CLZ`]); else
+/// [`leading_zeros_split`], a byte table, instead of the library's binary search (about
+/// 30 instructions and a call on the M0). The same value for every `d`.
+#[inline(always)]
+pub fn leading_zeros(d: u32) -> u32 {
+    if HAS_CLZ {
+        d.leading_zeros()
+    } else {
+        leading_zeros_split(d)
+    }
+}
+
+/// The leading zeros of each byte value (8 − its bit length; 8 for 0).
+static BYTE_LEADING_ZEROS: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).leading_zeros() as u8;
+        i += 1;
+    }
+    t
+};
+
+/// [`leading_zeros`] from a table of the leading zeros of each byte: one load for
+/// `d ≥ 2²⁴` (every coordinate of a valid table's graded corner: a compare, a branch, a
+/// shift and the load), a compare more for each lower byte. Always compiled: the host
+/// tests hold it to `u32::leading_zeros` (`host-tests/tests/arith.rs`).
+#[inline(always)]
+pub fn leading_zeros_split(d: u32) -> u32 {
+    let (shift, above) = if d >= 1 << 24 {
+        (24, 0)
+    } else if d >= 1 << 16 {
+        (16, 8)
+    } else if d >= 1 << 8 {
+        (8, 16)
+    } else {
+        (0, 24)
+    };
+    above + BYTE_LEADING_ZEROS[(d >> shift) as usize & 0xFF] as u32
+}
+
 /// The long-multiply form of a product, or its 16-bit-piece form without a long multiply
 /// ([`HAS_LONG_MULTIPLY`]; a constant, so only one form is compiled into the caller).
 macro_rules! long_or_split {
@@ -289,19 +334,20 @@ pub(crate) fn rsqrt(x: i64) -> (u32, u32) {
 
 /// `x > 0` normalised by an even shift `e`: `m = x 2^e ∈ [2^62, 2^64)`, so that
 /// `M = m / 2^64 ∈ [¼, 1)`, returned in Q30 (`m30 ∈ [2^28, 2^30)`) with `e`. By 32-bit
-/// halves: the Cortex-M0 has no `clz` (each is a library call) and no 64-bit shift (one
-/// more), so that a 64-bit `leading_zeros` took two calls and the shift a third. The
-/// same bits as `((x << e) >> 34, leading_zeros(x) & !1)` (tested).
+/// halves: the Cortex-M0 has no `clz` ([`leading_zeros`]: a byte table there) and no
+/// 64-bit shift (a library call), so that a 64-bit `leading_zeros` took two library
+/// calls and the shift a third. The same bits as `((x << e) >> 34, leading_zeros(x) &
+/// !1)` (tested).
 #[inline(always)]
 pub(crate) fn normalise(x: u64) -> (u32, u32) {
     let (hi, lo) = ((x >> 32) as u32, x as u32);
     if hi != 0 {
-        let e = hi.leading_zeros() & !1;
+        let e = leading_zeros(hi) & !1;
         // The top word of x 2^e: hi's bits, then lo's top e (none when e = 0).
         let top = if e == 0 { hi } else { hi << e | lo >> (32 - e) };
         (top >> 2, e)
     } else {
-        let e = 32 + (lo.leading_zeros() & !1);
+        let e = 32 + (leading_zeros(lo) & !1);
         ((lo << (e - 32)) >> 2, e)
     }
 }

@@ -9,6 +9,7 @@ use mccs::q::{
     mulhi_u_split,
 };
 use proptest::prelude::*;
+use rand::{Rng, SeedableRng};
 
 const EDGES: [i32; 12] = [
     i32::MIN,
@@ -160,5 +161,27 @@ proptest! {
         let want = ((a as i64 * (pos & 0x7FFF) as i64) >> 16) as i32;
         prop_assert_eq!(mul_t(a, pos), want);
         prop_assert_eq!(mul_t_split(a, pos & 0x7FFF), want);
+    }
+}
+
+/// The M0's leading zeros from a byte table (`q::leading_zeros_split`, which the graded
+/// corner's octave takes there) are `u32::leading_zeros`: every power of two and its
+/// neighbours, every top byte over each byte boundary, and 100,000 random values.
+#[test]
+fn leading_zeros_split_is_leading_zeros() {
+    let mut values = vec![0u32, u32::MAX];
+    for b in 0..32 {
+        let p = 1u32 << b;
+        values.extend([p, p.wrapping_sub(1), p.wrapping_add(1), p | (p >> 1)]);
+    }
+    for shift in [0, 8, 16, 24] {
+        values.extend((0..=255u32).map(|i| i << shift));
+        values.extend((0..=255u32).map(|i| (i << shift) | ((1 << shift) - 1)));
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+    values.extend((0..100_000).map(|_| rng.random::<u32>() >> rng.random_range(0..32)));
+    for d in values {
+        assert_eq!(mccs::q::leading_zeros_split(d), d.leading_zeros(), "{d:#x}");
+        assert_eq!(mccs::q::leading_zeros(d), d.leading_zeros(), "{d:#x}");
     }
 }

@@ -71,7 +71,7 @@
 //! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound.rs`:
 //! `docs/accuracy.md`.
 
-use crate::q::{mul_t, mul_wide, mulhi, mulhi_round, mulhi_u, shr_held};
+use crate::q::{self, mul_t, mul_wide, mulhi, mulhi_round, mulhi_u, shr_held};
 use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
 mod bound;
@@ -453,7 +453,8 @@ impl<const S: usize> ForceTable<S> {
     fn corner_segment(&self, e: i32) -> (&[i32; 4], u32, u32) {
         let r = &self.raw;
         let d = (r.corner_anchor.wrapping_sub(e) as u32).wrapping_mul(r.corner_pre);
-        let z = d.leading_zeros();
+        // (`q::leading_zeros`: a byte table on the M0, which has no `clz`.)
+        let z = q::leading_zeros(d);
         let pos = (d.wrapping_shl(z) << 1) >> (17 - CORNER_BITS);
         let i = r
             .corner_base
