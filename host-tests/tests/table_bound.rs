@@ -10,7 +10,8 @@
 //!   (`mccs_host::reference`) finds it within the bound (to 2 % of it and two LSBs of
 //!   the output formats: the two sample different strains); or
 //! - is refused with `TableError::BoundNotMet`, and the same sweep of the table built
-//!   anyway finds what the refusal reported (to within the sampling: ≥ 0.9 of it);
+//!   anyway finds what the refusal reported (to within the sampling: ≥ 0.9 of it, or at
+//!   least over the bound: [`refusal_confirmed`]);
 //! - or is refused for another typed reason (no nonlinear phase inside the domain, out
 //!   of the formats), counted apart.
 //!
@@ -182,18 +183,85 @@ fn format_limited(p: &Params, bound: &TableBound) -> bool {
         || STIFFNESS_LSB > bound.stiffness * smallest_stiffness(&r)
 }
 
+/// Whether the independent reference confirms a refusal at `reported` (the builder's
+/// measure of the table `from_law_best` builds anyway, which the table carries): on a
+/// measure the builder found over the bound, the reference sees the bound itself or 0.9
+/// of what the builder saw (either measure, when both were over). The two sample
+/// different strains: a table refused 1.2× over its stiffness bound may show 1.07× in the
+/// reference's samples — still over, so the refusal is real. `Ok` with the reference's
+/// measure, `Err` with it when it does not confirm.
+fn refusal_confirmed(
+    p: &Params,
+    reported: &TableBound,
+    bound: &TableBound,
+) -> Result<TableBound, TableBound> {
+    let law = mccs::Law::new(p).unwrap();
+    let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    assert_eq!(
+        TableBound::from_ppb(t.raw().err_force_ppb, t.raw().err_stiffness_ppb),
+        *reported
+    );
+    let m = independent(p, &t);
+    let sees = |m: f64, r: f64, b: f64| r > b && m >= (0.9 * r).min(b);
+    if sees(m.force, reported.force, bound.force)
+        || sees(m.stiffness, reported.stiffness, bound.stiffness)
+    {
+        Ok(m)
+    } else {
+        Err(m)
+    }
+}
+
+/// A spring of the long run (`TABLE_BOUND_SPRINGS=10000`; the test command's 1,000 do not
+/// reach it): refused at 1.2× its stiffness bound, which the reference, sampling other
+/// strains, sees at 1.07× — 0.89 of the builder's figure, which the check once took for
+/// a refusal the reference does not confirm (it asked for 0.9 of the builder's figure,
+/// not also the bound). Over the bound in both measures: a real refusal.
+#[test]
+fn a_refusal_just_over_the_bound_is_confirmed() {
+    let p = Params {
+        cone: Cone {
+            wire_diameter: 0.06383410103698191,
+            small_diameter: 0.6807040693258243,
+            large_diameter: 2.395111583971223,
+            active_coils: 2.8707839195794564,
+            compressible_height: 0.7359778848921906,
+            shear_modulus: 70573.95234011757,
+        },
+        linear: Linear {
+            wire_diameter: 0.03625479273965367,
+            mean_diameter: 0.13929865876966638,
+            active_coils: 10.455388166007594,
+            shear_modulus: 619510.1272567238,
+            preload: Some(0.0027247534827282),
+        },
+    };
+    let bound = TableBound::PRODUCT;
+    let reported = match ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound) {
+        Err(TableError::BoundNotMet {
+            force_ppb,
+            stiffness_ppb,
+        }) => TableBound::from_ppb(force_ppb, stiffness_ppb),
+        other => panic!("{other:?}"),
+    };
+    assert!(reported.force <= bound.force && reported.stiffness > bound.stiffness);
+    let m = refusal_confirmed(&p, &reported, &bound).expect("confirmed");
+    // (What the old check, 0.9 of the builder's figure alone, refused to confirm.)
+    assert!(
+        m.stiffness > bound.stiffness && m.stiffness < 0.9 * reported.stiffness,
+        "{m:?}"
+    );
+}
+
 #[test]
 fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
     let bound = TableBound::PRODUCT;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
     let mut decades = [Tally::default(); 7];
-    let (mut worst_met, mut least_refused) = (
-        TableBound {
-            force: 0.0,
-            stiffness: 0.0,
-        },
-        f64::INFINITY,
-    );
+    let mut worst_met = TableBound {
+        force: 0.0,
+        stiffness: 0.0,
+    };
     let n = springs();
     let mut said = std::time::Instant::now();
     for i in 0..n {
@@ -248,26 +316,10 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
                     !reported.within(&bound),
                     "{p:?}: refused within the bound: {reported:?}"
                 );
-                let law = mccs::Law::new(&p).unwrap();
-                let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
-                assert_eq!(t.raw().err_force_ppb, force_ppb);
-                assert_eq!(t.raw().err_stiffness_ppb, stiffness_ppb);
-                let m = independent(&p, &t);
-                // The refusal is real: on a measure the builder found over the bound, the
-                // reference sees the error it saw (either measure, when both were over: a
-                // spring refused for its stiffness stays refused when the two sample its
-                // force error a tenth apart).
-                let seen = |m: f64, r: f64, b: f64| if r > b { m / r } else { 0.0 };
-                let over = seen(m.force, reported.force, bound.force).max(seen(
-                    m.stiffness,
-                    reported.stiffness,
-                    bound.stiffness,
-                ));
-                assert!(
-                    over >= 0.9,
-                    "{p:?}: refused at {reported:?}, the reference finds {m:?}"
-                );
-                least_refused = least_refused.min(over);
+                // The refusal is real (`refusal_confirmed`).
+                if let Err(m) = refusal_confirmed(&p, &reported, &bound) {
+                    panic!("{p:?}: refused at {reported:?}, the reference finds {m:?}");
+                }
                 d.refused += 1;
                 d.over_force += usize::from(reported.force > bound.force);
                 d.over_stiffness += usize::from(reported.stiffness > bound.stiffness);

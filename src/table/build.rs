@@ -135,11 +135,11 @@ impl<const S: usize> ForceTable<S> {
                 }
             }
         }
-        // Still missed, with a preload's slope kink Δ(P) inside the domain: a preload near
-        // F_C, below which the cone rises steeply toward its own solid point, which the
-        // corner above does not reach (its octaves grade toward Δ(F_C), past Δ(P)). The
-        // graded corner then takes the part above Δ(P), smooth up to the solid point (or
-        // the domain's end, when that comes first), and the uniform grid's segments all go
+        // Still missed, with a preload's slope kink Δ(P) inside the domain (a preload near
+        // F_C: below Δ(P) the cone rises steeply toward its own solid point, which the
+        // corner above, grading toward Δ(F_C) past Δ(P), does not follow). The graded
+        // corner then takes the part above Δ(P), smooth up to the solid point (or the
+        // domain's end, when that comes first), and the uniform grid's segments all go
         // below a little past Δ(P), with a knot on it.
         let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
         let e_p = law.delta(law.preload);

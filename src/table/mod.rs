@@ -23,8 +23,8 @@
 //! `Δ(F_C)`: [`CORNER_OCTAVES`] octaves of distance from it, [`CORNER_PER_OCTAVE`]
 //! segments each, indexed by the leading zeros of `d = (A − e) · pre`
 //! ([`RawTable::corner_anchor`]), the uniform grid below it ([`ForceTable::corner`]).
-//! Where still none does and a preload near `F_C` puts its slope kink `Δ(P)` inside the
-//! domain (the cone rising steeply below it toward its own solid point), the graded
+//! Where still none does and a preload above `F_T` puts its slope kink `Δ(P)` inside the
+//! domain (near `F_C` the cone rises steeply below it toward its own solid point), the graded
 //! corner takes the smooth part above the kink instead, up to `Δ(F_C)` or, when that
 //! lies well past the domain, to the domain's end (the line above then the law's tangent
 //! there), so that the uniform grid's segments all go below a little past `Δ(P)`. The
