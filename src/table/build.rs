@@ -115,7 +115,8 @@ impl<const S: usize> ForceTable<S> {
         // The solid point may lie a little past the domain's end: the rise toward it is
         // then inside the domain.
         let lo = libm::fmax(law.strain_t(), from);
-        if missed && S >= 2 * CORNER_SEGMENTS && e_c <= to + 0.5 * (to - lo) {
+        let solid_near = e_c <= to + 0.5 * (to - lo);
+        if missed && S >= 2 * CORNER_SEGMENTS && solid_near {
             let curved = e_c - lo;
             'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
                 for fraction in CORNER_FRACTIONS {
@@ -144,7 +145,7 @@ impl<const S: usize> ForceTable<S> {
         let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
         let e_p = law.delta(law.preload);
         if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
-            let (end, e_end) = if e_c <= to + 0.5 * (to - lo) {
+            let (end, e_end) = if solid_near {
                 (CornerEnd::Solid, e_c)
             } else {
                 (CornerEnd::DomainEnd, to)
@@ -277,7 +278,7 @@ impl<const S: usize> ForceTable<S> {
             raw.force_hi = last >> shift;
             // Past the solid point the law's own k_p line; past the domain's end the
             // law's tangent at the last knot, as a grid that ends there has.
-            let above = match corner_end {
+            let above = match c.end {
                 CornerEnd::Solid => law.k_p,
                 CornerEnd::DomainEnd => {
                     1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0)))
@@ -304,8 +305,8 @@ struct Corner {
     hi: i32,
     /// Where the uniform grid ends (a little past the corner's start), strain.
     start: f64,
-    /// Whether the last knot is the solid point (its force `F_C` exactly).
-    solid: bool,
+    /// Where it ends: at the solid point, the last knot's force is `F_C` exactly.
+    end: CornerEnd,
 }
 
 /// Where a graded corner ends: its last knot, where the line above starts.
@@ -350,7 +351,7 @@ impl Corner {
             pre: pre as u32,
             hi: hi as i32,
             start,
-            solid: end == CornerEnd::Solid,
+            end,
         })
     }
 
@@ -363,7 +364,7 @@ impl Corner {
     /// solid point (the last knot of a corner ending there) the law's own `F_C` and
     /// slope from below.
     fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
-        let f = if self.solid && z == CORNER_OCTAVES - 1 && jj == 0 {
+        let f = if self.end == CornerEnd::Solid && z == CORNER_OCTAVES - 1 && jj == 0 {
             law.f_c
         } else {
             law.force(self.strain(z, jj))
