@@ -13,6 +13,7 @@ mccs::ForceTable::<64>::from_raw(mccs::RawTable {
     slope_lo: 617501836,
     force_hi: 10760720,
     stiffness_hi: 316594890,
+    slope_hi: 316594890,
     shift: 2,
     stiff_scale: 1625751552,
     stiff_post: 2,

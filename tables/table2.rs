@@ -13,6 +13,7 @@ mccs::ForceTable::<64>::from_raw(mccs::RawTable {
     slope_lo: 617501836,
     force_hi: 6793263,
     stiffness_hi: 959207,
+    slope_hi: 959207,
     shift: 7,
     stiff_scale: 93888512,
     stiff_post: 1,

@@ -7,7 +7,7 @@
 //! the improved Euler step; the probe coupling on the contact node. Software floating point
 //! on the M3 and M0 (and for `f64` everywhere).
 
-use mccs::units::{to_f64, DIR_FRAC, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
+use mccs::units::{to_f64, DIR_FRAC, FORCE_FRAC, STRAIN_FRAC};
 use mccs::{ForceTable, SolverConfig, Topology};
 
 /// The arithmetic the float patch needs.
@@ -181,6 +181,8 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         let h = 1.0 / (cfg.tick_hz * substeps as f64);
         // The line below's slope as its force uses it (`RawTable::slope_lo`).
         let k_lo = to_f64(raw.slope_lo, raw.slope_lo_frac());
+        // And the line above's (`RawTable::slope_hi`).
+        let k_hi = to_f64(raw.slope_hi, raw.slope_hi_frac());
         Self {
             springs,
             n_springs: topo.edges().len(),
@@ -194,10 +196,9 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             f_lo: T::of(
                 to_f64(raw.force_lo, FORCE_FRAC) - k_lo * to_f64(raw.anchor_lo, STRAIN_FRAC),
             ),
-            k_hi: T::of(to_f64(raw.stiffness_hi, STIFF_FRAC)),
+            k_hi: T::of(k_hi),
             f_hi: T::of(
-                to_f64(raw.force_hi, FORCE_FRAC)
-                    - to_f64(raw.stiffness_hi, STIFF_FRAC) * to_f64(raw.strain_hi, STRAIN_FRAC),
+                to_f64(raw.force_hi, FORCE_FRAC) - k_hi * to_f64(raw.strain_hi, STRAIN_FRAC),
             ),
             hm: T::of(1000.0 * h / cfg.node_mass),
             half_h: T::of(0.5 * h),

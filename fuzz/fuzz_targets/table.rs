@@ -13,7 +13,7 @@ struct Input {
     from: f64,
     to: f64,
     knots: u8,
-    raw: ([i32; 10], [u32; 3], [[i32; 4]; 16], [i32; 6]),
+    raw: ([i32; 10], [u32; 3], [[i32; 4]; 16], [i32; 7]),
     strains: Vec<i32>,
 }
 
@@ -66,7 +66,9 @@ fuzz_target!(|i: Input| {
         stiffness_lo: a[4],
         slope_lo: a[9],
         force_hi: a[5],
-        stiffness_hi: a[6],
+        // Half of them within ±2¹⁹, where the line above's slope is Q28.
+        stiffness_hi: if a[7] & 1 == 0 { a[6] >> 12 } else { a[6] },
+        slope_hi: c[6],
         shift: b[2],
         stiff_scale: a[7],
         stiff_post: a[8],

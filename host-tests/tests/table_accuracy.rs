@@ -121,9 +121,9 @@ fn table2_accuracy_per_knot_count() {
         s65.max_stiffness_rel
     );
     assert!(s129.max_force <= s65.max_force);
-    // 1 KiB of coefficients and an 84-byte header (24 of them the graded corner's, 4 the
-    // lower line's Q28 slope).
-    const { assert!(ForceTable::<64>::SIZE_BYTES == 1024 + 84) };
+    // 1 KiB of coefficients and an 88-byte header (24 of them the graded corner's, 4
+    // each line's Q28 slope).
+    const { assert!(ForceTable::<64>::SIZE_BYTES == 1024 + 88) };
 }
 
 #[test]

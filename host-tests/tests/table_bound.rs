@@ -522,7 +522,7 @@ fn a_small_springs_line_below_holds_the_bound() {
         "{:?} {md:?}",
         device.max_error()
     );
-    assert!(mccs::table::fine_lower_line(device.raw().stiffness_lo));
+    assert!(mccs::table::fine_line(device.raw().stiffness_lo));
     let best = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
         .expect("mccs table's meets the bound");
     let m = independent(&p, &best);
@@ -531,6 +531,59 @@ fn a_small_springs_line_below_holds_the_bound() {
         md.force, m.force, m.stiffness
     );
     assert!(m.within(&allowed));
+}
+
+/// The line above the solid point carries its force's slope in Q28 where it fits
+/// (`RawTable::slope_hi`, as the line below does). A spring of the random test (spring
+/// 220 of its 1,000) with a soft series spring (`k_p` 0.079 N per unit strain) and its
+/// solid point at strain 0.62, well inside the domain: the `k_p` line runs 0.33 strain
+/// to the domain's end, over which half a Q16 LSB of slope is 2.5e-6 N, more than its
+/// force bound (2e-5 of `F(0.95)` = 0.074 N: 1.5e-6 N). It was refused at 1.38× the
+/// force bound; now its table meets the bound, as the independent reference confirms.
+#[test]
+fn a_soft_series_springs_line_above_holds_the_bound() {
+    let p = Params {
+        cone: Cone {
+            wire_diameter: 0.08415754638957852,
+            small_diameter: 0.5651093394152188,
+            large_diameter: 1.0618934130922164,
+            active_coils: 14.987850312201942,
+            compressible_height: 0.24036206468259774,
+            shear_modulus: 85054.66108542222,
+        },
+        linear: Linear {
+            wire_diameter: 0.04292775309010174,
+            mean_diameter: 0.11991117569767738,
+            active_coils: 19.332100326324046,
+            shear_modulus: 6203.585660653346,
+            preload: Some(0.017670239109131364),
+        },
+    };
+    let r = Reference::new(&p).unwrap();
+    let k_p = r.series.unwrap().k_p;
+    let (e_c, scale) = (r.strain_c(), r.force(DOMAIN.1));
+    // What half a Q16 LSB of slope gives over the line, relative to F(0.95).
+    let q16 = 0.5 * STIFFNESS_LSB * (DOMAIN.1 - e_c) / scale;
+    assert!(q16 > TableBound::PRODUCT.force, "{q16:e}");
+    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("meets the bound");
+    // The table ends at the solid point: the line above is the law's own k_p line.
+    let (_, hi) = t.tabulated_range();
+    assert!((hi.to_num::<f64>() - e_c).abs() < 1e-3, "{hi} {e_c}");
+    assert!(mccs::table::fine_line(t.raw().stiffness_hi));
+    let slope = t.raw().slope_hi as f64 / (1u64 << mccs::table::FINE_SLOPE_FRAC) as f64;
+    assert!((slope - k_p).abs() <= 1e-8, "{slope} {k_p}");
+    let allowed = TableBound {
+        force: 1.02 * TableBound::PRODUCT.force + 2.0 * FORCE_LSB / scale,
+        stiffness: 1.02 * TableBound::PRODUCT.stiffness
+            + 2.0 * STIFFNESS_LSB / smallest_stiffness(&r),
+    };
+    let m = independent(&p, &t);
+    println!(
+        "LINEABOVE case=soft_series q16_line_force={q16:.1e} force={:.1e} stiffness={:.1e}",
+        m.force, m.stiffness
+    );
+    assert!(m.within(&allowed), "{m:?}");
 }
 
 /// The table's outputs round to the nearest LSB instead of flooring: the force through

@@ -35,6 +35,8 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             any::<i32>(),
             any::<i32>(),
             any::<i32>(),
+            // (And the line above's force slope.)
+            any::<i32>(),
         ),
     )
         .prop_map(|(a, b, c, segments, g)| RawTable {
@@ -48,7 +50,9 @@ fn any_raw() -> impl Strategy<Value = RawTable<16>> {
             stiffness_lo: if c.0 & 1 == 0 { b.1 >> 12 } else { b.1 },
             slope_lo: g.7,
             force_hi: b.2,
-            stiffness_hi: b.3,
+            // And half of them within ±2¹⁹, where the line above's slope is Q28.
+            stiffness_hi: if c.1 & 1 == 0 { b.3 >> 12 } else { b.3 },
+            slope_hi: g.8,
             shift: b.4,
             stiff_scale: c.0,
             stiff_post: c.1,
@@ -102,6 +106,7 @@ fn a_table_of_no_segments_evaluates_without_panic() {
         slope_lo: 1 << 28,
         force_hi: 1 << 20,
         stiffness_hi: 1 << 17,
+        slope_hi: 1 << 29,
         shift: 0,
         stiff_scale: 1 << 20,
         stiff_post: 1,

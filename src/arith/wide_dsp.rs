@@ -63,7 +63,7 @@ const _: () = {
 };
 
 /// Offsets of the table's header fields from its first segment (bytes, negative).
-const fn header<const S: usize>() -> [i32; 13] {
+const fn header<const S: usize>() -> [i32; 14] {
     let seg = core::mem::offset_of!(RawTable<S>, segments) as i32;
     [
         core::mem::offset_of!(RawTable<S>, strain_lo) as i32 - seg,
@@ -79,6 +79,7 @@ const fn header<const S: usize>() -> [i32; 13] {
         core::mem::offset_of!(RawTable<S>, corner_anchor) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, corner_pre) as i32 - seg,
         core::mem::offset_of!(RawTable<S>, corner_base) as i32 - seg,
+        core::mem::offset_of!(RawTable<S>, slope_hi) as i32 - seg,
     ]
 }
 
@@ -138,7 +139,7 @@ macro_rules! lower_any {
 }
 
 /// The same for a stiffness within ±2¹⁹ (Q16: below 8 N per unit strain, Table 2's is
-/// 2.3), whose `slope_lo` is Q28 ([`crate::table::fine_lower_line`]): `hi(slope_lo ·
+/// 2.3), whose `slope_lo` is Q28 ([`crate::table::fine_line`]): `hi(slope_lo ·
 /// d)`, one instruction.
 macro_rules! lower_gentle {
     () => {
@@ -236,17 +237,27 @@ macro_rules! spring_body {
             "qadd r5, r5, r3\n",
             "b 53f\n",
             // At or above strain_hi: the graded corner below corner_hi; above it
-            // force_hi + (stiffness_hi · (e ⊖ corner_hi)) >> 20, held.
+            // force_hi + hi(slope_hi · (e ⊖ corner_hi)) where stiffness_hi is within
+            // ±2¹⁹ (slope_hi is then Q28: `fine_line`), else
+            // force_hi + (slope_hi · (e ⊖ corner_hi)) >> 20, held.
             "52:\n",
             "ldr r5, [r11, #{corner_hi}]\n",
             "cmp r9, r5\n",
             "blt 54b\n",
             "qsub r3, r9, r5\n",
-            "ldr r5, [r11, #{stiffness_hi}]\n",
+            "ldr r8, [r11, #{stiffness_hi}]\n",
+            "ldr r5, [r11, #{slope_hi}]\n",
+            "add r8, r8, #0x80000\n",
+            "cmp r8, #0x100000\n",
+            "bhs 56f\n",
+            "smmul r3, r5, r3\n",
+            "b 57f\n",
+            "56:\n",
             "smull r3, r5, r5, r3\n",
             "ssat r5, #20, r5\n",
             "lsl r5, r5, #12\n",
             "orr r3, r5, r3, lsr #20\n",
+            "57:\n",
             "ldr r5, [r11, #{force_hi}]\n",
             "qadd r5, r5, r3\n",
             // f within ±64 N; f r' >> 25 (Q22; the law's product subtracts it); the
@@ -401,6 +412,7 @@ macro_rules! spring_loop {
             slope_lo = const header::<S>()[6],
             force_hi = const header::<S>()[7],
             stiffness_hi = const header::<S>()[8],
+            slope_hi = const header::<S>()[13],
             corner_hi = const header::<S>()[9],
             corner_anchor = const header::<S>()[10],
             corner_base = const header::<S>()[12],
@@ -434,7 +446,7 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
         warm: warm.as_mut_ptr(),
     };
     // The lower line's product as its slope allows (a constant per call).
-    let gentle = crate::table::fine_lower_line(raw.stiffness_lo);
+    let gentle = crate::table::fine_line(raw.stiffness_lo);
     // SAFETY (both loops): the loop reads the `n` edges of `topo` (`edges` up to `end`)
     // and as many warm-start values (n ≤ EDGES), writes only those values and the nodes' force
     // accumulators, and reads the table's header and segments. Every node index is in

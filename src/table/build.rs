@@ -4,9 +4,9 @@
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
 use super::{
-    corner_strain, fine_lower_line, knot_bias, measure, ForceTable, RawTable, TableBound,
-    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN,
-    FINE_SLOPE_FRAC, UNMEASURED,
+    corner_strain, fine_line, knot_bias, measure, ForceTable, RawTable, TableBound, TableError,
+    CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, FINE_SLOPE_FRAC,
+    UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -247,6 +247,7 @@ impl<const S: usize> ForceTable<S> {
             slope_lo: l.slope_lo,
             force_hi: segs.last >> shift,
             stiffness_hi: l.stiffness_hi,
+            slope_hi: l.slope_hi,
             shift,
             stiff_scale,
             stiff_post,
@@ -284,7 +285,7 @@ impl<const S: usize> ForceTable<S> {
                     1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0)))
                 }
             };
-            raw.stiffness_hi = checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?;
+            (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
         }
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
@@ -855,6 +856,7 @@ struct Lines {
     stiffness_lo: i32,
     slope_lo: i32,
     stiffness_hi: i32,
+    slope_hi: i32,
 }
 
 /// Below the table: at the kink, the exact line `k ε` through zero, with `k` rounded
@@ -869,26 +871,7 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
     } else {
         (1.0 / law.compliance(law.force(grid.lo)), libm::round)
     };
-    let kq = round(k * (1u64 << STIFF_FRAC) as f64);
-    if !(kq >= 0.0 && kq <= i32::MAX as f64) {
-        return Err(TableError::OutOfRange);
-    }
-    // Q28 where it fits (below 8 N per unit strain: `k · 2²⁸` < 2³¹); the stiffness is
-    // then the nearest Q16 value (the force's slope is the Q28 one, rounded as above),
-    // within one LSB of it.
-    let (stiffness_lo, slope_lo) = if fine_lower_line(kq as i32) {
-        let fine = round(libm::ldexp(k, FINE_SLOPE_FRAC as i32)) as i32;
-        let nearest = libm::round(k * (1u64 << STIFF_FRAC) as f64) as i32;
-        // (Not rounded up out of the fine range, where the slope would read as Q16.)
-        let stiffness = if fine_lower_line(nearest) {
-            nearest
-        } else {
-            kq as i32
-        };
-        (stiffness, fine)
-    } else {
-        (kq as i32, kq as i32)
-    };
+    let (stiffness_lo, slope_lo) = line_slopes(k, round)?;
     let (anchor_lo, force_lo) = if grid.at_kink {
         (0, 0)
     } else {
@@ -900,12 +883,38 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
     } else {
         1.0 / law.compliance(law.force(e_hi))
     };
+    let (stiffness_hi, slope_hi) = line_slopes(above, libm::round)?;
     Ok(Lines {
         anchor_lo,
         force_lo,
         stiffness_lo,
         slope_lo,
-        stiffness_hi: checked_from_f64(above, STIFF_FRAC).ok_or(TableError::OutOfRange)?,
+        stiffness_hi,
+        slope_hi,
+    })
+}
+
+/// A line's `(stiffness, slope)` for the slope `k` (N per unit strain), `round`ed: the
+/// stiffness in Q16; the force's slope in Q28 where it fits (below 8 N per unit strain:
+/// `k · 2²⁸` < 2³¹, [`fine_line`]), the stiffness then the nearest Q16 value, within one
+/// LSB of it; else the stiffness again.
+fn line_slopes(k: f64, round: fn(f64) -> f64) -> Result<(i32, i32), TableError> {
+    let kq = round(k * (1u64 << STIFF_FRAC) as f64);
+    if !(kq >= 0.0 && kq <= i32::MAX as f64) {
+        return Err(TableError::OutOfRange);
+    }
+    Ok(if fine_line(kq as i32) {
+        let fine = round(libm::ldexp(k, FINE_SLOPE_FRAC as i32)) as i32;
+        let nearest = libm::round(k * (1u64 << STIFF_FRAC) as f64) as i32;
+        // (Not rounded up out of the fine range, where the slope would read as Q16.)
+        let stiffness = if fine_line(nearest) {
+            nearest
+        } else {
+            kq as i32
+        };
+        (stiffness, fine)
+    } else {
+        (kq as i32, kq as i32)
     })
 }
 

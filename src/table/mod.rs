@@ -34,12 +34,12 @@
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
 //! the law bends harder than the grid resolves, so that the curve stays monotone), as
 //! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
-//! per segment, 1108 bytes in all for 65 knots with the header) so that each Horner step is one product
+//! per segment, 1112 bytes in all for 65 knots with the header) so that each Horner step is one product
 //! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
 //! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
-//! the kink, the line through zero with `k` rounded down, in Q28 where it fits:
-//! [`RawTable::slope_lo`]), so the curve is continuous and
-//! monotone.
+//! the kink, the line through zero with `k` rounded down; each line's slope in Q28 where
+//! it fits: [`RawTable::slope_lo`], [`RawTable::slope_hi`]), so the curve is continuous
+//! and monotone.
 //!
 //! # Formats and ranges
 //! - strain: [`Strain`] = `I8F24`, range ±128, resolution 6.0e-8;
@@ -49,9 +49,9 @@
 //! - coefficients: Q(20 + `shift`) N, the shift (0 … 12) chosen per table so that the
 //!   knots use most of an `i32` and no Horner step can overflow; every knot carries half
 //!   a Q20 LSB ([`knot_bias`]), so the force rounds to the nearest Q20 N;
-//! - the line below's slope for its force: Q28 below 8 N per unit strain, else Q16
-//!   ([`RawTable::slope_lo`]); the stiffness rounds to the nearest Q16 value (outside
-//!   the graded corner, which floors).
+//! - each line's slope for its force: Q28 below 8 N per unit strain, else Q16
+//!   ([`RawTable::slope_lo`], [`RawTable::slope_hi`]); the stiffness rounds to the
+//!   nearest Q16 value (outside the graded corner, which floors).
 //!
 //! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`).
 //!
@@ -120,15 +120,24 @@ pub struct RawTable<const S: usize> {
     pub stiffness_lo: i32,
     /// The same slope for the line's force, finer where it fits: Q28 N per unit strain
     /// when `stiffness_lo` is within ±2¹⁹ (below 8 N per unit strain,
-    /// [`fine_lower_line`]), the force then `force_lo + hi(slope_lo · (e ⊖ anchor_lo))`;
+    /// [`fine_line`]), the force then `force_lo + hi(slope_lo · (e ⊖ anchor_lo))`;
     /// else Q16, equal to `stiffness_lo`. A Q16 slope alone is off by up to 2⁻¹⁶ N per
     /// unit strain, which over the tension end of the domain is up to 8 force LSBs: more
     /// than the product's bound for a spring below 0.4 N at `F(0.95)`.
     pub slope_lo: i32,
-    /// The line above `strain_hi` passes through (`strain_hi`, `force_hi`) (Q20 N).
+    /// The line above the tabulated range passes through (`corner_hi`, `force_hi`) (Q20
+    /// N): the last knot.
     pub force_hi: i32,
-    /// Slope of the line above `strain_hi` (Q16 N per unit strain).
+    /// Slope of the line above (Q16 N per unit strain): its stiffness (the nearest Q16
+    /// value where `slope_hi` is Q28).
     pub stiffness_hi: i32,
+    /// The same slope for the line's force, as `slope_lo` is the line below's: Q28 when
+    /// `stiffness_hi` is within ±2¹⁹ ([`fine_line`]), the force then `force_hi +
+    /// hi(slope_hi · (e ⊖ corner_hi))`; else Q16, equal to `stiffness_hi`. A soft series
+    /// spring's `k_p` line from a solid point well inside the domain drifts, with a Q16
+    /// slope, by half an LSB per unit strain: 2.5 force LSBs over 0.33 strain, more than
+    /// the product's bound for a spring of 0.07 N at `F(0.95)`.
+    pub slope_hi: i32,
     /// The coefficients' unit: Q(20 + `shift`) N, `shift` ∈ 0 … 12.
     pub shift: u32,
     /// The stiffness in Q16 is `⌊(D · stiff_scale + 2³¹) / 2³²⌋ · stiff_post` (rounded)
@@ -264,16 +273,19 @@ impl<const S: usize> ForceTable<S> {
         })
     }
 
-    /// Whether the line below's force slope is its stiffness: to within one Q16 LSB in
-    /// Q28 ([`fine_lower_line`]), else the same.
+    /// Whether each line's force slope is its stiffness: to within one Q16 LSB in Q28
+    /// ([`fine_line`]), else the same.
     fn slope_fits(&self) -> bool {
+        let fits = |slope: i32, stiffness: i32| {
+            if fine_line(stiffness) {
+                let q16 = slope >> (FINE_SLOPE_FRAC - STIFF_FRAC);
+                slope >= 0 && (q16 - stiffness).abs() <= 1
+            } else {
+                slope == stiffness
+            }
+        };
         let r = &self.raw;
-        if fine_lower_line(r.stiffness_lo) {
-            let q16 = r.slope_lo >> (FINE_SLOPE_FRAC - STIFF_FRAC);
-            r.slope_lo >= 0 && (q16 - r.stiffness_lo).abs() <= 1
-        } else {
-            r.slope_lo == r.stiffness_lo
-        }
+        fits(r.slope_lo, r.stiffness_lo) && fits(r.slope_hi, r.stiffness_hi)
     }
 
     /// Whether the graded corner's coordinate stays in `[2²⁴, 2³²)` over its range and
@@ -351,7 +363,7 @@ impl<const S: usize> ForceTable<S> {
         }
         if e >= r.strain_hi {
             if e >= r.corner_hi {
-                return Force::from_bits(line(r.force_hi, r.stiffness_hi, e, r.corner_hi));
+                return Force::from_bits(line_above::<false, S>(r, e));
             }
             return Force::from_bits(self.corner_force(e));
         }
@@ -392,7 +404,7 @@ impl<const S: usize> ForceTable<S> {
         }
         if e >= r.strain_hi {
             if e >= r.corner_hi {
-                let f = line(r.force_hi, r.stiffness_hi, e, r.corner_hi);
+                let f = line_above::<false, S>(r, e);
                 return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_hi));
             }
             return self.corner_force_and_stiffness(e);
@@ -411,7 +423,7 @@ impl<const S: usize> ForceTable<S> {
     fn above_within(&self, e: i32) -> i32 {
         let r = &self.raw;
         if e >= r.corner_hi {
-            line_held(r.force_hi, r.stiffness_hi, e, r.corner_hi)
+            line_above::<true, S>(r, e)
         } else {
             self.corner_force(e)
         }
@@ -523,13 +535,6 @@ pub(crate) fn cubic_value<const S: usize>(r: &RawTable<S>, c: &[i32; 4], t: u32)
     c[0].wrapping_add(mul_t(a, t)).wrapping_shr(r.shift)
 }
 
-/// `f0 + (k (e − e0)) >> 20` in Q20 N from a Q20 force, a Q16 slope and Q24 strains;
-/// saturating exactly.
-#[inline(always)]
-fn line(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
-    f0.saturating_add(line_product(mul_wide(k, e.saturating_sub(e0))))
-}
-
 /// `p >> 20` for the product `p` of a Q16 slope and a Q24 strain difference, saturated
 /// to `i32` exactly.
 #[inline(always)]
@@ -559,38 +564,75 @@ pub const fn knot_bias(shift: u32) -> i32 {
     }
 }
 
-/// Fraction bits of the line below's force slope where it is fine ([`fine_lower_line`]).
+/// Fraction bits of a line's force slope where it is fine ([`fine_line`]).
 pub const FINE_SLOPE_FRAC: u32 = 28;
 
 impl<const S: usize> RawTable<S> {
     /// Fraction bits of [`RawTable::slope_lo`]: [`FINE_SLOPE_FRAC`] where
-    /// [`fine_lower_line`], else `STIFF_FRAC` (16).
+    /// [`fine_line`], else `STIFF_FRAC` (16).
     pub const fn slope_lo_frac(&self) -> u32 {
-        if fine_lower_line(self.stiffness_lo) {
-            FINE_SLOPE_FRAC
-        } else {
-            STIFF_FRAC
-        }
+        slope_frac(self.stiffness_lo)
+    }
+
+    /// Fraction bits of [`RawTable::slope_hi`], as [`RawTable::slope_lo_frac`].
+    pub const fn slope_hi_frac(&self) -> u32 {
+        slope_frac(self.stiffness_hi)
     }
 }
 
-/// Whether the line below a table with this `stiffness_lo` carries its force's slope in
-/// Q28 ([`RawTable::slope_lo`]): within ±2¹⁹ (below 8 N per unit strain in Q16), where
-/// the Q28 slope fits an `i32`.
+/// Fraction bits of a line's force slope with this stiffness (Q16).
+const fn slope_frac(stiffness: i32) -> u32 {
+    if fine_line(stiffness) {
+        FINE_SLOPE_FRAC
+    } else {
+        STIFF_FRAC
+    }
+}
+
+/// Whether a line (below or above the table) with this stiffness carries its force's
+/// slope in Q28 ([`RawTable::slope_lo`], [`RawTable::slope_hi`]): within ±2¹⁹ (below 8
+/// N per unit strain in Q16), where the Q28 slope fits an `i32`.
 #[inline(always)]
-pub const fn fine_lower_line(stiffness_lo: i32) -> bool {
-    stiffness_lo >= -(1 << 19) && stiffness_lo < 1 << 19
+pub const fn fine_line(stiffness: i32) -> bool {
+    stiffness >= -(1 << 19) && stiffness < 1 << 19
 }
 
 /// The line below the table in Q20 N at a Q24 strain `e`: `force_lo + hi(slope_lo · (e ⊖
-/// anchor_lo))` with a Q28 slope (a product's high word always fits), else [`line`]'s
-/// product of the Q16 slope, saturated exactly, or with `HELD` held as [`line_held`]'s
+/// anchor_lo))` with a Q28 slope (a product's high word always fits), else the product
+/// of the Q16 slope `>> 20`, saturated exactly ([`line_product`]), or with `HELD` held
+/// through its high word ([`shr_held`]: a held value is ±2048 N to within its low 12
+/// bits, beyond the clamp of every caller that holds)
 /// (the same values within ±1024 N). On the M4F one product and a select of its bits; on
 /// the other cores a branch between the two products (their loops keep their registers
 /// so: the M3's N = 5 substep 300 instructions fewer, the M0's `force_and_stiffness` 2,
 /// measured by the bench).
 #[inline(always)]
 fn line_below<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
+    line_at::<HELD, false, S>(r, e)
+}
+
+/// The line above the table, as [`line_below`]: `force_hi + hi(slope_hi · (e ⊖
+/// corner_hi))` with a Q28 slope, else the Q16 slope's product (past the solid point:
+/// off every loop's hot path).
+#[inline(always)]
+fn line_above<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
+    line_at::<HELD, true, S>(r, e)
+}
+
+/// The line below the table, or with `UPPER` the line above ([`line_below`]). (Each
+/// field read where it is used, as the line below's code always did: read up front, the
+/// anchor and the force were one `ldrd` into a register the M4F's
+/// `force_and_stiffness` then saved on every path, 27 → 29 instructions.)
+#[inline(always)]
+fn line_at<const HELD: bool, const UPPER: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
+    let f0 = || if UPPER { r.force_hi } else { r.force_lo };
+    let slope = || if UPPER { r.slope_hi } else { r.slope_lo };
+    let stiffness = if UPPER {
+        r.stiffness_hi
+    } else {
+        r.stiffness_lo
+    };
+    let e0 = || if UPPER { r.corner_hi } else { r.anchor_lo };
     const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
     let q16 = |p: i64| {
         if HELD {
@@ -601,28 +643,18 @@ fn line_below<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 
     };
     // (The sum in each branch: so the M3's loop keeps its registers; a sum after the
     // branch took its N = 5 substep from 7,970 to 8,256.)
-    let d = || e.saturating_sub(r.anchor_lo);
+    let d = || e.saturating_sub(e0());
     if cfg!(mccs_dsp) {
-        let p = mul_wide(r.slope_lo, d());
-        let df = if fine_lower_line(r.stiffness_lo) {
+        let p = mul_wide(slope(), d());
+        let df = if fine_line(stiffness) {
             (p >> 32) as i32
         } else {
             q16(p)
         };
-        r.force_lo.saturating_add(df)
-    } else if fine_lower_line(r.stiffness_lo) {
-        r.force_lo.saturating_add(mulhi(r.slope_lo, d()))
+        f0().saturating_add(df)
+    } else if fine_line(stiffness) {
+        f0().saturating_add(mulhi(slope(), d()))
     } else {
-        r.force_lo.saturating_add(q16(mul_wide(r.slope_lo, d())))
+        f0().saturating_add(q16(mul_wide(slope(), d())))
     }
-}
-
-/// [`line`] for callers that clamp the result to well inside ±2048 N: the product is held
-/// through its high word ([`shr_held`]), so a held value is ±2048 N to within its low 12
-/// bits (4 mN) — beyond any such clamp.
-#[inline(always)]
-fn line_held(f0: i32, k: i32, e: i32, e0: i32) -> i32 {
-    const SH: u32 = STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC;
-    let df = shr_held::<SH, 31>(mul_wide(k, e.saturating_sub(e0)));
-    f0.saturating_add(df)
 }

@@ -275,6 +275,7 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>, solid: Opti
         ("slope_lo", r.slope_lo as i64),
         ("force_hi", r.force_hi as i64),
         ("stiffness_hi", r.stiffness_hi as i64),
+        ("slope_hi", r.slope_hi as i64),
         ("shift", r.shift as i64),
         ("stiff_scale", r.stiff_scale as i64),
         ("stiff_post", r.stiff_post as i64),

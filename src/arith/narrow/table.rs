@@ -5,7 +5,7 @@ use super::Narrow;
 use crate::arith::ArithTable;
 use crate::q;
 use crate::table::{cubic_value, segment_at, RawTable};
-use crate::units::{Strain, STIFF_FRAC};
+use crate::units::Strain;
 
 /// What [`table_force`] needs beyond the raw table, derived from it: the index scale and
 /// the straight lines' slopes as 16-bit operands.
@@ -29,7 +29,7 @@ impl NarrowTable {
             scale: raw.index_scale >> k,
             scale_sh: 16u32.saturating_sub(k),
             lo: NarrowLine::new(raw.slope_lo, raw.slope_lo_frac(), raw.force_lo),
-            hi: NarrowLine::new(raw.stiffness_hi, STIFF_FRAC, raw.force_hi),
+            hi: NarrowLine::new(raw.slope_hi, raw.slope_hi_frac(), raw.force_hi),
         }
     }
 }

@@ -16,7 +16,9 @@
 //! their sums saturated); one with its lower line's anchor at `i32::MAX` (the strain
 //! difference saturates); one whose range ends at `i32::MIN + 1` (the upper line's
 //! does); and the stiff series spring's (`tables/stiff_series.rs`), whose last 32
-//! segments are a graded corner, where a quarter of the single springs are put.
+//! segments are a graded corner, where a quarter of the single springs are put. The
+//! second and fourth put each line's stiffness at either end of the range where its
+//! force takes the Q28 slope (`mccs::table::fine_line`), with the largest slopes.
 //!
 //! Warm-start values, velocities and force accumulators (which wrap) are random, and each
 //! state runs a few loops in a row with the integrator between them (its velocity and
@@ -196,6 +198,7 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
     steep.stiffness_lo = i32::MAX;
     steep.slope_lo = i32::MAX;
     steep.stiffness_hi = i32::MAX;
+    steep.slope_hi = i32::MAX;
     steep.force_lo = i32::MIN + 1;
     steep.force_hi = i32::MAX - 1;
     steep.strain_hi = raw.strain_lo + (raw.strain_hi - raw.strain_lo) / 8;
@@ -210,6 +213,11 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
     anchored.anchor_lo = i32::MAX;
     anchored.stiffness_lo = (1 << 19) - 1;
     anchored.slope_lo = i32::MAX;
+    // The same for the line above (its Q28 product or its Q16 one, chosen per strain).
+    large.stiffness_hi = (1 << 19) - 1;
+    large.slope_hi = i32::MAX;
+    anchored.stiffness_hi = 1 << 19;
+    anchored.slope_hi = i32::MIN;
     let mut ends = raw;
     ends.strain_lo = i32::MIN;
     ends.strain_hi = i32::MIN + 1;
