@@ -11,7 +11,7 @@ mccs::ForceTable::<64>::from_raw(mccs::RawTable {
     force_lo: 0,
     stiffness_lo: 150757,
     slope_lo: 617501836,
-    force_hi: 10760720,
+    force_hi: 10760986,
     stiffness_hi: 316594890,
     slope_hi: 316594890,
     shift: 2,

@@ -11,7 +11,7 @@ mccs::ForceTable::<64>::from_raw(mccs::RawTable {
     force_lo: 0,
     stiffness_lo: 150757,
     slope_lo: 617501836,
-    force_hi: 6793263,
+    force_hi: 6793264,
     stiffness_hi: 959207,
     slope_hi: 959207,
     shift: 7,

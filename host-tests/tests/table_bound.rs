@@ -586,6 +586,53 @@ fn a_soft_series_springs_line_above_holds_the_bound() {
     assert!(m.within(&allowed), "{m:?}");
 }
 
+/// The line above starts at `corner_hi`, the first strain past the table, through the
+/// law's force there. It once went through the last knot's force instead, which lies up
+/// to a strain LSB below `corner_hi` (a knot is rarely a Q24 strain): along a steep
+/// `k_p` line every force above the table was off by `k_p` times that fraction of an LSB.
+/// A spring of the 10,000-spring run (number 1,774: `k_p` 222 N per unit strain, 0.19 N
+/// at `F(0.95)`, the solid point 3.4e-5 strain below the domain's end): the line was 14
+/// Q20 LSBs low, 3.7 times the force bound, all the way to the domain's end. Over
+/// `[corner_hi, 0.95]` it is now within 1.5 LSBs of the independent reference. (The
+/// spring stays refused, for the corner's last segment below the solid point.)
+#[test]
+fn the_line_above_starts_where_it_is_anchored() {
+    let p = Params {
+        cone: Cone {
+            wire_diameter: 0.035684804751812974,
+            small_diameter: 0.22593373612418716,
+            large_diameter: 0.2759579370464339,
+            active_coils: 11.10924102321305,
+            compressible_height: 0.9495196674323417,
+            shear_modulus: 118693.02799795533,
+        },
+        linear: Linear {
+            wire_diameter: 0.1302667794067873,
+            mean_diameter: 0.07075248743991168,
+            active_coils: 8.778341107257436,
+            shear_modulus: 19153.018895052664,
+            preload: Some(0.07925828179715935),
+        },
+    };
+    let r = Reference::new(&p).unwrap();
+    let law = mccs::Law::new(&p).unwrap();
+    let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    let hi = t.raw().corner_hi;
+    assert!(hi < Strain::from_num(DOMAIN.1).to_bits());
+    let end = Strain::from_num(DOMAIN.1).to_bits();
+    let mut worst = 0.0f64;
+    for e in hi..=end {
+        let (f, _) = t.force_and_stiffness(Strain::from_bits(e));
+        let x = e as f64 / (1u64 << 24) as f64;
+        worst = worst.max((f.to_num::<f64>() - r.force(x)).abs() / FORCE_LSB);
+    }
+    println!(
+        "LINEANCHOR case=kp222 strains={} worst_lsb={worst:.2}",
+        end - hi + 1
+    );
+    assert!(worst <= 1.5, "{worst} LSBs");
+}
+
 /// The table's outputs round to the nearest LSB instead of flooring: the force through
 /// the knots' bias (`mccs::table::knot_bias`), the stiffness through a rounded product
 /// (`q::mulhi_round`). On a small spring (Table 2 scaled to 0.2 N at `F(0.95)`, its

@@ -233,8 +233,9 @@ impl<const S: usize> ForceTable<S> {
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
-        // The lines are anchored on the end knots floored to Q20: the table's own values
-        // floor the same way, so the curve stays monotone across the anchors.
+        // The line below is anchored on the first knot floored to Q20 (the table's own
+        // values floor the same way, so the curve stays monotone across the anchor); the
+        // line above on the law at the first strain past the table (below).
         let l = lines::<S>(law, &grid, segs.first >> shift)?;
         let mut raw = RawTable {
             strain_lo: grid.strain_lo,
@@ -287,6 +288,14 @@ impl<const S: usize> ForceTable<S> {
             };
             (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
         }
+        // The line above passes through (corner_hi, force_hi): the law's force at corner_hi
+        // itself, to the nearest Q20 N, not the last knot's (as the segments round it),
+        // which lies up to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
+        // Along a steep line that LSB is many force LSBs: k_p = 222 N per unit strain
+        // makes it 14, all along the line (`the_line_above_starts_where_it_is_anchored`).
+        let e_hi = raw.corner_hi as f64 / (1u64 << STRAIN_FRAC) as f64;
+        raw.force_hi =
+            checked_from_f64(law.force(e_hi), FORCE_FRAC).ok_or(TableError::OutOfRange)?;
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
     }

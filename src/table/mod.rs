@@ -36,7 +36,7 @@
 //! power-basis coefficients in `τ ∈ [0, 1)`, stored as `[c0, 2c1, 4c2, 8c3]` (`4 × i32`
 //! per segment, 1112 bytes in all for 65 knots with the header) so that each Horner step is one product
 //! by `τ/2` ([`mul_t`]). `8c3 = 8(c0' − c0) − 4(2c1) − 2(4c2)` exactly, so each segment
-//! ends bit-exactly on the next knot; the straight lines are anchored on the end knots (at
+//! ends bit-exactly on the next knot; the straight lines are anchored on the table's ends (at
 //! the kink, the line through zero with `k` rounded down; each line's slope in Q28 where
 //! it fits: [`RawTable::slope_lo`], [`RawTable::slope_hi`]), so the curve is continuous
 //! and monotone.
@@ -126,7 +126,7 @@ pub struct RawTable<const S: usize> {
     /// than the product's bound for a spring below 0.4 N at `F(0.95)`.
     pub slope_lo: i32,
     /// The line above the tabulated range passes through (`corner_hi`, `force_hi`) (Q20
-    /// N): the last knot.
+    /// N): the law's force at `corner_hi`, the first strain past the last knot.
     pub force_hi: i32,
     /// Slope of the line above (Q16 N per unit strain): its stiffness (the nearest Q16
     /// value where `slope_hi` is Q28).
