@@ -74,6 +74,40 @@ fn spring(rng: &mut impl Rng) -> (Params, f64) {
     }
 }
 
+/// A preloaded spring from its cone `[d, D1, D2, n, H, G]` and series spring
+/// `[d, D, n, G, P]` (the tests' springs of the random draw).
+fn spring_of(cone: [f64; 6], linear: [f64; 5]) -> Params {
+    Params {
+        cone: Cone {
+            wire_diameter: cone[0],
+            small_diameter: cone[1],
+            large_diameter: cone[2],
+            active_coils: cone[3],
+            compressible_height: cone[4],
+            shear_modulus: cone[5],
+        },
+        linear: Linear {
+            wire_diameter: linear[0],
+            mean_diameter: linear[1],
+            active_coils: linear[2],
+            shear_modulus: linear[3],
+            preload: Some(linear[4]),
+        },
+    }
+}
+
+/// What `ForceTable::with_bound` reports when it refuses `p` at the product's bound
+/// (panics on anything else: the caller's spring is one it refuses).
+fn refused_at(p: &Params) -> TableBound {
+    match ForceTable::<128>::with_bound(p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT) {
+        Err(TableError::BoundNotMet {
+            force_ppb,
+            stiffness_ppb,
+        }) => TableBound::from_ppb(force_ppb, stiffness_ppb),
+        other => panic!("{other:?}"),
+    }
+}
+
 /// The table's largest errors over the domain against the independent reference, as
 /// the builder defines them (see `mccs::table::bound`), on a uniform sweep.
 fn independent<const S: usize>(p: &Params, t: &ForceTable<S>) -> TableBound {
@@ -242,31 +276,25 @@ const REFUSAL_DENSE: usize = 64;
 /// not also the bound). Over the bound in both measures: a real refusal.
 #[test]
 fn a_refusal_just_over_the_bound_is_confirmed() {
-    let p = Params {
-        cone: Cone {
-            wire_diameter: 0.06383410103698191,
-            small_diameter: 0.6807040693258243,
-            large_diameter: 2.395111583971223,
-            active_coils: 2.8707839195794564,
-            compressible_height: 0.7359778848921906,
-            shear_modulus: 70573.95234011757,
-        },
-        linear: Linear {
-            wire_diameter: 0.03625479273965367,
-            mean_diameter: 0.13929865876966638,
-            active_coils: 10.455388166007594,
-            shear_modulus: 619510.1272567238,
-            preload: Some(0.0027247534827282),
-        },
-    };
+    let p = spring_of(
+        [
+            0.06383410103698191,
+            0.6807040693258243,
+            2.395111583971223,
+            2.8707839195794564,
+            0.7359778848921906,
+            70573.95234011757,
+        ],
+        [
+            0.03625479273965367,
+            0.13929865876966638,
+            10.455388166007594,
+            619510.1272567238,
+            0.0027247534827282,
+        ],
+    );
     let bound = TableBound::PRODUCT;
-    let reported = match ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound) {
-        Err(TableError::BoundNotMet {
-            force_ppb,
-            stiffness_ppb,
-        }) => TableBound::from_ppb(force_ppb, stiffness_ppb),
-        other => panic!("{other:?}"),
-    };
+    let reported = refused_at(&p);
     assert!(reported.force <= bound.force && reported.stiffness > bound.stiffness);
     let m = refusal_confirmed(&p, &reported, &bound).expect("confirmed");
     // (What the old check, 0.9 of the builder's figure alone, refused to confirm.)
@@ -286,31 +314,25 @@ fn a_refusal_just_over_the_bound_is_confirmed() {
 /// refusal there. The denser sweep confirms it.
 #[test]
 fn a_refusal_in_a_corner_stiffness_step_is_confirmed_on_a_denser_sweep() {
-    let p = Params {
-        cone: Cone {
-            wire_diameter: 0.09999884560205972,
-            small_diameter: 0.10816074888376898,
-            large_diameter: 0.14345311285156548,
-            active_coils: 5.768710937260612,
-            compressible_height: 0.4798300674067617,
-            shear_modulus: 130352.12634001768,
-        },
-        linear: Linear {
-            wire_diameter: 0.03359777711843514,
-            mean_diameter: 0.06834779329444923,
-            active_coils: 9.505725237591076,
-            shear_modulus: 8639.431416106921,
-            preload: Some(96.39404665791423),
-        },
-    };
+    let p = spring_of(
+        [
+            0.09999884560205972,
+            0.10816074888376898,
+            0.14345311285156548,
+            5.768710937260612,
+            0.4798300674067617,
+            130352.12634001768,
+        ],
+        [
+            0.03359777711843514,
+            0.06834779329444923,
+            9.505725237591076,
+            8639.431416106921,
+            96.39404665791423,
+        ],
+    );
     let bound = TableBound::PRODUCT;
-    let reported = match ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound) {
-        Err(TableError::BoundNotMet {
-            force_ppb,
-            stiffness_ppb,
-        }) => TableBound::from_ppb(force_ppb, stiffness_ppb),
-        other => panic!("{other:?}"),
-    };
+    let reported = refused_at(&p);
     assert!(reported.force <= bound.force && reported.stiffness > bound.stiffness);
     let law = mccs::Law::new(&p).unwrap();
     let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
@@ -542,23 +564,23 @@ fn a_small_springs_line_below_holds_the_bound() {
 /// force bound; now its table meets the bound, as the independent reference confirms.
 #[test]
 fn a_soft_series_springs_line_above_holds_the_bound() {
-    let p = Params {
-        cone: Cone {
-            wire_diameter: 0.08415754638957852,
-            small_diameter: 0.5651093394152188,
-            large_diameter: 1.0618934130922164,
-            active_coils: 14.987850312201942,
-            compressible_height: 0.24036206468259774,
-            shear_modulus: 85054.66108542222,
-        },
-        linear: Linear {
-            wire_diameter: 0.04292775309010174,
-            mean_diameter: 0.11991117569767738,
-            active_coils: 19.332100326324046,
-            shear_modulus: 6203.585660653346,
-            preload: Some(0.017670239109131364),
-        },
-    };
+    let p = spring_of(
+        [
+            0.08415754638957852,
+            0.5651093394152188,
+            1.0618934130922164,
+            14.987850312201942,
+            0.24036206468259774,
+            85054.66108542222,
+        ],
+        [
+            0.04292775309010174,
+            0.11991117569767738,
+            19.332100326324046,
+            6203.585660653346,
+            0.017670239109131364,
+        ],
+    );
     let r = Reference::new(&p).unwrap();
     let k_p = r.series.unwrap().k_p;
     let (e_c, scale) = (r.strain_c(), r.force(DOMAIN.1));
@@ -597,23 +619,23 @@ fn a_soft_series_springs_line_above_holds_the_bound() {
 /// spring stays refused, for the corner's last segment below the solid point.)
 #[test]
 fn the_line_above_starts_where_it_is_anchored() {
-    let p = Params {
-        cone: Cone {
-            wire_diameter: 0.035684804751812974,
-            small_diameter: 0.22593373612418716,
-            large_diameter: 0.2759579370464339,
-            active_coils: 11.10924102321305,
-            compressible_height: 0.9495196674323417,
-            shear_modulus: 118693.02799795533,
-        },
-        linear: Linear {
-            wire_diameter: 0.1302667794067873,
-            mean_diameter: 0.07075248743991168,
-            active_coils: 8.778341107257436,
-            shear_modulus: 19153.018895052664,
-            preload: Some(0.07925828179715935),
-        },
-    };
+    let p = spring_of(
+        [
+            0.035684804751812974,
+            0.22593373612418716,
+            0.2759579370464339,
+            11.10924102321305,
+            0.9495196674323417,
+            118693.02799795533,
+        ],
+        [
+            0.1302667794067873,
+            0.07075248743991168,
+            8.778341107257436,
+            19153.018895052664,
+            0.07925828179715935,
+        ],
+    );
     let r = Reference::new(&p).unwrap();
     let law = mccs::Law::new(&p).unwrap();
     let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
@@ -805,28 +827,11 @@ fn named_springs_report_their_bound() {
 /// alone (a device's table) does not.
 #[test]
 fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
-    let spring = |cone: [f64; 6], linear: [f64; 5]| Params {
-        cone: Cone {
-            wire_diameter: cone[0],
-            small_diameter: cone[1],
-            large_diameter: cone[2],
-            active_coils: cone[3],
-            compressible_height: cone[4],
-            shear_modulus: cone[5],
-        },
-        linear: Linear {
-            wire_diameter: linear[0],
-            mean_diameter: linear[1],
-            active_coils: linear[2],
-            shear_modulus: linear[3],
-            preload: Some(linear[4]),
-        },
-    };
     // (name, spring, whether the corner ends at the domain's end, not the solid point.)
     let cases = [
         (
             "kp1.2e-2_p0.9",
-            spring(
+            spring_of(
                 [
                     0.0630138115362447,
                     0.3519773312502775,
@@ -847,7 +852,7 @@ fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
         ),
         (
             "kp1.4e-3_p0.9",
-            spring(
+            spring_of(
                 [
                     0.1838776985746176,
                     0.22706386652202876,
@@ -868,7 +873,7 @@ fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
         ),
         (
             "kp2.4e-1_p0.82",
-            spring(
+            spring_of(
                 [
                     0.16375711479469612,
                     0.4796241629561431,

@@ -246,7 +246,8 @@ impl<const S: usize> ForceTable<S> {
             force_lo: l.force_lo,
             stiffness_lo: l.stiffness_lo,
             slope_lo: l.slope_lo,
-            force_hi: segs.last >> shift,
+            // (The law's force at corner_hi: below, once the corner is placed.)
+            force_hi: 0,
             stiffness_hi: l.stiffness_hi,
             slope_hi: l.slope_hi,
             shift,
@@ -269,7 +270,7 @@ impl<const S: usize> ForceTable<S> {
             if !(d < 1 << 32 && grid.strain_hi < c.hi) {
                 return Err(TableError::TooNarrow);
             }
-            let last = fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
+            fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
             let (scale, post) = corner_scale(c.pre, shift)?;
             raw.corner_hi = c.hi;
             raw.corner_anchor = c.anchor;
@@ -277,7 +278,6 @@ impl<const S: usize> ForceTable<S> {
             raw.corner_base = n as u32;
             raw.corner_scale = scale;
             raw.corner_post = post;
-            raw.force_hi = last >> shift;
             // Past the solid point the law's own k_p line; past the domain's end the
             // law's tangent at the last knot, as a grid that ends there has.
             let above = match c.end {
@@ -426,20 +426,19 @@ fn magnitude(ends: &[[f64; 4]; CORNER_SEGMENTS]) -> (f64, f64) {
 }
 
 /// The corner's coefficients in the unit of `shift`, rounded as [`segments`] rounds
-/// them ([`rounded_cubic`], with octave `z`'s `2^z`); returns the last knot (at the
-/// solid point: segment `(7, 0)`'s upper end) in that unit.
+/// them ([`rounded_cubic`], with octave `z`'s `2^z`).
 fn fill_corner(
     ends: &[[f64; 4]; CORNER_SEGMENTS],
     shift: u32,
     out: &mut [[i32; 4]],
-) -> Result<i32, TableError> {
+) -> Result<(), TableError> {
     let scale = (1u64 << shift) as f64;
     for (i, (c, &[a0, a1, m0, m1])) in out.iter_mut().zip(ends).enumerate() {
         let (a0, a1) = (knot_units(a0, shift), knot_units(a1, shift));
         let z = (i / CORNER_PER_OCTAVE) as i32;
         *c = rounded_cubic(a0, a1, m0 * scale, m1 * scale, z)?;
     }
-    Ok(knot_units(ends[(CORNER_OCTAVES - 1) * CORNER_PER_OCTAVE][0], shift) as i32)
+    Ok(())
 }
 
 /// A knot's value (Q20 N, as an `f64`) in the coefficients' unit Q(20 + `shift`):
@@ -792,12 +791,11 @@ fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64)) -> Result<u32, 
     Ok(shift)
 }
 
-/// The segments' coefficients in the unit of `shift`, with the first and last knots and a
-/// bound on `|dF/dτ|` (in the unit).
+/// The segments' coefficients in the unit of `shift`, with the first knot and a bound on
+/// `|dF/dτ|` (in the unit).
 struct Segments<const S: usize> {
     coefficients: [[i32; 4]; S],
     first: i32,
-    last: i32,
     slope_bound: f64,
 }
 
@@ -822,7 +820,6 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
     Ok(Segments {
         coefficients,
         first: a_first as i32,
-        last: a0 as i32,
         slope_bound,
     })
 }
