@@ -183,6 +183,10 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         let k_lo = to_f64(raw.slope_lo, raw.slope_lo_frac());
         // And the line above's (`RawTable::slope_hi`).
         let k_hi = to_f64(raw.slope_hi, raw.slope_hi_frac());
+        // The fixed-point lines floor their product, and the builder puts half a Q20 LSB
+        // into their anchors so that the floor rounds (`mccs::table`, `rounding_anchor`):
+        // the line in float is the floor's argument less that half.
+        let half_lsb = 0.5 / (1u64 << FORCE_FRAC) as f64;
         Self {
             springs,
             n_springs: topo.edges().len(),
@@ -194,11 +198,15 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             per_strain: T::of(raw.index_scale as f64 * raw.index_pre as f64 / (1u64 << 23) as f64),
             k_lo: T::of(k_lo),
             f_lo: T::of(
-                to_f64(raw.force_lo, FORCE_FRAC) - k_lo * to_f64(raw.anchor_lo, STRAIN_FRAC),
+                to_f64(raw.force_lo, FORCE_FRAC)
+                    - half_lsb
+                    - k_lo * to_f64(raw.anchor_lo, STRAIN_FRAC),
             ),
             k_hi: T::of(k_hi),
             f_hi: T::of(
-                to_f64(raw.force_hi, FORCE_FRAC) - k_hi * to_f64(raw.strain_hi, STRAIN_FRAC),
+                to_f64(raw.force_hi, FORCE_FRAC)
+                    - half_lsb
+                    - k_hi * to_f64(raw.strain_hi, STRAIN_FRAC),
             ),
             hm: T::of(1000.0 * h / cfg.node_mass),
             half_h: T::of(0.5 * h),

@@ -694,6 +694,64 @@ fn the_table_rounds_to_the_nearest_lsb() {
     );
 }
 
+/// The line below the table rounds to the nearest LSB too, although its evaluation
+/// floors the product (`force_lo + ⌊slope · (e − anchor_lo) / 2^P⌋`): the builder places
+/// its anchor where the line's exact force is half an LSB below a Q20 value
+/// (`rounding_anchor` in `src/table/build.rs`). Before, the anchor was the kink's origin
+/// or the first knot, and every force on the line was up to a whole LSB below it, half
+/// an LSB on average: on the small spring of the test above, 1.0 of its force bound's
+/// 1.9 LSBs. 100,000 strains below `strain_lo`, against the line itself (the law's own
+/// on a table that starts at the kink; the tangent through the law's force at
+/// `strain_lo` on one that starts inside the curve), for a Q28 slope at the kink, a Q28
+/// slope off it and a Q16 slope (a spring above 8 N per unit strain there).
+#[test]
+fn the_line_below_rounds_to_the_nearest_lsb() {
+    let scaled = |to: f64| {
+        let mut p = Params::TABLE2;
+        let scale = to / Reference::new(&p).unwrap().force(DOMAIN.1);
+        p.cone.shear_modulus *= scale;
+        p.linear.shear_modulus *= scale;
+        p
+    };
+    for (case, p, from, fine) in [
+        ("kink_q28", scaled(0.2), DOMAIN.0, true),
+        ("tangent_q28", scaled(0.2), 0.3, true),
+        ("kink_q16", scaled(50.0), DOMAIN.0, false),
+    ] {
+        let law = mccs::Law::new(&p).unwrap();
+        let t = ForceTable::<128>::from_law(&law, from, DOMAIN.1).unwrap();
+        let raw = t.raw();
+        assert_eq!(mccs::table::fine_line(raw.stiffness_lo), fine, "{case}");
+        let k = raw.slope_lo as f64 / (1u64 << raw.slope_lo_frac()) as f64;
+        let lo = raw.strain_lo as f64 / (1u64 << 24) as f64;
+        let at_kink = from == DOMAIN.0;
+        // The exact line (N) at strain e.
+        let line = |e: f64| {
+            if at_kink {
+                k * e
+            } else {
+                law.force(lo) + k * (e - lo)
+            }
+        };
+        let n = 100_000i64;
+        let start = Strain::from_num(-0.5).to_bits();
+        let (mut sum, mut worst) = (0.0f64, 0.0f64);
+        for i in 0..=n {
+            let bits = start + ((raw.strain_lo - start) as i64 * i / n) as i32;
+            let (f, _) = t.force_and_stiffness(Strain::from_bits(bits));
+            let err = (f.to_num::<f64>() - line(bits as f64 / (1u64 << 24) as f64)) / FORCE_LSB;
+            sum += err;
+            worst = worst.max(err.abs());
+        }
+        let mean = sum / (n + 1) as f64;
+        println!("LINEROUNDING case={case} mean_lsb={mean:.3} max_lsb={worst:.3}");
+        assert!(
+            mean.abs() < 0.1 && worst < 0.53,
+            "{case}: mean {mean}, max {worst} LSB"
+        );
+    }
+}
+
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device
 /// takes (`from_law`, the first that builds), on 200 random springs: its largest error
 /// relative to the product's bound is at most the other's. Prints how many it improved.

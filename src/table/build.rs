@@ -233,8 +233,8 @@ impl<const S: usize> ForceTable<S> {
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
-        // The line below is anchored on the first knot floored to Q20 (the table's own
-        // values floor the same way, so the curve stays monotone across the anchor); the
+        // The line below is anchored where its floor rounds, never above the first knot
+        // (`first`, the knot's Q20 value), so that the curve stays monotone across it; the
         // line above on the law at the first strain past the table (below).
         let l = lines::<S>(law, &grid, segs.first >> shift)?;
         let mut raw = RawTable {
@@ -293,9 +293,16 @@ impl<const S: usize> ForceTable<S> {
         // which lies up to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
         // Along a steep line that LSB is many force LSBs: k_p = 222 N per unit strain
         // makes it 14, all along the line (`the_line_above_starts_where_it_is_anchored`).
+        // Its anchor cannot move (corner_hi ends the table), so the floor of the line's
+        // product is balanced in its force instead: `⌊F + 1⌋` LSBs, which puts the line
+        // within (−1, 1) LSB of the law where the nearest Q20 value put it within
+        // [−1.5, 0.5) (the anchor below is placed for a true rounding: `rounding_anchor`).
         let e_hi = raw.corner_hi as f64 / (1u64 << STRAIN_FRAC) as f64;
-        raw.force_hi =
-            checked_from_f64(law.force(e_hi), FORCE_FRAC).ok_or(TableError::OutOfRange)?;
+        let f_hi = libm::floor(law.force(e_hi) * (1u64 << FORCE_FRAC) as f64) + 1.0;
+        if !(f_hi >= i32::MIN as f64 && f_hi <= i32::MAX as f64) {
+            return Err(TableError::OutOfRange);
+        }
+        raw.force_hi = f_hi as i32;
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
     }
@@ -869,8 +876,10 @@ struct Lines {
 /// down so that the line never passes above the first knot (the curve stays monotone;
 /// the step up at the knot is `(k − k_q) ε_lo`: at most 2⁻²⁸ ε_lo N with the Q28 slope
 /// of [`RawTable::slope_lo`], 2⁻¹⁶ ε_lo N without); otherwise the tangent at the domain
-/// edge, through the first knot (`first_q20`). Above the table, the line through the
-/// last knot: `k_p` when the table ends at the solid point, else the tangent there.
+/// edge, through the law at the first knot; either anchored by [`rounding_anchor`] and
+/// held at or below the first knot's value (`first_q20`). Above the table, the line
+/// through the last knot: `k_p` when the table ends at the solid point, else the tangent
+/// there.
 fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines, TableError> {
     let (k, round): (f64, fn(f64) -> f64) = if grid.at_kink {
         (law.k, libm::floor)
@@ -878,11 +887,24 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
         (1.0 / law.compliance(law.force(grid.lo)), libm::round)
     };
     let (stiffness_lo, slope_lo) = line_slopes(k, round)?;
-    let (anchor_lo, force_lo) = if grid.at_kink {
-        (0, 0)
+    // The line's exact point: the origin on a table that starts at the kink, else the
+    // law at the first knot (whose rounded force, `first_q20`, the table starts from).
+    let (e_a, f_a) = if grid.at_kink {
+        (0, 0.0)
     } else {
-        (grid.strain_lo, first_q20)
+        let e = grid.strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
+        (grid.strain_lo, law.force(e) * (1u64 << FORCE_FRAC) as f64)
     };
+    let (anchor_lo, mut force_lo) = rounding_anchor(e_a, f_a, slope_lo, stiffness_lo)?;
+    // Never above the first knot at strain_lo, so that the curve stays monotone across
+    // it (the nearest Q20 values of the law there may differ by one LSB from the knot's).
+    let p = line_product_shift(stiffness_lo);
+    let at_lo =
+        force_lo as i64 + ((slope_lo as i64 * (grid.strain_lo as i64 - anchor_lo as i64)) >> p);
+    if at_lo > first_q20 as i64 {
+        force_lo = i32::try_from(force_lo as i64 - (at_lo - first_q20 as i64))
+            .map_err(|_| TableError::OutOfRange)?;
+    }
     let e_hi = grid.lo + grid.used as f64 * grid.step;
     let above = if grid.at_solid {
         law.k_p
@@ -898,6 +920,58 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
         stiffness_hi,
         slope_hi,
     })
+}
+
+/// An anchor `(e0, f0)` (Q24 strain, Q20 N) for the line through `(e_a, f_a)` (Q24,
+/// Q20 units, exact) with this slope, such that the evaluation's
+/// `f0 + ⌊slope · (e − e0) / 2^P⌋` (`P` = 32 for a Q28 slope, 20 for a Q16 one: the
+/// product's high word, or its floor shifted) rounds the line to the nearest Q20 N instead
+/// of flooring it (issue #16: the floor put every force on the line up to a whole LSB
+/// below the law, which cost small springs their bound). With `s_j = slope · j / 2^P`, the
+/// table is `⌊L(e) + ½ − r⌋` for `e0 = e_a + j`, `f0 = ⌊f_a + ½ + s_j⌋` and
+/// `r = frac(f_a + ½ + s_j)`: the search takes the `j` (within ±1,024 strain LSBs) with
+/// the least `r`, stopping below 1/64, so that a force on the line is within
+/// `½ + r` LSB of it (and never above its rounding: a table at the kink stays below its
+/// first knot). No cost per evaluation: only where the line is anchored moves.
+fn rounding_anchor(
+    e_a: i32,
+    f_a: f64,
+    slope: i32,
+    stiffness: i32,
+) -> Result<(i32, i32), TableError> {
+    let p = line_product_shift(stiffness);
+    let residual = |j: i32| {
+        let x = f_a + 0.5 + libm::ldexp(slope as f64 * j as f64, -(p as i32));
+        x - libm::floor(x)
+    };
+    let fits = |j: i32| e_a.checked_add(j).is_some();
+    let mut best = 0;
+    for step in 1..=1024 {
+        if residual(best) < 1.0 / 64.0 {
+            break;
+        }
+        for j in [step, -step] {
+            if fits(j) && residual(j) < residual(best) {
+                best = j;
+            }
+        }
+    }
+    let x = f_a + 0.5 + libm::ldexp(slope as f64 * best as f64, -(p as i32));
+    let f0 = libm::floor(x);
+    if !(f0 >= i32::MIN as f64 && f0 <= i32::MAX as f64) {
+        return Err(TableError::OutOfRange);
+    }
+    Ok((e_a + best, f0 as i32))
+}
+
+/// The shift `P` that takes a line's product `slope · Δe` to Q20 N: 32 with a Q28 slope
+/// (its high word), 20 with a Q16 one.
+fn line_product_shift(stiffness: i32) -> u32 {
+    if fine_line(stiffness) {
+        FINE_SLOPE_FRAC + STRAIN_FRAC - FORCE_FRAC
+    } else {
+        STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC
+    }
 }
 
 /// A line's `(stiffness, slope)` for the slope `k` (N per unit strain), `round`ed: the

@@ -110,8 +110,11 @@ pub struct RawTable<const S: usize> {
     pub index_pre: u32,
     /// See `index_pre`.
     pub index_scale: u32,
-    /// The line below `strain_lo` passes through (`anchor_lo`, `force_lo`) (Q24, Q20 N):
-    /// through zero when the table starts at the kink, else through the first knot.
+    /// The line below `strain_lo` is `force_lo + ⌊slope_lo · (e − anchor_lo)⌋` (Q24,
+    /// Q20 N; the product in Q20): a floor, so a built table puts the anchor where the
+    /// exact line is half an LSB below `force_lo`, within 1,024 strain LSBs of its own
+    /// point (zero when the table starts at the kink, else the law at the first knot),
+    /// and the line rounds to the nearest Q20 N (`docs/accuracy.md`).
     pub anchor_lo: i32,
     /// See `anchor_lo`.
     pub force_lo: i32,
@@ -125,8 +128,10 @@ pub struct RawTable<const S: usize> {
     /// unit strain, which over the tension end of the domain is up to 8 force LSBs: more
     /// than the product's bound for a spring below 0.4 N at `F(0.95)`.
     pub slope_lo: i32,
-    /// The line above the tabulated range passes through (`corner_hi`, `force_hi`) (Q20
-    /// N): the law's force at `corner_hi`, the first strain past the last knot.
+    /// The line above the tabulated range is `force_hi + ⌊slope_hi · (e − corner_hi)⌋`
+    /// (Q20 N): on a built table `force_hi` is the law's force at `corner_hi` (the first
+    /// strain past the last knot) floored, plus one LSB, which balances the product's
+    /// floor (the line within (−1, 1) LSB of the law).
     pub force_hi: i32,
     /// Slope of the line above (Q16 N per unit strain): its stiffness (the nearest Q16
     /// value where `slope_hi` is Q28).
