@@ -752,6 +752,52 @@ fn the_line_below_rounds_to_the_nearest_lsb() {
     }
 }
 
+/// A preload's kink inside the graded corner toward the solid point gets a knot, with the
+/// law's slope from each side on the segments either side of it. Spring 195 of the 1,000
+/// (`k_p/k` 72, preloaded to 0.9 `F_C`: its kink `Δ(P)` 7e-3 strain below the solid
+/// point) was refused at 1.04 times the force bound, its error a cubic across the kink
+/// (12 LSBs). `from_law_best` now also tries the corner lengths that put one of its
+/// knots on `Δ(P)` (`kink_on_knot`). Its table meets the bound, and the independent
+/// reference agrees.
+#[test]
+fn a_preload_kink_in_the_graded_corner_sits_on_a_knot() {
+    let p = spring_of(
+        [
+            0.036135718024974804,
+            0.3666530642744079,
+            0.48875281126334436,
+            6.315522131293631,
+            0.91112220027952,
+            294801.7828751232,
+        ],
+        [
+            0.21320476344835468,
+            0.08072468335819159,
+            9.01454497985456,
+            165.76270783221173,
+            0.16551249802441623,
+        ],
+    );
+    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("within the bound");
+    let r = Reference::new(&p).unwrap();
+    let e_p = r.delta(p.linear.preload.unwrap());
+    let (a, b) = (
+        t.raw().strain_hi as f64 / (1u64 << 24) as f64,
+        t.raw().corner_hi as f64 / (1u64 << 24) as f64,
+    );
+    assert!(
+        a < e_p && e_p < b,
+        "the kink {e_p} inside the corner [{a}, {b})"
+    );
+    let m = independent(&p, &t);
+    println!(
+        "KINKKNOT case=spring195 force={:.1e} stiffness={:.1e}",
+        m.force, m.stiffness
+    );
+    assert!(m.within(&TableBound::PRODUCT), "{m:?}");
+}
+
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device
 /// takes (`from_law`, the first that builds), on 200 random springs: its largest error
 /// relative to the product's bound is at most the other's. Prints how many it improved.

@@ -118,9 +118,18 @@ impl<const S: usize> ForceTable<S> {
         let solid_near = e_c <= to + 0.5 * (to - lo);
         if missed && S >= 2 * CORNER_SEGMENTS && solid_near {
             let curved = e_c - lo;
+            // A preload's kink Δ(P) inside such a corner needs a knot on it (a cubic
+            // across a kink misses by the slope's jump times a fraction of the segment):
+            // after the usual lengths, those that put a corner knot on Δ(P).
+            let e_p = law.delta(law.preload);
+            let kinked = law.preload > law.f_t && e_p > lo && e_p < e_c;
+            let on_kink = (0..KINK_KNOTS.len()).filter_map(|i| {
+                let len = kink_on_knot(e_c - e_p, KINK_KNOTS[i])?;
+                (kinked && len < curved).then_some(len)
+            });
             'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
-                for fraction in CORNER_FRACTIONS {
-                    let len = fraction * curved;
+                let lens = CORNER_FRACTIONS.map(|f| f * curved);
+                for len in lens.into_iter().chain(on_kink.clone()) {
                     let built = if align == Align::FromDomain {
                         Self::on_grid::<true, true>(law, from, to, align, len, CornerEnd::Solid)
                     } else {
@@ -324,6 +333,10 @@ struct Corner {
     start: f64,
     /// Where it ends: at the solid point, the last knot's force is `F_C` exactly.
     end: CornerEnd,
+    /// The knot `(z, jj)` that lies on a preload's kink `Δ(P)` (within
+    /// [`KINK_ON_KNOT_LSB`]), if one does: the segments on either side of it take the
+    /// law's slope from their own side.
+    kink: Option<(usize, usize)>,
 }
 
 /// Where a graded corner ends: its last knot, where the line above starts.
@@ -363,12 +376,25 @@ impl Corner {
         if start.partial_cmp(&to) != Some(core::cmp::Ordering::Less) {
             return Err(TableError::TooNarrow);
         }
+        let pre = pre as u32;
+        let kink = if law.preload > law.f_t {
+            let e_p = law.delta(law.preload) * unit;
+            (0..CORNER_OCTAVES)
+                .flat_map(|z| (0..CORNER_PER_OCTAVE).map(move |jj| (z, jj)))
+                .find(|&(z, jj)| {
+                    let e = corner_strain(anchor, pre, z, jj) * unit;
+                    libm::fabs(e - e_p) < KINK_ON_KNOT_LSB
+                })
+        } else {
+            None
+        };
         Ok(Self {
             anchor,
-            pre: pre as u32,
+            pre,
             hi: hi as i32,
             start,
             end,
+            kink,
         })
     }
 
@@ -409,9 +435,24 @@ impl Corner {
                 _ => knots[z - 1][0],
             };
         }
+        // On a preload's kink: the slope from below for the segment under the knot, from
+        // above for the one over it (a knot is in both).
+        let unit = (1u64 << FORCE_FRAC) as f64;
+        let below = 1.0 / law.compliance(law.preload) * unit;
+        let above = 1.0 / law.compliance_above(law.preload) * unit;
+        let is_kink = |z: usize, jj: usize| {
+            self.kink == Some((z, jj))
+                || (jj == CORNER_PER_OCTAVE && z >= 1 && self.kink == Some((z - 1, 0)))
+        };
         Ok(core::array::from_fn(|i| {
             let (z, j) = (i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE);
-            let ((a0, k0), (a1, k1)) = (knots[z][j], knots[z][j + 1]);
+            let ((a0, mut k0), (a1, mut k1)) = (knots[z][j], knots[z][j + 1]);
+            if is_kink(z, j) {
+                k0 = below;
+            }
+            if is_kink(z, j + 1) {
+                k1 = above;
+            }
             let w = self.strain(z, j) - self.strain(z, j + 1);
             [a0, a1, -k0 * w, -k1 * w]
         }))
@@ -481,6 +522,44 @@ fn with_post(mut v: f64) -> Result<(i32, i32), TableError> {
 /// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
 /// law's curved part.
 const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
+
+/// How near (Q24 LSBs) a corner knot must lie to a preload's kink to take the law's
+/// one-sided slopes there ([`Corner::kink`]).
+const KINK_ON_KNOT_LSB: f64 = 64.0;
+
+/// The corner knots `(z, jj)` ([`corner_strain`]) that [`ForceTable::from_law_best`]
+/// tries to put on a preload's kink inside a corner toward the solid point: each
+/// octave's outer end and midpoint.
+const KINK_KNOTS: [(u32, u32); 16] = [
+    (0, 0),
+    (0, 2),
+    (1, 0),
+    (1, 2),
+    (2, 0),
+    (2, 2),
+    (3, 0),
+    (3, 2),
+    (4, 0),
+    (4, 2),
+    (5, 0),
+    (5, 2),
+    (6, 0),
+    (6, 2),
+    (7, 0),
+    (7, 2),
+];
+
+/// The corner length (strain) whose knot `(z, jj)` lies `below` (strain) under its end:
+/// with `D` = `below` in Q24 LSBs, the anchor `2²⁴/pre` past the end and the knot at
+/// `2^(31 − z) (1 + jj/4) / pre` under the anchor, `pre = (2^(31 − z)(1 + jj/4) − 2²⁴)/D`
+/// (rounded: the knot then lies within a few strain LSBs of the kink), and the length
+/// `2³²/pre` LSBs. `None` where `pre` is out of [`Corner::place`]'s range.
+fn kink_on_knot(below: f64, (z, jj): (u32, u32)) -> Option<f64> {
+    let unit = (1u64 << STRAIN_FRAC) as f64;
+    let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
+    let pre = libm::round((d - libm::ldexp(1.0, 24)) / (below * unit));
+    (pre >= 1.0 && pre <= libm::ldexp(1.0, 24)).then(|| libm::ldexp(1.0, 32) / (pre * unit))
+}
 
 /// Where the graded corner above a preload's kink starts, as fractions of the way from
 /// `Δ(P)` to its end ([`ForceTable::from_law_best`]): the uniform grid ends there.
