@@ -123,10 +123,13 @@ impl<const S: usize> ForceTable<S> {
             // after the usual lengths, those that put a corner knot on Δ(P).
             let e_p = law.delta(law.preload);
             let kinked = law.preload > law.f_t && e_p > lo && e_p < e_c;
-            let on_kink = (0..KINK_KNOTS.len()).filter_map(|i| {
-                let len = kink_on_knot(e_c - e_p, KINK_KNOTS[i])?;
-                (kinked && len < curved).then_some(len)
-            });
+            // (Each octave's outer end and midpoint.)
+            let on_kink = (0..CORNER_OCTAVES as u32)
+                .flat_map(|z| [(z, 0), (z, 2)])
+                .filter_map(|knot| {
+                    let len = kink_on_knot(e_c - e_p, knot)?;
+                    (kinked && len < curved).then_some(len)
+                });
             'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
                 let lens = CORNER_FRACTIONS.map(|f| f * curved);
                 for len in lens.into_iter().chain(on_kink.clone()) {
@@ -165,6 +168,23 @@ impl<const S: usize> ForceTable<S> {
                     if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
                         if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                             break 'above_kink;
+                        }
+                    }
+                }
+            }
+        }
+        // Still missed, with Δ(P) inside the domain: the corner graded toward Δ(P) from
+        // below, over a fraction of the curved part under it, and the law's tangent from
+        // above as the line past it (`CornerEnd::Kink`).
+        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
+            'to_kink: for align in [Align::Shortest, Align::Off] {
+                for fraction in CORNER_FRACTIONS {
+                    let len = fraction * (e_p - lo);
+                    let end = CornerEnd::Kink;
+                    if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
+                            break 'to_kink;
                         }
                     }
                 }
@@ -294,6 +314,7 @@ impl<const S: usize> ForceTable<S> {
                 CornerEnd::DomainEnd => {
                     1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0)))
                 }
+                CornerEnd::Kink => 1.0 / law.compliance_above(law.preload),
             };
             (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
         }
@@ -350,6 +371,12 @@ enum CornerEnd {
     /// point. Past the domain's end the line above is the law's tangent there (as on a
     /// grid that ends there).
     DomainEnd,
+    /// At a preload's kink `Δ(P)`, graded toward it from below, where the cone rises
+    /// steeply toward its own solid point (`P` near `F_C`); past it the law's tangent
+    /// from above as the line above, which holds where the series spring is much softer
+    /// than the cone there (the law above `Δ(P)` then nearly straight). Its last knot is
+    /// `P` with the slope from below.
+    Kink,
 }
 
 impl Corner {
@@ -359,7 +386,16 @@ impl Corner {
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
+            CornerEnd::Kink => law.delta(law.preload),
         };
+        // Every other placement has knots up to the domain's end, each held within the
+        // format's range (`Corner::knot`, `Grid::knot`); this one's line must be too.
+        // (False for a NaN too.)
+        let within =
+            libm::fabs(law.force(to)) * ((1u64 << FORCE_FRAC) as f64) < (1u64 << 30) as f64;
+        if end == CornerEnd::Kink && !within {
+            return Err(TableError::OutOfRange);
+        }
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
         // The nearest octave's inner end at least a strain LSB from the anchor.
@@ -407,10 +443,11 @@ impl Corner {
     /// solid point (the last knot of a corner ending there) the law's own `F_C` and
     /// slope from below.
     fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
-        let f = if self.end == CornerEnd::Solid && z == CORNER_OCTAVES - 1 && jj == 0 {
-            law.f_c
-        } else {
-            law.force(self.strain(z, jj))
+        let last = z == CORNER_OCTAVES - 1 && jj == 0;
+        let f = match self.end {
+            CornerEnd::Solid if last => law.f_c,
+            CornerEnd::Kink if last => law.preload,
+            _ => law.force(self.strain(z, jj)),
         };
         let k = 1.0 / law.compliance(f);
         let unit = (1u64 << FORCE_FRAC) as f64;
@@ -527,33 +564,12 @@ const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
 /// one-sided slopes there ([`Corner::kink`]).
 const KINK_ON_KNOT_LSB: f64 = 64.0;
 
-/// The corner knots `(z, jj)` ([`corner_strain`]) that [`ForceTable::from_law_best`]
-/// tries to put on a preload's kink inside a corner toward the solid point: each
-/// octave's outer end and midpoint.
-const KINK_KNOTS: [(u32, u32); 16] = [
-    (0, 0),
-    (0, 2),
-    (1, 0),
-    (1, 2),
-    (2, 0),
-    (2, 2),
-    (3, 0),
-    (3, 2),
-    (4, 0),
-    (4, 2),
-    (5, 0),
-    (5, 2),
-    (6, 0),
-    (6, 2),
-    (7, 0),
-    (7, 2),
-];
-
 /// The corner length (strain) whose knot `(z, jj)` lies `below` (strain) under its end:
 /// with `D` = `below` in Q24 LSBs, the anchor `2²⁴/pre` past the end and the knot at
 /// `2^(31 − z) (1 + jj/4) / pre` under the anchor, `pre = (2^(31 − z)(1 + jj/4) − 2²⁴)/D`
 /// (rounded: the knot then lies within a few strain LSBs of the kink), and the length
 /// `2³²/pre` LSBs. `None` where `pre` is out of [`Corner::place`]'s range.
+/// [`ForceTable::from_law_best`] tries each octave's outer end and midpoint.
 fn kink_on_knot(below: f64, (z, jj): (u32, u32)) -> Option<f64> {
     let unit = (1u64 << STRAIN_FRAC) as f64;
     let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
