@@ -108,6 +108,18 @@ fn refused_at(p: &Params) -> TableBound {
     }
 }
 
+/// The table `ForceTable::with_bound` builds for a preloaded `p` within the product's
+/// bound (panics if it refuses), its preload's kink `Δ(P)` and its graded corner's range
+/// `[strain_hi, corner_hi)` (strain).
+fn met_with_corner(p: &Params) -> (ForceTable<128>, f64, (f64, f64)) {
+    let t = ForceTable::<128>::with_bound(p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("within the bound");
+    let e_p = Reference::new(p).unwrap().delta(p.linear.preload.unwrap());
+    let strain = |bits: i32| bits as f64 / (1u64 << 24) as f64;
+    let corner = (strain(t.raw().strain_hi), strain(t.raw().corner_hi));
+    (t, e_p, corner)
+}
+
 /// The table's largest errors over the domain against the independent reference, as
 /// the builder defines them (see `mccs::table::bound`), on a uniform sweep.
 fn independent<const S: usize>(p: &Params, t: &ForceTable<S>) -> TableBound {
@@ -335,10 +347,7 @@ fn a_refusal_once_confirmed_only_on_a_denser_sweep_now_meets_the_bound() {
         ],
     );
     let bound = TableBound::PRODUCT;
-    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound).expect("met");
-    let r = Reference::new(&p).unwrap();
-    let e_p = r.delta(p.linear.preload.unwrap());
-    let end = t.raw().corner_hi as f64 / (1u64 << 24) as f64;
+    let (t, e_p, (_, end)) = met_with_corner(&p);
     assert!(
         (end - e_p).abs() < 1e-6,
         "the corner ends at {end}, Δ(P) {e_p}"
@@ -786,14 +795,7 @@ fn a_preload_kink_in_the_graded_corner_sits_on_a_knot() {
             0.16551249802441623,
         ],
     );
-    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
-        .expect("within the bound");
-    let r = Reference::new(&p).unwrap();
-    let e_p = r.delta(p.linear.preload.unwrap());
-    let (a, b) = (
-        t.raw().strain_hi as f64 / (1u64 << 24) as f64,
-        t.raw().corner_hi as f64 / (1u64 << 24) as f64,
-    );
+    let (t, e_p, (a, b)) = met_with_corner(&p);
     assert!(
         a < e_p && e_p < b,
         "the kink {e_p} inside the corner [{a}, {b})"
@@ -833,11 +835,7 @@ fn a_corner_graded_toward_a_preloads_kink_from_below() {
             88.12073296802753,
         ],
     );
-    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
-        .expect("within the bound");
-    let r = Reference::new(&p).unwrap();
-    let e_p = r.delta(p.linear.preload.unwrap());
-    let end = t.raw().corner_hi as f64 / (1u64 << 24) as f64;
+    let (t, e_p, (_, end)) = met_with_corner(&p);
     assert!(
         (end - e_p).abs() < 1e-6,
         "the corner ends at {end}, Δ(P) {e_p}"
