@@ -441,7 +441,8 @@ impl Corner {
 
     /// The force and stiffness at `(z, jj)`, in Q20 N and N per unit strain: at the
     /// solid point (the last knot of a corner ending there) the law's own `F_C` and
-    /// slope from below.
+    /// slope from below; at a preload's kink (the last knot of [`CornerEnd::Kink`]) `P`
+    /// and the slope from below.
     fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
         let last = z == CORNER_OCTAVES - 1 && jj == 0;
         let f = match self.end {
