@@ -96,6 +96,20 @@ fn spring_of(cone: [f64; 6], linear: [f64; 5]) -> Params {
     }
 }
 
+/// Table 2 with both springs' shear moduli times `scale`: every force and stiffness
+/// `scale` times Table 2's, the strains the same.
+fn table2_scaled(scale: f64) -> Params {
+    let mut p = Params::TABLE2;
+    p.cone.shear_modulus *= scale;
+    p.linear.shear_modulus *= scale;
+    p
+}
+
+/// [`table2_scaled`] to `f95` N at `F(0.95)`.
+fn table2_at(f95: f64) -> Params {
+    table2_scaled(f95 / Reference::new(&Params::TABLE2).unwrap().force(DOMAIN.1))
+}
+
 /// What `ForceTable::with_bound` reports when it refuses `p` at the product's bound
 /// (panics on anything else: the caller's spring is one it refuses).
 fn refused_at(p: &Params) -> TableBound {
@@ -533,12 +547,9 @@ fn the_inner_corner_is_on_a_knot_and_meets_the_bound() {
 /// `mccs table`'s.
 #[test]
 fn a_small_springs_line_below_holds_the_bound() {
-    let mut p = Params::TABLE2;
-    let r = Reference::new(&p).unwrap();
+    let r = Reference::new(&Params::TABLE2).unwrap();
     let k = r.k * 0.2 / r.force(DOMAIN.1) / STIFFNESS_LSB;
-    let scale = (k.floor() + 0.9) * STIFFNESS_LSB / r.k;
-    p.cone.shear_modulus *= scale;
-    p.linear.shear_modulus *= scale;
+    let p = table2_scaled((k.floor() + 0.9) * STIFFNESS_LSB / r.k);
     let r = Reference::new(&p).unwrap();
     assert!((r.force(DOMAIN.1) - 0.2).abs() < 1e-3 && r.strain_t() > DOMAIN.0);
     let law = mccs::Law::new(&p).unwrap();
@@ -681,10 +692,7 @@ fn the_line_above_starts_where_it_is_anchored() {
 /// (flooring: up to 1).
 #[test]
 fn the_table_rounds_to_the_nearest_lsb() {
-    let mut p = Params::TABLE2;
-    let scale = 0.2 / Reference::new(&p).unwrap().force(DOMAIN.1);
-    p.cone.shear_modulus *= scale;
-    p.linear.shear_modulus *= scale;
+    let p = table2_at(0.2);
     let r = Reference::new(&p).unwrap();
     let law = mccs::Law::new(&p).unwrap();
     let t = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1).unwrap();
@@ -723,17 +731,10 @@ fn the_table_rounds_to_the_nearest_lsb() {
 /// slope off it and a Q16 slope (a spring above 8 N per unit strain there).
 #[test]
 fn the_line_below_rounds_to_the_nearest_lsb() {
-    let scaled = |to: f64| {
-        let mut p = Params::TABLE2;
-        let scale = to / Reference::new(&p).unwrap().force(DOMAIN.1);
-        p.cone.shear_modulus *= scale;
-        p.linear.shear_modulus *= scale;
-        p
-    };
     for (case, p, from, fine) in [
-        ("kink_q28", scaled(0.2), DOMAIN.0, true),
-        ("tangent_q28", scaled(0.2), 0.3, true),
-        ("kink_q16", scaled(50.0), DOMAIN.0, false),
+        ("kink_q28", table2_at(0.2), DOMAIN.0, true),
+        ("tangent_q28", table2_at(0.2), 0.3, true),
+        ("kink_q16", table2_at(50.0), DOMAIN.0, false),
     ] {
         let law = mccs::Law::new(&p).unwrap();
         let t = ForceTable::<128>::from_law(&law, from, DOMAIN.1).unwrap();

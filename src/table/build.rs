@@ -4,9 +4,9 @@
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
 use super::{
-    corner_strain, fine_line, knot_bias, measure, ForceTable, RawTable, TableBound, TableError,
-    CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, FINE_SLOPE_FRAC,
-    UNMEASURED,
+    corner_strain, fine_line, knot_bias, measure, slope_frac, ForceTable, RawTable, TableBound,
+    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN,
+    FINE_SLOPE_FRAC, UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -318,9 +318,9 @@ impl<const S: usize> ForceTable<S> {
             };
             (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
         }
-        // The line above passes through (corner_hi, force_hi): the law's force at corner_hi
-        // itself, to the nearest Q20 N, not the last knot's (as the segments round it),
-        // which lies up to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
+        // The line above passes through (corner_hi, force_hi): from the law's force at
+        // corner_hi itself, not the last knot's (as the segments round it), which lies up
+        // to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
         // Along a steep line that LSB is many force LSBs: k_p = 222 N per unit strain
         // makes it 14, all along the line (`the_line_above_starts_where_it_is_anchored`).
         // Its anchor cannot move (corner_hi ends the table), so the floor of the line's
@@ -390,11 +390,13 @@ impl Corner {
         };
         // Every other placement has knots up to the domain's end, each held within the
         // format's range (`Corner::knot`, `Grid::knot`); this one's line must be too.
-        // (False for a NaN too.)
-        let within =
-            libm::fabs(law.force(to)) * ((1u64 << FORCE_FRAC) as f64) < (1u64 << 30) as f64;
-        if end == CornerEnd::Kink && !within {
-            return Err(TableError::OutOfRange);
+        // (`within` is false for a NaN too.)
+        if end == CornerEnd::Kink {
+            let within =
+                libm::fabs(law.force(to)) * ((1u64 << FORCE_FRAC) as f64) < (1u64 << 30) as f64;
+            if !within {
+                return Err(TableError::OutOfRange);
+            }
         }
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
@@ -994,7 +996,7 @@ fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines
     let (anchor_lo, mut force_lo) = rounding_anchor(e_a, f_a, slope_lo, stiffness_lo)?;
     // Never above the first knot at strain_lo, so that the curve stays monotone across
     // it (the nearest Q20 values of the law there may differ by one LSB from the knot's).
-    let p = line_product_shift(stiffness_lo);
+    let p = slope_frac(stiffness_lo) + STRAIN_FRAC - FORCE_FRAC;
     let at_lo =
         force_lo as i64 + ((slope_lo as i64 * (grid.strain_lo as i64 - anchor_lo as i64)) >> p);
     if at_lo > first_q20 as i64 {
@@ -1035,11 +1037,11 @@ fn rounding_anchor(
     slope: i32,
     stiffness: i32,
 ) -> Result<(i32, i32), TableError> {
-    let p = line_product_shift(stiffness);
-    let residual = |j: i32| {
-        let x = f_a + 0.5 + libm::ldexp(slope as f64 * j as f64, -(p as i32));
-        x - libm::floor(x)
-    };
+    // The product's shift to Q20 N: 32 with a Q28 slope (its high word), 20 with Q16.
+    let p = slope_frac(stiffness) + STRAIN_FRAC - FORCE_FRAC;
+    // `f_a + ½ + s_j`, and its fraction `r`.
+    let x = |j: i32| f_a + 0.5 + libm::ldexp(slope as f64 * j as f64, -(p as i32));
+    let residual = |j: i32| x(j) - libm::floor(x(j));
     let fits = |j: i32| e_a.checked_add(j).is_some();
     let mut best = 0;
     for step in 1..=1024 {
@@ -1052,22 +1054,11 @@ fn rounding_anchor(
             }
         }
     }
-    let x = f_a + 0.5 + libm::ldexp(slope as f64 * best as f64, -(p as i32));
-    let f0 = libm::floor(x);
+    let f0 = libm::floor(x(best));
     if !(f0 >= i32::MIN as f64 && f0 <= i32::MAX as f64) {
         return Err(TableError::OutOfRange);
     }
     Ok((e_a + best, f0 as i32))
-}
-
-/// The shift `P` that takes a line's product `slope · Δe` to Q20 N: 32 with a Q28 slope
-/// (its high word), 20 with a Q16 one.
-fn line_product_shift(stiffness: i32) -> u32 {
-    if fine_line(stiffness) {
-        FINE_SLOPE_FRAC + STRAIN_FRAC - FORCE_FRAC
-    } else {
-        STIFF_FRAC + STRAIN_FRAC - FORCE_FRAC
-    }
 }
 
 /// A line's `(stiffness, slope)` for the slope `k` (N per unit strain), `round`ed: the

@@ -586,7 +586,7 @@ impl<const S: usize> RawTable<S> {
 }
 
 /// Fraction bits of a line's force slope with this stiffness (Q16).
-const fn slope_frac(stiffness: i32) -> u32 {
+pub(crate) const fn slope_frac(stiffness: i32) -> u32 {
     if fine_line(stiffness) {
         FINE_SLOPE_FRAC
     } else {
