@@ -9,8 +9,8 @@ use core::hint::black_box;
 use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
 use mccs::{
-    Arith, DefaultArith, Edge, ForceTable64, Length, ProxyConfig, Solver, SolverConfig, Strain,
-    Topology, WindowConfig,
+    Arith, DefaultArith, Edge, End, ForceTable64, Length, ProxyConfig, Solver, SolverConfig,
+    Strain, Topology, WindowConfig,
 };
 use mccs_firmware::demo::{self, DemoSpec};
 use mccs_firmware::entry as e;
@@ -461,4 +461,65 @@ fn roaming_in<const N: usize, const E: usize, const CAP: bool>(
         exit(false)
     }
     out
+}
+
+/// One spring where the solver runs it (`e::spring_loop`, on the M4F its assembly loop),
+/// per spring, with every spring at the same `strain` (compression positive) on `table`:
+/// 16 springs in parallel between two free nodes 2.5 mm apart, the far end displaced
+/// along the springs (and 0.1 mm across), both ends moving. What each path of a spring
+/// costs (the table's line below, uniform part, graded corner and line above, an edge
+/// vector held at ±2, `l0/l` held), so that a tick's cost can be bounded over every
+/// state, not only the pressed patch's. The loop's own overhead per call is in the
+/// figure (1/16 of it per spring).
+#[inline(never)]
+pub fn spring_path(h: &Harness, table: &ForceTable64, strain: f64, empty: u32) -> u32 {
+    const SPRINGS: usize = 16;
+    const L0: f64 = 2.5;
+    let mut topo = Topology::<3, SPRINGS>::new();
+    let (Ok(a), Ok(b)) = (
+        topo.add_free_node([0.0, 0.0, 0.0]),
+        topo.add_free_node([0.0, 0.0, -L0]),
+    ) else {
+        exit(false)
+    };
+    for _ in 0..SPRINGS {
+        if topo.add_edge(End::Free(a), End::Free(b)).is_err() {
+            exit(false)
+        }
+    }
+    let cfg = SolverConfig::default();
+    let coeffs = DefaultArith::coeffs(&mccs::arith::StepSpec {
+        h: 1.0 / 3000.0,
+        node_mass: cfg.node_mass,
+        node_damping: cfg.node_damping,
+        spring_damping: cfg.spring_damping,
+        integrator: cfg.integrator,
+        damping_factor: 1.0,
+    });
+    let q24 = |mm: f64| Length::from_num(mm).to_bits();
+    let v16 = |mm_s: i32| DefaultArith::store_velocity(&coeffs, mm_s << 16);
+    let mut nodes = [mccs::state::Node::ZERO; 3];
+    nodes[1].v = [v16(3), v16(-2), v16(5)];
+    nodes[2].u = [q24(0.1), q24(-0.1), q24(strain * L0)];
+    nodes[2].v = [v16(-1), v16(4), v16(-6)];
+    let (u, v) = (nodes[2].u, nodes[2].v);
+    let table = ArithTable::<64, DefaultArith>::new(*table);
+    let mut warm = [DefaultArith::REST; SPRINGS];
+    // Settle the warm starts on this state first (each run takes one Newton step).
+    for _ in 0..8 {
+        e::spring_loop(&table, &coeffs, &topo, &mut warm, &mut nodes);
+    }
+    let run = h.measure(16, || {
+        // The loop accumulates forces on the nodes; the ends do not move.
+        e::spring_loop(
+            black_box(&table),
+            &coeffs,
+            black_box(&topo),
+            &mut warm,
+            &mut nodes,
+        );
+        nodes[2].u = u;
+        nodes[2].v = v;
+    });
+    (run.saturating_sub(empty) + SPRINGS as u32 / 2) / SPRINGS as u32
 }

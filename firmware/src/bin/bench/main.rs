@@ -35,7 +35,9 @@ mod rng;
 mod firmware {
     use super::fw_common::exit;
     use super::harness::Harness;
-    use super::report::{check_budgets, fits, largest_patch, substep_case, Figures, Steps};
+    use super::report::{
+        check_budgets, fits, largest_patch, substep_case, Figures, Steps, SPRING_PATH_SPREAD,
+    };
     use super::{cases, harness, hold_check, kernel_check};
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -93,6 +95,24 @@ mod firmware {
             "spring_in_loop_n5",
             cases::spring_in_loop::<10, 61>(&h, 5, table, probe, empty),
         );
+        // One spring on each path of its arithmetic, in the loop (`cases::spring_path`).
+        let corner = STIFF_SERIES
+            .corner()
+            .map_or(0.5, |(a, b)| 0.5 * (a.to_num::<f64>() + b.to_num::<f64>()));
+        let (mut fastest, mut slowest) = (u32::MAX, 0);
+        for (name, t, strain) in [
+            ("spring_path_uniform", table, 0.3),
+            ("spring_path_below", table, -0.7),
+            ("spring_path_above", table, 0.97),
+            ("spring_path_corner", &STIFF_SERIES, corner),
+            ("spring_path_stretched", table, -1.5),
+            ("spring_path_crushed", table, 0.995),
+        ] {
+            let path = cases::spring_path(&h, t, strain, empty);
+            (fastest, slowest) = (fastest.min(path), slowest.max(path));
+            figs.report(name, path);
+        }
+        figs.report(SPRING_PATH_SPREAD, slowest.saturating_sub(fastest));
         if CORE != Core::M0 {
             figs.report(
                 "spring_in_loop_n8",
