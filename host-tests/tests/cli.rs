@@ -506,6 +506,22 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             "{name}: {src}"
         );
     }
+    // With 33 knots the stiff series spring misses the bound, and the refusal names the
+    // fewest knots it measured to meet it over the same domain (65, not 129).
+    let f = temp_file("stiff-series.toml", &stiff_series);
+    let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "33"]);
+    assert_one_line_error(
+        &out,
+        &[
+            "stiff-series.toml",
+            "the 33-knot table misses the bound",
+            "more knots meet it: --knots 65 (measured: force ",
+            "of F(0.95)",
+            "--accept-error",
+        ],
+    );
+    let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "65"]);
+    assert!(out.status.success());
     // Table 2 with its preload at 15 F_T (0.79 F_C), its slope kink Δ(P) on the cone's
     // steep rise toward its own solid point, far above Δ(F_T): no placement the builder
     // knows meets the bound (docs/accuracy.md, "The grid below a preload's kink").
@@ -516,10 +532,9 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
     assert_ne!(kinked, TABLE2);
     let f = temp_file("kinked.toml", &kinked);
     let path = f.to_str().unwrap();
-    for (knots, advice) in [
-        ("65", "more knots (--knots 129)"),
-        ("129", "a narrower domain"),
-    ] {
+    // The refusal names a remedy it built and measured: 129 knots do not meet the bound
+    // either, a lower `--to` does, and the command it names builds that table.
+    for knots in ["65", "129"] {
         let out = mccs(&["table", "--params", path, "--knots", knots]);
         assert_one_line_error(
             &out,
@@ -527,9 +542,48 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
                 "kinked.toml",
                 "misses the bound",
                 "k_p/k = 7.14e0",
-                advice,
+                "a narrower domain meets it: --to ",
+                " (measured: force ",
+                " or --from ",
                 "--accept-error",
             ],
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        let to = err
+            .split("meets it: --to ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .unwrap();
+        let measured = err.split("(measured: ").nth(1).unwrap();
+        let measured = measured.split(") or --from").next().unwrap();
+        assert!(to.parse::<f64>().unwrap() < 0.95, "{err}");
+        let from = err
+            .split(" or --from ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .unwrap();
+        assert!(from.parse::<f64>().unwrap() > -0.5, "{err}");
+        let ok = mccs(&["table", "--params", path, "--knots", knots, "--from", from]);
+        assert!(
+            ok.status.success(),
+            "{}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+        let ok = mccs(&["table", "--params", path, "--knots", knots, "--to", to]);
+        assert!(
+            ok.status.success(),
+            "{}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+        // The same figures (`force 4.1e-6 of F(0.587), stiffness 1.7e-4`).
+        let emitted = String::from_utf8_lossy(&ok.stderr);
+        let (force, stiffness) = measured.split_once(", stiffness ").unwrap();
+        let force = force.trim_start_matches("force ");
+        assert!(
+            emitted.contains(&format!(
+                "force error {force}, stiffness error {stiffness} "
+            )),
+            "{err} / {emitted}"
         );
     }
     // A spring 1,000 times weaker than Table 2: half an LSB of the output formats is over

@@ -56,11 +56,11 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                     "the fixed-point formats cannot hold this spring to it (half an output LSB is {:.1e} of F({to:?}) and {:.1e} of its least stiffness): no knot count or domain meets it; emit it anyway with --accept-error",
                     floor.force, floor.stiffness
                 )
-            } else if knots < 129 {
-                "use more knots (--knots 129) or a narrower domain (--from/--to), or emit it anyway with --accept-error".to_string()
             } else {
-                "use a narrower domain (--from/--to), or emit it anyway with --accept-error"
-                    .to_string()
+                format!(
+                    "{}; or emit it anyway with --accept-error",
+                    remedy(&t, &law, from, to)
+                )
             };
             return Err(file_error(
                 &a.params,
@@ -90,6 +90,132 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display()))),
         None => out.write_all(src.as_bytes()).map_err(io_error),
     }
+}
+
+/// What one of [`remedy`]'s builds gave.
+enum Tried {
+    /// Built within the product's bound, which it measured at this.
+    Meets(TableBound),
+    /// Built, over the bound.
+    Misses,
+    /// Not built (the builder refused the domain) or out of builds: stop that way.
+    Stop,
+}
+
+/// Tables a refusal's [`remedy`] may build, at most: each that misses the bound takes
+/// about half a second with 129 knots for a spring with a preload (the builder tries
+/// every placement), so that a refusal comes within about 9 s.
+const REMEDY_BUILDS: usize = 16;
+
+/// [`remedy`]'s first steps in the domain: sixths of it.
+const STEPS: usize = 6;
+
+/// [`remedy`]'s halvings of the step where a domain first met the bound.
+const HALVINGS: usize = 3;
+
+/// What to change so that a table `t` over `[from, to]` that misses the product's bound
+/// (with the formats able to meet it) meets it, found by building and measuring: the
+/// fewest knots above `t`'s that meet it over the whole domain; else the widest domains
+/// it found with the same knots, one with a lower `--to` and one with a higher `--from`,
+/// each stepping by sixths of the domain and then halving the last step three times.
+/// Each value it names is one it built and measured, rounded to 0.001 inward, so that the
+/// command it names builds that table. Where nothing it tried meets the bound, it says so.
+fn remedy<const S: usize>(_: &ForceTable<S>, law: &mccs::Law, from: f64, to: f64) -> String {
+    let bound = TableBound::PRODUCT;
+    let mut builds = 0;
+    let mut tried = |s: usize, a: f64, b: f64| -> Tried {
+        if builds >= REMEDY_BUILDS {
+            return Tried::Stop;
+        }
+        builds += 1;
+        let built = match s {
+            32 => ForceTable::<32>::from_law_best(law, a, b).map(|t| t.max_error()),
+            64 => ForceTable::<64>::from_law_best(law, a, b).map(|t| t.max_error()),
+            128 => ForceTable::<128>::from_law_best(law, a, b).map(|t| t.max_error()),
+            _ => ForceTable::<S>::from_law_best(law, a, b).map(|t| t.max_error()),
+        };
+        match built {
+            Ok(Some(r)) if r.within(&bound) => Tried::Meets(r),
+            Ok(_) => Tried::Misses,
+            // No nonlinear phase left, too narrow: nothing further that way.
+            Err(_) => Tried::Stop,
+        }
+    };
+    let measured = |flag: &str, r: &TableBound, to_at: f64| {
+        format!(
+            "{flag} (measured: force {:.1e} of F({to_at}), stiffness {:.1e})",
+            r.force, r.stiffness
+        )
+    };
+    // The fewest knots above `t`'s that meet it over the whole domain.
+    for more in [32, 64, 128].into_iter().filter(|&m| m > S) {
+        if let Tried::Meets(r) = tried(more, from, to) {
+            return format!(
+                "more knots meet it: {}",
+                measured(&format!("--knots {}", more + 1), &r, to)
+            );
+        }
+    }
+    let span = to - from;
+    // Lower `to`, and raise `from`: each a remedy of its own.
+    let mut found = Vec::new();
+    for lower_to in [true, false] {
+        let end = if lower_to { to } else { from };
+        let sign = if lower_to { -1.0 } else { 1.0 };
+        let at = |x: f64| {
+            let r = if lower_to {
+                (x * 1000.0).floor()
+            } else {
+                (x * 1000.0).ceil()
+            };
+            r / 1000.0
+        };
+        let domain = |x: f64| if lower_to { (from, x) } else { (x, to) };
+        let mut last_bad = end;
+        let mut good = None;
+        for k in 1..STEPS {
+            let x = at(end + sign * span * k as f64 / STEPS as f64);
+            let (a, b) = domain(x);
+            match tried(S, a, b) {
+                Tried::Meets(r) => {
+                    good = Some((x, r));
+                    break;
+                }
+                Tried::Misses => last_bad = x,
+                Tried::Stop => break,
+            }
+        }
+        let Some((mut x, mut r)) = good else {
+            continue;
+        };
+        // Halve the step between the last that missed and the first that met.
+        for _ in 0..HALVINGS {
+            let mid = at(0.5 * (x + last_bad));
+            if mid == x || mid == last_bad {
+                break;
+            }
+            let (a, b) = domain(mid);
+            match tried(S, a, b) {
+                Tried::Meets(m) => (x, r) = (mid, m),
+                Tried::Misses => last_bad = mid,
+                Tried::Stop => break,
+            }
+        }
+        found.push(if lower_to {
+            measured(&format!("--to {x}"), &r, x)
+        } else {
+            measured(&format!("--from {x}"), &r, to)
+        });
+    }
+    if !found.is_empty() {
+        return format!("a narrower domain meets it: {}", found.join(" or "));
+    }
+    let knots = if S < 128 {
+        "neither more knots nor a"
+    } else {
+        "no"
+    };
+    format!("{knots} narrower domain it tried (lowering --to, raising --from) meets it")
 }
 
 /// The product's bound in words: `force 2e-5, stiffness 1e-3`.
