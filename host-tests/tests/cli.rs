@@ -586,6 +586,19 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             "{err} / {emitted}"
         );
     }
+    // A domain reaching far past where the law bends: the search steps across the bend,
+    // not across the domain (sixths of [-100, 100] would step over it).
+    let out = mccs(&[
+        "table", "--params", path, "--knots", "129", "--from", "-100", "--to", "100",
+    ]);
+    assert_one_line_error(
+        &out,
+        &[
+            "kinked.toml",
+            "a narrower domain meets it: --to 0.",
+            " or --from 0.",
+        ],
+    );
     // A spring 1,000 times weaker than Table 2: half an LSB of the output formats is over
     // the bound, and the refusal says that no knot count or domain helps.
     let weak = TABLE2

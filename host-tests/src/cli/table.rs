@@ -116,9 +116,11 @@ const HALVINGS: usize = 3;
 /// What to change so that a table `t` over `[from, to]` that misses the product's bound
 /// (with the formats able to meet it) meets it, found by building and measuring: the
 /// fewest knots above `t`'s that meet it over the whole domain; else the widest domains
-/// it found with the same knots, one with a lower `--to` and one with a higher `--from`,
-/// each stepping by sixths of the domain and then halving the last step three times.
-/// Each value it names is one it built and measured, rounded to 0.001 inward, so that the
+/// it found with the same knots, one with a lower `--to` and one with a higher `--from`.
+/// Each steps across the part of the domain where the law bends, between `Δ(F_T)` and
+/// the solid point `Δ(F_C)` (from the bend's end where the domain reaches past it: the
+/// law is straight there), by sixths of it, then halves the last step three times. Each
+/// value it names is one it built and measured, rounded to 0.001 inward, so that the
 /// command it names builds that table. Where nothing it tried meets the bound, it says so.
 fn remedy<const S: usize>(_: &ForceTable<S>, law: &mccs::Law, from: f64, to: f64) -> String {
     let bound = TableBound::PRODUCT;
@@ -156,11 +158,18 @@ fn remedy<const S: usize>(_: &ForceTable<S>, law: &mccs::Law, from: f64, to: f64
             );
         }
     }
-    let span = to - from;
     // Lower `to`, and raise `from`: each a remedy of its own.
+    let (bends_from, bends_to) = (from.max(law.strain_t()), to.min(law.strain_c()));
+    let span = bends_to - bends_from;
     let mut found = Vec::new();
     for lower_to in [true, false] {
-        let end = if lower_to { to } else { from };
+        // The bend's end first, where the domain reaches past it.
+        let (end, start) = if lower_to {
+            (to, bends_to)
+        } else {
+            (from, bends_from)
+        };
+        let first = if start == end { 1 } else { 0 };
         let sign = if lower_to { -1.0 } else { 1.0 };
         let at = |x: f64| {
             let r = if lower_to {
@@ -173,8 +182,11 @@ fn remedy<const S: usize>(_: &ForceTable<S>, law: &mccs::Law, from: f64, to: f64
         let domain = |x: f64| if lower_to { (from, x) } else { (x, to) };
         let mut last_bad = end;
         let mut good = None;
-        for k in 1..STEPS {
-            let x = at(end + sign * span * k as f64 / STEPS as f64);
+        for k in first..STEPS {
+            let x = at(start + sign * span * k as f64 / STEPS as f64);
+            if x == last_bad {
+                continue;
+            }
             let (a, b) = domain(x);
             match tried(S, a, b) {
                 Tried::Meets(r) => {
