@@ -124,7 +124,9 @@ impl From<IntegratorArg> for mccs::Integrator {
 enum Command {
     /// Print F(ε) and dF/dε as CSV `strain,force_n,stiffness_n` for ε = FROM, FROM+STEP, … ≤ TO.
     Curve(curve::Args),
-    /// Emit the fixed-point force table as Rust source for `include!`.
+    /// Emit the fixed-point force table as Rust source for `include!`, its measured error
+    /// in its header; a table over the product's bound is refused (exit 2) with the knots
+    /// or the narrower domain that meets it, measured.
     Table(table::Args),
     /// Fit models to compression data (CSV `strain,force_n`) and compare them: one line
     /// `FIT model=<name> mean_abs=<f> max_abs=<f> mse=<f>` per model.
