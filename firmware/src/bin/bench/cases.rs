@@ -464,17 +464,28 @@ fn roaming_in<const N: usize, const E: usize, const CAP: bool>(
 }
 
 /// One spring where the solver runs it (`e::spring_loop`, on the M4F its assembly loop),
-/// per spring, with every spring at the same `strain` (compression positive) on `table`:
-/// 16 springs in parallel between two free nodes 2.5 mm apart, the far end displaced
-/// along the springs (and 0.1 mm across), both ends moving. What each path of a spring
-/// costs (the table's line below, uniform part, graded corner and line above, an edge
-/// vector held at ±2, `l0/l` held), so that a tick's cost can be bounded over every
-/// state, not only the pressed patch's. The loop's own overhead per call is in the
-/// figure (1/16 of it per spring).
+/// per spring, with every spring at the same `strain` (compression positive) on `table`,
+/// which must fall on `path` (else the bench fails): 16 springs in parallel between two
+/// free nodes 2.5 mm apart, the far end displaced along the springs (and 0.001 mm
+/// across, which moves the strain by less than 1e-4), both ends moving. What each path of
+/// a spring costs (the table's line below, uniform part, graded corner and line above,
+/// an edge vector held at ±2, `l0/l` held), so that a tick's cost can be bounded over
+/// every state, not only the pressed patch's. The loop's own overhead per call is in
+/// the figure (1/16 of it per spring).
 #[inline(never)]
-pub fn spring_path(h: &Harness, table: &ForceTable64, strain: f64, empty: u32) -> u32 {
+pub fn spring_path(
+    h: &Harness,
+    table: &ForceTable64,
+    strain: f64,
+    path: TablePath,
+    empty: u32,
+) -> u32 {
     const SPRINGS: usize = 16;
     const L0: f64 = 2.5;
+    // The strain is on the path named, or the figure would be another path's.
+    if TablePath::of(table, strain) != path {
+        exit(false)
+    }
     let mut topo = Topology::<3, SPRINGS>::new();
     let (Ok(a), Ok(b)) = (
         topo.add_free_node([0.0, 0.0, 0.0]),
@@ -500,7 +511,7 @@ pub fn spring_path(h: &Harness, table: &ForceTable64, strain: f64, empty: u32) -
     let v16 = |mm_s: i32| DefaultArith::store_velocity(&coeffs, mm_s << 16);
     let mut nodes = [mccs::state::Node::ZERO; 3];
     nodes[1].v = [v16(3), v16(-2), v16(5)];
-    nodes[2].u = [q24(0.1), q24(-0.1), q24(strain * L0)];
+    nodes[2].u = [q24(0.001), q24(-0.001), q24(strain * L0)];
     nodes[2].v = [v16(-1), v16(4), v16(-6)];
     let (u, v) = (nodes[2].u, nodes[2].v);
     let table = ArithTable::<64, DefaultArith>::new(*table);
@@ -522,4 +533,34 @@ pub fn spring_path(h: &Harness, table: &ForceTable64, strain: f64, empty: u32) -
         nodes[2].v = v;
     });
     (run.saturating_sub(empty) + SPRINGS as u32 / 2) / SPRINGS as u32
+}
+
+/// Where a strain falls in a force table: which of its evaluation's paths it takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TablePath {
+    /// The line below the table.
+    Below,
+    /// The uniform part.
+    Uniform,
+    /// The graded corner.
+    Corner,
+    /// The line above.
+    Above,
+}
+
+impl TablePath {
+    /// The path `strain` takes in `table` (the branches of `ForceTable::force`).
+    pub fn of(table: &ForceTable64, strain: f64) -> Self {
+        let r = table.raw();
+        let e = Strain::from_num(strain).to_bits();
+        if e <= r.strain_lo {
+            Self::Below
+        } else if e < r.strain_hi {
+            Self::Uniform
+        } else if e < r.corner_hi {
+            Self::Corner
+        } else {
+            Self::Above
+        }
+    }
 }
