@@ -482,8 +482,13 @@ pub fn spring_path(
 ) -> u32 {
     const SPRINGS: usize = 16;
     const L0: f64 = 2.5;
-    // The strain is on the path named, or the figure would be another path's.
-    if TablePath::of(table, strain) != path {
+    // The far end's displacement: along the springs by `strain`, and a little across.
+    const ACROSS: f64 = 0.001;
+    // The springs' strain as placed (the crossways offset lengthens them a little), on
+    // the path named, or the figure would be another path's.
+    let along = L0 * (1.0 - strain);
+    let placed = 1.0 - libm::sqrt(2.0 * ACROSS * ACROSS + along * along) / L0;
+    if TablePath::of(table, placed) != path {
         exit(false)
     }
     let mut topo = Topology::<3, SPRINGS>::new();
@@ -511,7 +516,7 @@ pub fn spring_path(
     let v16 = |mm_s: i32| DefaultArith::store_velocity(&coeffs, mm_s << 16);
     let mut nodes = [mccs::state::Node::ZERO; 3];
     nodes[1].v = [v16(3), v16(-2), v16(5)];
-    nodes[2].u = [q24(0.001), q24(-0.001), q24(strain * L0)];
+    nodes[2].u = [q24(ACROSS), q24(-ACROSS), q24(strain * L0)];
     nodes[2].v = [v16(-1), v16(4), v16(-6)];
     let (u, v) = (nodes[2].u, nodes[2].v);
     let table = ArithTable::<64, DefaultArith>::new(*table);
