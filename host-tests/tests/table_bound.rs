@@ -134,6 +134,14 @@ fn met_with_corner(p: &Params) -> (ForceTable<128>, f64, (f64, f64)) {
     (t, e_p, corner)
 }
 
+/// Prints `line` with `t`'s largest errors on the independent reference (a figure the
+/// docs quote), and asserts that they are within the product's bound.
+fn holds_on_the_reference<const S: usize>(line: &str, p: &Params, t: &ForceTable<S>) {
+    let m = independent(p, t);
+    println!("{line} force={:.1e} stiffness={:.1e}", m.force, m.stiffness);
+    assert!(m.within(&TableBound::PRODUCT), "{m:?}");
+}
+
 /// The table's largest errors over the domain against the independent reference, as
 /// the builder defines them (see `mccs::table::bound`), on a uniform sweep.
 fn independent<const S: usize>(p: &Params, t: &ForceTable<S>) -> TableBound {
@@ -801,12 +809,7 @@ fn a_preload_kink_in_the_graded_corner_sits_on_a_knot() {
         a < e_p && e_p < b,
         "the kink {e_p} inside the corner [{a}, {b})"
     );
-    let m = independent(&p, &t);
-    println!(
-        "KINKKNOT case=spring195 force={:.1e} stiffness={:.1e}",
-        m.force, m.stiffness
-    );
-    assert!(m.within(&TableBound::PRODUCT), "{m:?}");
+    holds_on_the_reference("KINKKNOT case=spring195", &p, &t);
 }
 
 /// A preload near the cone's collapse force on a soft series spring: below `Δ(P)` the cone
@@ -841,12 +844,7 @@ fn a_corner_graded_toward_a_preloads_kink_from_below() {
         (end - e_p).abs() < 1e-6,
         "the corner ends at {end}, Δ(P) {e_p}"
     );
-    let m = independent(&p, &t);
-    println!(
-        "KINKEND case=spring7042 force={:.1e} stiffness={:.1e}",
-        m.force, m.stiffness
-    );
-    assert!(m.within(&TableBound::PRODUCT), "{m:?}");
+    holds_on_the_reference("KINKEND case=spring7042", &p, &t);
 }
 
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device

@@ -554,18 +554,18 @@ pub enum TablePath {
 }
 
 impl TablePath {
-    /// The path `strain` takes in `table` (the branches of `ForceTable::force`).
+    /// The path `strain` takes in `table`, from its layout (`tabulated_range`, `corner`).
     pub fn of(table: &ForceTable64, strain: f64) -> Self {
-        let r = table.raw();
-        let e = Strain::from_num(strain).to_bits();
-        if e <= r.strain_lo {
+        let e = Strain::from_num(strain);
+        let (lo, hi) = table.tabulated_range();
+        if e <= lo {
             Self::Below
-        } else if e < r.strain_hi {
-            Self::Uniform
-        } else if e < r.corner_hi {
+        } else if e >= hi {
+            Self::Above
+        } else if table.corner().is_some_and(|(a, _)| e >= a) {
             Self::Corner
         } else {
-            Self::Above
+            Self::Uniform
         }
     }
 }
