@@ -152,3 +152,40 @@ pub(crate) fn for_each_spring<const NODES: usize, const EDGES: usize>(
         *fa = core::array::from_fn(|k| fa[k].wrapping_add(f_on_a[k]));
     }
 }
+
+/// [`for_each_spring`] over slices, out of line and with checked indices: one copy per
+/// kernel whatever the topology's size, for a loop that is rarely run (a table with a
+/// lower corner, [`crate::ForceTable::lower_corner`]: inlined into every patch size, its
+/// copies overflowed the M3 bench's flash). The same results, the same order; a spring
+/// whose node is not in `nodes` (never, for a topology's edges and its own nodes) is
+/// skipped.
+#[inline(never)]
+pub(crate) fn for_each_spring_checked(
+    edges: &[Edge],
+    warm: &mut [i32],
+    nodes: &mut [Node],
+    kernel: &impl SpringKernel,
+) {
+    for (e, w) in edges.iter().zip(warm.iter_mut()) {
+        let (a, b) = (e.a as usize, e.b as usize);
+        let grounded = e.b == GROUND;
+        let f = {
+            let (Some(na), nb) = (nodes.get(a), nodes.get(b)) else {
+                continue;
+            };
+            match (grounded, nb) {
+                (true, _) => kernel.force(e, Ends::of(na, None), w),
+                (false, Some(nb)) => kernel.force(e, Ends::of(na, Some(nb)), w),
+                (false, None) => continue,
+            }
+        };
+        if !grounded {
+            if let Some(nb) = nodes.get_mut(b) {
+                nb.f = core::array::from_fn(|k| nb.f[k].wrapping_sub(f[k]));
+            }
+        }
+        if let Some(na) = nodes.get_mut(a) {
+            na.f = core::array::from_fn(|k| na.f[k].wrapping_add(f[k]));
+        }
+    }
+}

@@ -434,13 +434,17 @@ fn table2_scaled(k: f64) -> Params {
 /// the graded corner.
 static STIFF_SERIES: ForceTable<64> = include!("../../tables/stiff_series.rs");
 
+/// The committed steep kink's table (`params/steep-kink.toml`): its 32 graded segments
+/// are a lower corner, under the uniform grid.
+static STEEP_KINK: ForceTable<64> = include!("../../tables/steep_kink.rs");
+
 /// The solver's `force_within` is `force` clamped, over the whole strain range, on the
-/// Table 2 spring, on springs with large forces (whose lines saturate) and on the stiff
-/// series spring's graded corner.
+/// Table 2 spring, on springs with large forces (whose lines saturate), on the stiff
+/// series spring's graded corner and on the steep kink's lower one.
 #[test]
 fn force_within_is_force_clamped() {
     let built = [Params::TABLE2, table2_scaled(30.0)].map(|p| ForceTable::<64>::new(&p).unwrap());
-    for t in built.into_iter().chain([STIFF_SERIES]) {
+    for t in built.into_iter().chain([STIFF_SERIES, STEEP_KINK]) {
         let mut bits = i32::MIN;
         loop {
             let e = Strain::from_bits(bits);
@@ -460,13 +464,13 @@ fn force_within_is_force_clamped() {
 /// uniform grid and the graded corner) the same bits as `force_within::<26>`; on the
 /// straight lines within 2⁻¹⁵ of the line's rise plus 1 LSB; over the whole strain
 /// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring, and
-/// the stiff series spring (its corner every 7 strain LSBs).
+/// the stiff series spring and the steep kink (their corners every 7 strain LSBs).
 #[test]
 fn force_narrow_is_force_within_to_a_slope_lsb() {
     let mut worst = 0.0f64;
     let built = [Params::TABLE2, table2_scaled(30.0), table2_scaled(0.02)]
         .map(|p| ForceTable::<64>::new(&p).unwrap());
-    for t in built.into_iter().chain([STIFF_SERIES]) {
+    for t in built.into_iter().chain([STIFF_SERIES, STEEP_KINK]) {
         let narrow = ArithTable::<64, Narrow>::new(t);
         let (lo, hi) = t.tabulated_range();
         let (f_lo, f_hi) = (t.raw().force_lo as f64, t.raw().force_hi as f64);
@@ -506,32 +510,40 @@ fn force_narrow_is_force_within_to_a_slope_lsb() {
 
 /// The graded corner, every strain LSB from below its start to past its end: the force
 /// never decreases (across its own knots and octaves, and where it meets the uniform
-/// grid below and the line above), and it stays within the bound of the law, with its
-/// stiffness, as the builder measured.
+/// grid and the lines), and it stays within the bound of the law, with its stiffness,
+/// as the builder measured. The stiff series spring's corner above its grid, and the
+/// steep kink's lower corner under it.
 #[test]
 fn a_graded_corner_is_continuous_and_monotone() {
-    let t = STIFF_SERIES;
-    let (a, b) = t.corner().unwrap();
-    let (a, b) = (a.to_bits(), b.to_bits());
-    let mut p = Params::TABLE2;
-    p.linear.shear_modulus = 1.4460e8;
-    let r = Reference::new(&p).unwrap();
-    let scale = r.force(DOMAIN.1);
-    let mut prev = t.force(Strain::from_bits(a - (1 << 16)));
-    let (mut worst, mut steps) = (0.0f64, 0u32);
-    for bits in a - (1 << 16)..b + (1 << 16) {
-        let e = Strain::from_bits(bits);
-        let f = t.force(e);
-        assert!(f >= prev, "{bits}: {f} after {prev}");
-        prev = f;
-        if bits % 97 == 0 {
-            let err = (f.to_num::<f64>() - r.force(e.to_num::<f64>())).abs() / scale;
-            worst = worst.max(err);
-            steps += 1;
+    let mut stiff_series = Params::TABLE2;
+    stiff_series.linear.shear_modulus = 1.4460e8;
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let path = std::path::PathBuf::from(root).join("params/steep-kink.toml");
+    let steep_kink = mccs_host::paramfile::read(&path).unwrap();
+    for (name, t, p) in [
+        ("stiff series", STIFF_SERIES, stiff_series),
+        ("steep kink", STEEP_KINK, steep_kink),
+    ] {
+        let (a, b) = t.corner().unwrap();
+        let (a, b) = (a.to_bits(), b.to_bits());
+        let r = Reference::new(&p).unwrap();
+        let scale = r.force(DOMAIN.1);
+        let mut prev = t.force(Strain::from_bits(a - (1 << 16)));
+        let (mut worst, mut steps) = (0.0f64, 0u32);
+        for bits in a - (1 << 16)..b + (1 << 16) {
+            let e = Strain::from_bits(bits);
+            let f = t.force(e);
+            assert!(f >= prev, "{name}, {bits}: {f} after {prev}");
+            prev = f;
+            if bits % 97 == 0 {
+                let err = (f.to_num::<f64>() - r.force(e.to_num::<f64>())).abs() / scale;
+                worst = worst.max(err);
+                steps += 1;
+            }
         }
+        println!("graded corner ({name}): monotone over {} strains; force within {worst:.1e} of F(0.95) ({steps} compared)", b - a + (2 << 16));
+        assert!(worst <= 2e-5);
     }
-    println!("graded corner: monotone over {} strains; force within {worst:.1e} of F(0.95) ({steps} compared)", b - a + (2 << 16));
-    assert!(worst <= 2e-5);
 }
 
 proptest! {

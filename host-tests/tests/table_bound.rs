@@ -124,14 +124,13 @@ fn refused_at(p: &Params) -> TableBound {
 
 /// The table `ForceTable::with_bound` builds for a preloaded `p` within the product's
 /// bound (panics if it refuses), its preload's kink `Δ(P)` and its graded corner's range
-/// `[strain_hi, corner_hi)` (strain).
+/// `[lo, hi)` (strain; panics if it has none).
 fn met_with_corner(p: &Params) -> (ForceTable<128>, f64, (f64, f64)) {
     let t = ForceTable::<128>::with_bound(p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
         .expect("within the bound");
     let e_p = Reference::new(p).unwrap().delta(p.linear.preload.unwrap());
-    let strain = |bits: i32| bits as f64 / (1u64 << 24) as f64;
-    let corner = (strain(t.raw().strain_hi), strain(t.raw().corner_hi));
-    (t, e_p, corner)
+    let (a, b) = t.corner().expect("a graded corner");
+    (t, e_p, (a.to_num::<f64>(), b.to_num::<f64>()))
 }
 
 /// Prints `line` with `t`'s largest errors on the independent reference (a figure the
@@ -845,6 +844,35 @@ fn a_corner_graded_toward_a_preloads_kink_from_below() {
         "the corner ends at {end}, Δ(P) {e_p}"
     );
     holds_on_the_reference("KINKEND case=spring7042", &p, &t);
+}
+
+/// A preload whose kink `Δ(P)` lies on the cone's steep rise toward its own solid point,
+/// with a law still curved above it (`params/steep-kink.toml`: spring 261 of the 1,000,
+/// `k_p/k` 1.05). Every placement with the uniform grid below `Δ(P)` missed the bound
+/// (the one placement-limited refusal of the 1,000, at 129 knots: `docs/accuracy.md`).
+/// `from_law_best` now also tries a *lower* corner: graded toward `Δ(P)` from below,
+/// from the law's first kink `Δ(F_T)`, under the uniform grid, which starts on `Δ(P)`
+/// (`CornerEnd::Lower`). Its table meets the bound at 65 and 129 knots, and the
+/// independent reference agrees.
+#[test]
+fn a_lower_corner_under_the_grid_from_a_steep_kink() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let path = std::path::PathBuf::from(root).join("params/steep-kink.toml");
+    let p = mccs_host::paramfile::read(&path).unwrap();
+    let r = Reference::new(&p).unwrap();
+    let (e_t, e_p) = (r.strain_t(), r.delta(p.linear.preload.unwrap()));
+    let (t, _, (a, b)) = met_with_corner(&p);
+    assert!(t.lower_corner());
+    let lsb = 1.0 / (1u64 << 24) as f64;
+    assert!(
+        a <= e_t + lsb && (b - e_p).abs() < 4.0 * lsb,
+        "the corner [{a}, {b}) from Δ(F_T) {e_t} to Δ(P) {e_p}"
+    );
+    holds_on_the_reference("LOWERCORNER case=spring261 knots=129", &p, &t);
+    let t65 = ForceTable::<64>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("within the bound");
+    assert!(t65.lower_corner());
+    holds_on_the_reference("LOWERCORNER case=spring261 knots=65", &p, &t65);
 }
 
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device

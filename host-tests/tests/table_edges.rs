@@ -135,6 +135,65 @@ fn a_table_of_no_segments_evaluates_without_panic() {
     assert_eq!(t.segments_used(), 0);
 }
 
+/// A lower corner (`tables/steep_kink.rs`, `ForceTable::lower_corner`): the table is
+/// valid, each strain at the ends of its pieces takes the piece it belongs to (the line
+/// below at `corner_hi`, the corner from one above it up to `strain_lo`, the grid above,
+/// the line above from `strain_hi`, anchored at `corner_hi`), and `validate` refuses a corner
+/// end between the grid's ends, a coordinate that leaves `[2²⁴, 2³²)` at either end,
+/// a corner past the last segment and a line above from a force below zero.
+#[test]
+fn a_lower_corner_is_valid_and_evaluated_on_its_own_range() {
+    static STEEP_KINK: ForceTable<64> = include!("../../tables/steep_kink.rs");
+    let t = STEEP_KINK;
+    let r = *t.raw();
+    assert_eq!(t.validate(), Ok(()));
+    assert!(t.lower_corner() && r.corner_hi < r.strain_lo);
+    assert_eq!(
+        t.corner(),
+        Some((
+            Strain::from_bits(r.corner_hi + 1),
+            Strain::from_bits(r.strain_lo + 1)
+        ))
+    );
+    assert_eq!(
+        t.tabulated_range(),
+        (
+            Strain::from_bits(r.corner_hi),
+            Strain::from_bits(r.strain_hi)
+        )
+    );
+    // The line above is anchored at corner_hi, below the table: its force there is the
+    // line extrapolated down, at least zero (a held product still saturates it).
+    let at_end = t.force(Strain::from_bits(r.strain_hi)).to_bits();
+    assert!(r.force_hi >= 0 && r.force_hi < at_end);
+    // Each piece's ends: the force never decreases across them, and force_within and the
+    // narrow lookup agree with force on the cubic pieces.
+    let narrow = ArithTable::<64, Narrow>::new(t);
+    let ends = [r.corner_hi, r.strain_lo, r.strain_hi];
+    for e in ends.iter().flat_map(|&x| [x - 1, x, x + 1]) {
+        let e = Strain::from_bits(e);
+        let (f, _) = t.force_and_stiffness(e);
+        assert_eq!(f, t.force(e));
+        assert!(t.force(Strain::from_bits(e.to_bits() + 1)) >= f);
+        let (lo, hi) = t.tabulated_range();
+        if e > lo && e < hi {
+            assert_eq!(table_force(&narrow, e), t.force_within::<26>(e));
+        }
+    }
+    let refused = |edit: &dyn Fn(&mut RawTable<64>)| {
+        let mut raw = r;
+        edit(&mut raw);
+        ForceTable::from_raw(raw).validate()
+    };
+    assert!(refused(&|x| x.corner_hi = x.strain_lo).is_err());
+    assert!(refused(&|x| x.corner_hi = x.strain_hi - 1).is_err());
+    // The coordinate reaches 2³² one strain below the corner, 2²⁴ at its end.
+    assert!(refused(&|x| x.corner_hi -= 1).is_err());
+    assert!(refused(&|x| x.strain_lo += 1).is_err());
+    assert!(refused(&|x| x.corner_base = 33).is_err());
+    assert!(refused(&|x| x.force_hi = -1).is_err());
+}
+
 /// The repro: a domain ending a hair above the kink left 17 knots within one
 /// strain LSB (and an index scale of 32 bits, on which the narrow arithmetic's
 /// derivation overflowed). Such a domain is now refused as too narrow.

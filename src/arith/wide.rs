@@ -4,7 +4,9 @@
 
 use super::{Arith, ArithTable, StepSpec, SPRING_FORCE_BITS, SPRING_FORCE_LIMIT};
 use crate::q::{self, V3};
-use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, DISP_LIMIT};
+use crate::state::{
+    for_each_spring, for_each_spring_checked, Ends, Node, SpringEnds, SpringKernel, DISP_LIMIT,
+};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
 use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, VEL_FRAC};
@@ -120,7 +122,7 @@ impl Arith for Wide {
         e: &SpringEnds,
         warm: &mut i32,
     ) -> V3 {
-        spring(&table.table, edge, e.into(), warm, c.damping)
+        spring::<S, true>(&table.table, edge, e.into(), warm, c.damping)
     }
 
     #[inline(always)]
@@ -162,23 +164,27 @@ pub fn spring_forces_portable<const S: usize, const NODES: usize, const EDGES: u
     warm: &mut [i32; EDGES],
     nodes: &mut [Node; NODES],
 ) {
-    let kernel = Kernel {
-        table,
-        damping: c.damping,
-    };
-    for_each_spring(topo, warm, nodes, &kernel);
+    let damping = c.damping;
+    // (A lower corner's check only in the loop of a table that has one, out of line.)
+    if table.lower_corner() {
+        let kernel = Kernel::<S, true> { table, damping };
+        for_each_spring_checked(topo.edges(), warm, nodes, &kernel);
+    } else {
+        for_each_spring(topo, warm, nodes, &Kernel::<S, false> { table, damping });
+    }
 }
 
-/// [`spring`] with its table and damping, for the solver's loop.
-struct Kernel<'a, const S: usize> {
+/// [`spring`] with its table and damping, for the solver's loop (`LOWER`: whether the
+/// table may have a lower corner, [`ForceTable::force_within_for`]).
+struct Kernel<'a, const S: usize, const LOWER: bool> {
     table: &'a ForceTable<S>,
     damping: i32,
 }
 
-impl<const S: usize> SpringKernel for Kernel<'_, S> {
+impl<const S: usize, const LOWER: bool> SpringKernel for Kernel<'_, S, LOWER> {
     #[inline(always)]
     fn force(&self, edge: &Edge, ends: Ends<'_>, warm: &mut i32) -> V3 {
-        spring(self.table, edge, ends, warm, self.damping)
+        spring::<S, LOWER>(self.table, edge, ends, warm, self.damping)
     }
 }
 
@@ -186,7 +192,8 @@ impl<const S: usize> SpringKernel for Kernel<'_, S> {
 /// damping (eq. 17), from the ends' displacements (Q24 mm) and velocities (Q16 mm/s).
 /// `dir` is the unit rest vector (Q23), `inv_len` is `1/l0` (Q31), `r` the spring's
 /// warm-started `l0/l` (Q27), advanced by one guarded Newton step, and `damping` the
-/// spring damping (Q36 N·s/mm).
+/// spring damping (Q36 N·s/mm). `LOWER`: whether the table may have a lower corner
+/// ([`ForceTable::force_within_for`]).
 ///
 /// Ranges that let most steps skip saturation: displacements within ±64 mm and velocities
 /// within ±16384 mm/s (the integrator clamps them), rest lengths ≥ 1 mm and at most
@@ -205,7 +212,7 @@ impl<const S: usize> SpringKernel for Kernel<'_, S> {
 /// Every product is one long multiply (the M0 builds it from 16-bit pieces with the same
 /// bits, [`crate::q`]); the formats are chosen so that most need no shift after it.
 #[inline(always)]
-fn spring<const S: usize>(
+fn spring<const S: usize, const LOWER: bool>(
     table: &ForceTable<S>,
     edge: &Edge,
     ends: Ends<'_>,
@@ -249,7 +256,7 @@ fn spring<const S: usize>(
     // |w| = a r' = (a r) + (a r) g: Q28, < 6 (one `smmla`); the strain 1 − |w| in Q24.
     let stretch = q::mulhi_acc(ar, g, ar);
     let strain = Strain::from_bits(((1 << AR_Q) - stretch) >> (AR_Q - LEN_FRAC));
-    let f = table.force_within::<SPRING_FORCE_BITS>(strain);
+    let f = table.force_within_for::<SPRING_FORCE_BITS, LOWER>(strain);
     // A compressed spring (f > 0) pushes a away from b: −f w/|w| = w (−f r).
     // f r: Q20 · Q27 = Q47, Q22 is `>> 25`: |f| ≤ 64 N and r < 8 keep it within
     // ±512 N, which Q22 holds (and its negation). Negated after the shift, so that the

@@ -147,13 +147,31 @@ macro_rules! lower_gentle {
     };
 }
 
+/// The start of the line below's path in the loop of a table without a lower corner:
+/// nothing.
+macro_rules! no_lower_corner {
+    () => {
+        ""
+    };
+}
+
+/// The same in the loop of a table with a lower corner ([`ForceTable::lower_corner`]):
+/// a strain above `corner_hi` is the corner's (three instructions; the other loops
+/// have none, so that a table without one pays nothing on its most common path).
+macro_rules! lower_corner {
+    () => {
+        concat!("ldr r3, [r11, #{corner_hi}]\n", "cmp r9, r3\n", "bgt 54b\n",)
+    };
+}
+
 /// The part of one spring both of its kinds share: from `dir + d/l0` (r0–r2, Q23) to
 /// the edge vector `w` (r0–r2, Q30), the advanced warm-start `l0/l` (r10, stored
 /// through r7, which moves on) and `f l0/l` (r8, Q22); r3 is the damping. Keeps r4
 /// (node b), r6 (node a), r7, r12. `$lower`: the lower line's product
-/// ([`lower_any`] or [`lower_gentle`]).
+/// ([`lower_any`] or [`lower_gentle`]); `$below`: what comes before it
+/// ([`no_lower_corner`] or [`lower_corner`]).
 macro_rules! spring_body {
-    ($lower:ident) => {
+    ($lower:ident, $below:ident) => {
         concat!(
             // w held within ±2 (Q23), then Q30.
             "ssat r0, #25, r0\n",
@@ -227,8 +245,10 @@ macro_rules! spring_body {
             "ubfx r3, r3, #14, #15\n",
             "lsl r3, r3, #16\n",
             "b 55b\n",
-            // Below: force_lo + the slope's product with e ⊖ anchor_lo.
+            // Below: force_lo + the slope's product with e ⊖ anchor_lo (or first, in
+            // the loop of a table with a lower corner, that corner above corner_hi).
             "51:\n",
+            $below!(),
             "ldr r3, [r11, #{anchor_lo}]\n",
             "qsub r3, r9, r3\n",
             "ldr r5, [r11, #{slope_lo}]\n",
@@ -339,10 +359,11 @@ macro_rules! a_takes_p_and_loops {
 }
 
 /// The spring loop over [`LoopArgs`] `$args`, with `$lower` the lower line's product
-/// ([`lower_any`] or [`lower_gentle`]); in `spring_forces`, whose generics the constants
-/// name.
+/// ([`lower_any`] or [`lower_gentle`]) and `$below` what comes before it
+/// ([`no_lower_corner`] or [`lower_corner`]); in `spring_forces`, whose generics the
+/// constants name.
 macro_rules! spring_loop {
-    ($args:ident, $lower:ident) => {
+    ($args:ident, $lower:ident, $below:ident) => {
         asm_writing_all!(
             "push {{r6, r7}}",
             "ldm r0, {{r1, r2, r3, r4, r5, r6, r7, r8}}",
@@ -372,7 +393,7 @@ macro_rules! spring_loop {
             "smmla r0, r5, r3, r0",
             "smmla r1, r8, r3, r1",
             "smmla r2, r9, r3, r2",
-            spring_body!($lower),
+            spring_body!($lower, $below),
             "ldm r6, {{r5, r9, r10}}",
             axis_two!("r0", "0", "r5"),
             axis_two!("r1", "4", "r9"),
@@ -393,7 +414,7 @@ macro_rules! spring_loop {
             "smmls r0, r10, r3, r0",
             "smmls r1, r11, r3, r1",
             "smmls r2, lr, r3, r2",
-            spring_body!($lower),
+            spring_body!($lower, $below),
             // −f r' for the ground's axes.
             "rsb r8, r8, #0",
             "ldm r6, {{r5, r9, r10}}",
@@ -445,9 +466,11 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
         edges: edges.as_ptr(),
         warm: warm.as_mut_ptr(),
     };
-    // The lower line's product as its slope allows (a constant per call).
+    // The lower line's product as its slope allows, and a lower corner's check only
+    // where the table has one (constants per call).
     let gentle = crate::table::fine_line(raw.stiffness_lo);
-    // SAFETY (both loops): the loop reads the `n` edges of `topo` (`edges` up to `end`)
+    let lower = table.lower_corner();
+    // SAFETY (all four loops): the loop reads the `n` edges of `topo` (`edges` up to `end`)
     // and as many warm-start values (n ≤ EDGES), writes only those values and the nodes' force
     // accumulators, and reads the table's header and segments. Every node index is in
     // bounds of `nodes` and `a` is never the ground nor equal to `b`, as
@@ -456,10 +479,11 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
     // reads are asserted above. It saves and restores r6 and r7 itself (the registers
     // the compiler reserves), declares every other register it writes, and leaves the
     // stack as it found it.
-    if gentle {
-        unsafe { spring_loop!(args, lower_gentle) }
-    } else {
-        unsafe { spring_loop!(args, lower_any) }
+    match (gentle, lower) {
+        (true, false) => unsafe { spring_loop!(args, lower_gentle, no_lower_corner) },
+        (false, false) => unsafe { spring_loop!(args, lower_any, no_lower_corner) },
+        (true, true) => unsafe { spring_loop!(args, lower_gentle, lower_corner) },
+        (false, true) => unsafe { spring_loop!(args, lower_any, lower_corner) },
     }
 }
 

@@ -147,10 +147,14 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
     };
     let r = table.raw();
     let (lo, hi) = (r.strain_lo as f64 * u_strain, r.strain_hi as f64 * u_strain);
-    let top = r.corner_hi as f64 * u_strain;
+    let (bottom, top) = table.tabulated_range();
+    let (bottom, top) = (
+        bottom.to_bits() as f64 * u_strain,
+        top.to_bits() as f64 * u_strain,
+    );
     let n = POINTS_PER_SEGMENT;
     // The lines beyond the table, then every segment, then the graded corner's.
-    for (a, b) in [(from, lo), (top, to)] {
+    for (a, b) in [(from, bottom), (top, to)] {
         if b > a {
             for j in 0..=n {
                 at(a + (b - a) * j as f64 / n as f64);

@@ -70,9 +70,11 @@ impl<const S: usize> ForceTable<S> {
     /// segments on the straight line, but a small spring's line slope in Q16 can cost
     /// more than that. Where none meets the bound, a graded corner (the module docs):
     /// toward the solid point under each placement (up to 24 more), then above a
-    /// preload's kink near `F_C` (up to 10 more), the first within the bound kept. Up to
-    /// 39 builds and measurements (5 for a spring the uniform grid serves): what
-    /// `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
+    /// preload's kink near `F_C` (up to 10 more), then toward that kink from below (up to
+    /// 12 more, the uniform grid below it; then 2, a *lower* corner under the grid), the
+    /// first within the bound kept. Up to 53 builds and measurements (5 for a spring the
+    /// uniform grid serves): what `mccs table` and [`ForceTable::with_bound`] do, not for
+    /// a device's start-up.
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
@@ -190,6 +192,22 @@ impl<const S: usize> ForceTable<S> {
                 }
             }
         }
+        // Still missed, with Δ(P) inside the domain: a lower corner, graded toward Δ(P)
+        // from below over the whole curved part under it (down to Δ(F_T) or the domain's
+        // start), the uniform grid above from Δ(P) (`CornerEnd::Lower`): the cone's steep
+        // rise toward its own solid point below the kink, and a law still curved above it.
+        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
+            for align in [Align::Shortest, Align::Off] {
+                let len = (e_p - lo) * LOWER_CORNER_REACH;
+                let end = CornerEnd::Lower;
+                if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+                    if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
+                        break;
+                    }
+                }
+            }
+        }
         // Without a table every placement failed (a duplicate implies one built).
         match (best, first_err) {
             (Some((_, t)), _) => Ok(t),
@@ -251,7 +269,15 @@ impl<const S: usize> ForceTable<S> {
             None
         };
         let n = if CORNER { S - CORNER_SEGMENTS } else { S };
-        let grid = Grid::place::<TENSION>(law, from, to, align, n, corner.map(|c| c.start))?;
+        // A lower corner ends where the grid starts, at its first knot; any other ends
+        // above the grid.
+        let lower = corner.filter(|c| c.end == CornerEnd::Lower);
+        let (start, end) = match corner {
+            Some(c) if c.end == CornerEnd::Lower => (Some(c.hi - 1), None),
+            Some(c) => (None, Some(c.start)),
+            None => (None, None),
+        };
+        let grid = Grid::place::<TENSION>(law, from, to, align, n, start, end)?;
         // The corner's segments' ends, from the law once (its shift, then its
         // coefficients).
         let corner_ends = match &corner {
@@ -265,7 +291,22 @@ impl<const S: usize> ForceTable<S> {
         // The line below is anchored where its floor rounds, never above the first knot
         // (`first`, the knot's Q20 value), so that the curve stays monotone across it; the
         // line above on the law at the first strain past the table (below).
-        let l = lines::<S>(law, &grid, segs.first >> shift)?;
+        // Under a lower corner the line below meets the corner's first knot instead.
+        let l = match (&lower, &corner_ends) {
+            (Some(c), Some(ends)) => {
+                let first = knot_units(ends[CORNER_PER_OCTAVE - 1][1], shift) as i32;
+                let unit = (1u64 << STRAIN_FRAC) as f64;
+                let bottom = c.bottom();
+                let at_kink = bottom as f64 / unit <= law.strain_t();
+                lines::<S>(law, &grid, (at_kink, bottom), first >> shift)?
+            }
+            _ => lines::<S>(
+                law,
+                &grid,
+                (grid.at_kink, grid.strain_lo),
+                segs.first >> shift,
+            )?,
+        };
         let mut raw = RawTable {
             strain_lo: grid.strain_lo,
             strain_hi: grid.strain_hi,
@@ -294,14 +335,24 @@ impl<const S: usize> ForceTable<S> {
         };
         if let (Some(c), Some(ends)) = (corner, corner_ends) {
             // The corner starts inside the uniform grid's last segment (its coordinate
-            // below 2³² there) and ends past it.
-            let d = (c.anchor as i64 - grid.strain_hi as i64) * c.pre as i64;
-            if !(d < 1 << 32 && grid.strain_hi < c.hi) {
+            // below 2³² there) and ends past it; a lower one ends on the grid's first
+            // strain (its coordinate at least 2²⁴ there) and starts below it.
+            let d = |e: i32| (c.anchor as i64 - e as i64) * c.pre as i64;
+            let fits = if c.end == CornerEnd::Lower {
+                d(grid.strain_lo) >= 1 << 24 && c.bottom() < grid.strain_lo
+            } else {
+                d(grid.strain_hi) < 1 << 32 && grid.strain_hi < c.hi
+            };
+            if !fits {
                 return Err(TableError::TooNarrow);
             }
             fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
             let (scale, post) = corner_scale(c.pre, shift)?;
-            raw.corner_hi = c.hi;
+            raw.corner_hi = if c.end == CornerEnd::Lower {
+                c.bottom()
+            } else {
+                c.hi
+            };
             raw.corner_anchor = c.anchor;
             raw.corner_pre = c.pre;
             raw.corner_base = n as u32;
@@ -309,14 +360,18 @@ impl<const S: usize> ForceTable<S> {
             raw.corner_post = post;
             // Past the solid point the law's own k_p line; past the domain's end the
             // law's tangent at the last knot, as a grid that ends there has.
+            // (Above a lower corner the grid's own line, from `lines`.)
             let above = match c.end {
-                CornerEnd::Solid => law.k_p,
+                CornerEnd::Solid => Some(law.k_p),
                 CornerEnd::DomainEnd => {
-                    1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0)))
+                    Some(1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0))))
                 }
-                CornerEnd::Kink => 1.0 / law.compliance_above(law.preload),
+                CornerEnd::Kink => Some(1.0 / law.compliance_above(law.preload)),
+                CornerEnd::Lower => None,
             };
-            (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
+            if let Some(above) = above {
+                (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
+            }
         }
         // The line above passes through (corner_hi, force_hi): from the law's force at
         // corner_hi itself, not the last knot's (as the segments round it), which lies up
@@ -327,8 +382,32 @@ impl<const S: usize> ForceTable<S> {
         // product is balanced in its force instead: `⌊F + 1⌋` LSBs, which puts the line
         // within (−1, 1) LSB of the law where the nearest Q20 value put it within
         // [−1.5, 0.5) (the anchor below is placed for a true rounding: `rounding_anchor`).
-        let e_hi = raw.corner_hi as f64 / (1u64 << STRAIN_FRAC) as f64;
-        let f_hi = libm::floor(law.force(e_hi) * (1u64 << FORCE_FRAC) as f64) + 1.0;
+        // Under a lower corner the table ends at strain_hi, and the line's anchor
+        // corner_hi lies below it: force_hi is the line extrapolated there in the
+        // evaluation's own terms, `⌊v + 1 − frac(a)⌋ − ⌊a⌋` for the law's force `v`
+        // (LSBs) at strain_hi and the product `a = slope_hi · (strain_hi − corner_hi)`
+        // (LSBs), so that from strain_hi up the line is `⌊v + 1 − frac(a)⌋ + ⌊frac(a) +
+        // b⌋` for the rise `b` beyond it: within (−1, 1] LSB of the law, as above. At
+        // least zero, so that a product held at ±2048 N (`line_at`) still saturates it.
+        let end = if lower.is_some() {
+            raw.strain_hi
+        } else {
+            raw.corner_hi
+        };
+        let v = law.force(end as f64 / (1u64 << STRAIN_FRAC) as f64) * (1u64 << FORCE_FRAC) as f64;
+        let f_hi = if lower.is_some() {
+            let p = slope_frac(raw.stiffness_hi) + STRAIN_FRAC - FORCE_FRAC;
+            let a = raw.slope_hi as i64 * (raw.strain_hi as i64 - raw.corner_hi as i64);
+            let frac = (a & ((1i64 << p) - 1)) as f64 / (1u64 << p) as f64;
+            let f = libm::floor(v + 1.0 - frac) - (a >> p) as f64;
+            // (Also when it is NaN.)
+            if f.is_nan() || f < 0.0 {
+                return Err(TableError::OutOfRange);
+            }
+            f
+        } else {
+            libm::floor(v) + 1.0
+        };
         if !(f_hi >= i32::MIN as f64 && f_hi <= i32::MAX as f64) {
             return Err(TableError::OutOfRange);
         }
@@ -377,6 +456,11 @@ enum CornerEnd {
     /// than the cone there (the law above `Δ(P)` then nearly straight). Its last knot is
     /// `P` with the slope from below.
     Kink,
+    /// At a preload's kink `Δ(P)`, as [`CornerEnd::Kink`], but under the uniform grid,
+    /// which starts there (a *lower* corner, [`ForceTable::lower_corner`]): it reaches down
+    /// to the law's first kink (or the domain's start), the line below under it, and the
+    /// grid follows the law above `Δ(P)` where the series spring is not much softer.
+    Lower,
 }
 
 impl Corner {
@@ -386,7 +470,7 @@ impl Corner {
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
-            CornerEnd::Kink => law.delta(law.preload),
+            CornerEnd::Kink | CornerEnd::Lower => law.delta(law.preload),
         };
         // Every other placement has knots up to the domain's end, each held within the
         // format's range (`Corner::knot`, `Grid::knot`); this one's line must be too.
@@ -399,7 +483,13 @@ impl Corner {
             }
         }
         let unit = (1u64 << STRAIN_FRAC) as f64;
-        let pre = libm::round(libm::ldexp(1.0, 32) / (len * unit));
+        // (A lower corner's length at least `len`: it must reach the line below.)
+        let pre = libm::ldexp(1.0, 32) / (len * unit);
+        let pre = if end == CornerEnd::Lower {
+            libm::floor(pre)
+        } else {
+            libm::round(pre)
+        };
         // The nearest octave's inner end at least a strain LSB from the anchor.
         if !(pre >= 1.0 && pre <= (1u64 << 24) as f64) {
             return Err(TableError::TooNarrow);
@@ -436,6 +526,14 @@ impl Corner {
         })
     }
 
+    /// A lower corner's `corner_hi` (Q24): the last strain below it, whose coordinate
+    /// `(A − e) · pre` is 2³² or more.
+    fn bottom(&self) -> i32 {
+        let e = libm::floor(self.anchor as f64 - libm::ldexp(1.0, 32) / self.pre as f64);
+        // (Within the format: the corner's start is a strain below its anchor.)
+        e.max(i32::MIN as f64) as i32
+    }
+
     /// The strain of coordinate `(z, jj)` ([`corner_strain`]).
     fn strain(&self, z: usize, jj: usize) -> f64 {
         corner_strain(self.anchor, self.pre, z, jj)
@@ -449,7 +547,7 @@ impl Corner {
         let last = z == CORNER_OCTAVES - 1 && jj == 0;
         let f = match self.end {
             CornerEnd::Solid if last => law.f_c,
-            CornerEnd::Kink if last => law.preload,
+            CornerEnd::Kink | CornerEnd::Lower if last => law.preload,
             _ => law.force(self.strain(z, jj)),
         };
         let k = 1.0 / law.compliance(f);
@@ -580,6 +678,11 @@ fn kink_on_knot(below: f64, (z, jj): (u32, u32)) -> Option<f64> {
     (pre >= 1.0 && pre <= libm::ldexp(1.0, 24)).then(|| libm::ldexp(1.0, 32) / (pre * unit))
 }
 
+/// How far a lower corner reaches below `Δ(P)`, as a factor of the way down to the
+/// law's first kink (or the domain's start): its nearest octave's `1/256` lies past
+/// `Δ(P)`, so `256/255` (and a little more) puts its first knot at or below that start.
+const LOWER_CORNER_REACH: f64 = 256.0 / 255.0 * (1.0 + 1e-9);
+
 /// Where the graded corner above a preload's kink starts, as fractions of the way from
 /// `Δ(P)` to its end ([`ForceTable::from_law_best`]): the uniform grid ends there.
 const ABOVE_KINK_MARGINS: [f64; 5] = [0.02, 0.05, 0.1, 0.2, 0.35];
@@ -633,13 +736,16 @@ struct Grid {
 
 impl Grid {
     /// Places `S` segments over the law's curved part inside `[from, to]` (with
-    /// `TENSION` and [`Align::FromDomain`], from `from` instead).
+    /// `TENSION` and [`Align::FromDomain`], from `from` instead; from `start`, a Q24
+    /// strain on a preload's kink `Δ(P)` with a knot on it, above a lower corner; up to
+    /// `end`, below a graded corner).
     fn place<const TENSION: bool>(
         law: &Law,
         from: f64,
         to: f64,
         align: Align,
         n: usize,
+        start: Option<i32>,
         end: Option<f64>,
     ) -> Result<Self, TableError> {
         if n == 0 {
@@ -653,8 +759,13 @@ impl Grid {
         // beyond), decided before the ends are rounded to the strain format.
         let from_domain = TENSION && align == Align::FromDomain && from < e_t;
         // With a graded corner (`end`), the uniform grid ends where the corner starts.
-        let (at_kink, at_solid) = (from <= e_t && !from_domain, to >= e_c && end.is_none());
-        let lo = if at_kink { e_t } else { from };
+        let at_kink = from <= e_t && !from_domain && start.is_none();
+        let at_solid = to >= e_c && end.is_none();
+        let lo = match start {
+            Some(s) => s as f64 / (1u64 << STRAIN_FRAC) as f64,
+            None if at_kink => e_t,
+            None => from,
+        };
         let hi = match end {
             Some(x) => x,
             None if at_solid => e_c,
@@ -691,7 +802,12 @@ impl Grid {
         // The strain the aligned knot sits on: Δ(P) (Δ(F_T) without a preload, where
         // P = F_T) from the domain's start, else the inner corner.
         let mut knot_at = e_p;
-        if from_domain {
+        if start.is_some() {
+            // Above a lower corner: the first knot on Δ(P) (the strain the corner ends
+            // on), the grid uniform from there.
+            knot_at = lo;
+            kink_knot = Some(0);
+        } else if from_domain {
             // j segments from the domain's start to that knot, the most that still
             // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
             knot_at = law.delta(law.preload);
@@ -975,30 +1091,35 @@ struct Lines {
 /// the step up at the knot is `(k − k_q) ε_lo`: at most 2⁻²⁸ ε_lo N with the Q28 slope
 /// of [`RawTable::slope_lo`], 2⁻¹⁶ ε_lo N without); otherwise the tangent at the domain
 /// edge, through the law at the first knot; either anchored by [`rounding_anchor`] and
-/// held at or below the first knot's value (`first_q20`). Above the table, the line
-/// through the last knot: `k_p` when the table ends at the solid point, else the tangent
-/// there.
-fn lines<const S: usize>(law: &Law, grid: &Grid, first_q20: i32) -> Result<Lines, TableError> {
-    let (k, round): (f64, fn(f64) -> f64) = if grid.at_kink {
+/// held at or below the first knot's value (`first_q20`). The table starts at `bottom
+/// = (at_kink, strain)` (Q24): the grid's start, or a lower corner's `corner_hi`. Above
+/// the table, the line through the grid's last knot: `k_p` when the table ends at the
+/// solid point, else the tangent there.
+fn lines<const S: usize>(
+    law: &Law,
+    grid: &Grid,
+    (at_kink, strain_lo): (bool, i32),
+    first_q20: i32,
+) -> Result<Lines, TableError> {
+    let e_lo = strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
+    let (k, round): (f64, fn(f64) -> f64) = if at_kink {
         (law.k, libm::floor)
     } else {
-        (1.0 / law.compliance(law.force(grid.lo)), libm::round)
+        (1.0 / law.compliance(law.force(e_lo)), libm::round)
     };
     let (stiffness_lo, slope_lo) = line_slopes(k, round)?;
     // The line's exact point: the origin on a table that starts at the kink, else the
     // law at the first knot (whose rounded force, `first_q20`, the table starts from).
-    let (e_a, f_a) = if grid.at_kink {
+    let (e_a, f_a) = if at_kink {
         (0, 0.0)
     } else {
-        let e = grid.strain_lo as f64 / (1u64 << STRAIN_FRAC) as f64;
-        (grid.strain_lo, law.force(e) * (1u64 << FORCE_FRAC) as f64)
+        (strain_lo, law.force(e_lo) * (1u64 << FORCE_FRAC) as f64)
     };
     let (anchor_lo, mut force_lo) = rounding_anchor(e_a, f_a, slope_lo, stiffness_lo)?;
     // Never above the first knot at strain_lo, so that the curve stays monotone across
     // it (the nearest Q20 values of the law there may differ by one LSB from the knot's).
     let p = slope_frac(stiffness_lo) + STRAIN_FRAC - FORCE_FRAC;
-    let at_lo =
-        force_lo as i64 + ((slope_lo as i64 * (grid.strain_lo as i64 - anchor_lo as i64)) >> p);
+    let at_lo = force_lo as i64 + ((slope_lo as i64 * (strain_lo as i64 - anchor_lo as i64)) >> p);
     if at_lo > first_q20 as i64 {
         force_lo = i32::try_from(force_lo as i64 - (at_lo - first_q20 as i64))
             .map_err(|_| TableError::OutOfRange)?;

@@ -131,7 +131,11 @@ pub struct RawTable<const S: usize> {
     /// The line above the tabulated range is `force_hi + ⌊slope_hi · (e − corner_hi)⌋`
     /// (Q20 N): on a built table `force_hi` is the law's force at `corner_hi` (the first
     /// strain past the last knot) floored, plus one LSB, which balances the product's
-    /// floor (the line within (−1, 1) LSB of the law).
+    /// floor (the line within (−1, 1) LSB of the law). Under a lower corner
+    /// ([`ForceTable::lower_corner`]) `corner_hi` lies below the table: `force_hi` is
+    /// then the same line extrapolated down to it, exactly in the product's terms (so
+    /// that the line is the same from `strain_hi` up), and at least zero (so that a
+    /// product held at ±2048 N still saturates the force).
     pub force_hi: i32,
     /// Slope of the line above (Q16 N per unit strain): its stiffness (the nearest Q16
     /// value where `slope_hi` is Q28).
@@ -152,10 +156,11 @@ pub struct RawTable<const S: usize> {
     pub stiff_post: i32,
     /// The end of the graded corner (Q24), exclusive: the line above starts here.
     /// `strain_hi` when the table has no graded corner (see [`ForceTable::corner`]).
+    /// Below `strain_lo` for a *lower* corner ([`ForceTable::lower_corner`]): the corner
+    /// is then `(corner_hi, strain_lo]`, the line below at and under `corner_hi`.
     pub corner_hi: i32,
-    /// The graded corner's anchor `A` (Q24), just past `corner_hi`: a strain `e` in
-    /// `[strain_hi, corner_hi)` has the coordinate `d = (A − e) · corner_pre` (`u32`) in
-    /// `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
+    /// The graded corner's anchor `A` (Q24), just past its end: a strain `e` in it has
+    /// the coordinate `d = (A − e) · corner_pre` (`u32`) in `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
     pub corner_anchor: i32,
     /// See `corner_anchor`.
     pub corner_pre: u32,
@@ -210,8 +215,10 @@ impl<const S: usize> ForceTable<S> {
     /// Checks the invariants every built table keeps (a raw table from elsewhere may not):
     /// a tabulated range of at least one strain LSB per segment, a power-of-two index
     /// prefactor, an index scale of 1 … 31 significant bits, a coefficient shift of at
-    /// most 12, a power-of-two stiffness post-factor, and non-negative slopes on the
-    /// lines. Evaluation never panics either way; on a table that fails this check its
+    /// most 12, a power-of-two stiffness post-factor, non-negative slopes on the lines,
+    /// and a graded corner's coordinate within its octaves over its range (above the
+    /// grid, or under it as a lower corner, whose line above then starts from a force of
+    /// at least zero). Evaluation never panics either way; on a table that fails this check its
     /// values mean nothing.
     pub fn validate(&self) -> Result<(), TableError> {
         let r = &self.raw;
@@ -228,8 +235,9 @@ impl<const S: usize> ForceTable<S> {
             && r.stiffness_lo >= 0
             && self.slope_fits()
             && r.stiffness_hi >= 0
-            && r.corner_hi >= r.strain_hi
-            && (r.corner_hi == r.strain_hi || self.corner_fits());
+            && (r.corner_hi >= r.strain_hi || r.corner_hi < r.strain_lo)
+            && (r.corner_hi == r.strain_hi || self.corner_fits())
+            && (!self.lower_corner() || r.force_hi >= 0);
         if ok {
             Ok(())
         } else {
@@ -257,25 +265,48 @@ impl<const S: usize> ForceTable<S> {
     /// Size of the table in bytes.
     pub const SIZE_BYTES: usize = core::mem::size_of::<RawTable<S>>();
 
-    /// The tabulated strain range `[lo, hi]` (with the graded corner, if any).
+    /// The tabulated strain range `(lo, hi)` (with the graded corner, if any): the line
+    /// below at and under `lo`, the line above at and over `hi`.
     pub fn tabulated_range(&self) -> (Strain, Strain) {
-        (
-            Strain::from_bits(self.raw.strain_lo),
-            Strain::from_bits(self.raw.corner_hi),
-        )
+        let r = &self.raw;
+        let (lo, hi) = if self.lower_corner() {
+            (r.corner_hi, r.strain_hi)
+        } else {
+            (r.strain_lo, r.corner_hi)
+        };
+        (Strain::from_bits(lo), Strain::from_bits(hi))
     }
 
-    /// The graded corner's range `[strain_hi, corner_hi)`, if the table has one: knots
-    /// graded geometrically toward its anchor (the solid point `Δ(F_C)`), where a stiff
-    /// series spring's law bends hardest (see the module docs).
+    /// The graded corner's range `[lo, hi)`, if the table has one: knots graded
+    /// geometrically toward its anchor (the solid point `Δ(F_C)`, or a preload's kink
+    /// `Δ(P)`), where the law bends hardest (see the module docs). Above the uniform grid
+    /// `[strain_hi, corner_hi)`; a lower corner ([`ForceTable::lower_corner`])
+    /// `[corner_hi + 1, strain_lo + 1)`.
     pub fn corner(&self) -> Option<(Strain, Strain)> {
+        // (The end saturates only on a table that fails `validate`.)
+        let (first, last) = self.corner_strains()?;
+        let end = (last + 1).min(i32::MAX as i64);
+        Some((
+            Strain::from_bits(first as i32),
+            Strain::from_bits(end as i32),
+        ))
+    }
+
+    /// The graded corner's first and last strains (Q24, `first ≤ last`), if it has one.
+    fn corner_strains(&self) -> Option<(i64, i64)> {
         let r = &self.raw;
-        (r.corner_hi > r.strain_hi).then(|| {
-            (
-                Strain::from_bits(r.strain_hi),
-                Strain::from_bits(r.corner_hi),
-            )
-        })
+        if self.lower_corner() {
+            Some((r.corner_hi as i64 + 1, r.strain_lo as i64))
+        } else {
+            (r.corner_hi > r.strain_hi).then_some((r.strain_hi as i64, r.corner_hi as i64 - 1))
+        }
+    }
+
+    /// Whether the graded corner lies below the uniform grid (`corner_hi < strain_lo`):
+    /// over `(corner_hi, strain_lo]`, graded toward a preload's kink `Δ(P)` at the grid's
+    /// first knot, the line below under it and the line above anchored at `strain_hi`.
+    pub fn lower_corner(&self) -> bool {
+        self.raw.corner_hi < self.raw.strain_lo
     }
 
     /// Whether each line's force slope is its stiffness: to within one Q16 LSB in Q28
@@ -297,11 +328,14 @@ impl<const S: usize> ForceTable<S> {
     /// its segments are inside the table.
     fn corner_fits(&self) -> bool {
         let r = &self.raw;
-        let d = |e: i32| (r.corner_anchor as i64 - e as i64) * r.corner_pre as i64;
+        let d = |e: i64| (r.corner_anchor as i64 - e) * r.corner_pre as i64;
+        let Some((first, last)) = self.corner_strains() else {
+            return false;
+        };
         S >= CORNER_SEGMENTS
             && r.corner_base as usize <= S - CORNER_SEGMENTS
-            && d(r.strain_hi) < 1 << 32
-            && d(r.corner_hi - 1) >= 1 << 24
+            && d(first) < 1 << 32
+            && d(last) >= 1 << 24
             && r.corner_post > 0
             && (r.corner_post as u32).is_power_of_two()
             && r.corner_scale <= 0
@@ -332,12 +366,12 @@ impl<const S: usize> ForceTable<S> {
             let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
             max = max.max(k.to_bits());
         }
-        if self.corner().is_some() {
+        if let Some((first, last)) = self.corner_strains() {
             for i in 0..CORNER_SEGMENTS {
                 let (a, b) = self.corner_segment_range(i);
                 for x in [a, (a + b) / 2.0, b] {
                     let e = libm::round(x * (1u64 << STRAIN_FRAC) as f64) as i64;
-                    let e = e.clamp(r.strain_hi as i64, r.corner_hi as i64 - 1);
+                    let e = e.clamp(first, last);
                     let (_, k) = self.force_and_stiffness(Strain::from_bits(e as i32));
                     max = max.max(k.to_bits());
                 }
@@ -364,6 +398,9 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
+            if e > r.corner_hi {
+                return Force::from_bits(self.corner_force(e));
+            }
             return Force::from_bits(line_below::<false, S>(r, e));
         }
         if e >= r.strain_hi {
@@ -381,11 +418,25 @@ impl<const S: usize> ForceTable<S> {
     /// less (the clamp makes the saturation of the straight lines exact).
     #[inline]
     pub fn force_within<const BITS: u32>(&self, strain: Strain) -> i32 {
+        self.force_within_for::<BITS, true>(strain)
+    }
+
+    /// [`ForceTable::force_within`] where the caller knows whether the table may have a
+    /// lower corner ([`ForceTable::lower_corner`]; `LOWER` true serves every table): the
+    /// solver's loops choose once per call, so that a table without one pays nothing for
+    /// it on the line below, their most common path. `LOWER` false on a table that has
+    /// one evaluates that corner as the line below (wrong values, no panic).
+    #[inline(always)]
+    pub fn force_within_for<const BITS: u32, const LOWER: bool>(&self, strain: Strain) -> i32 {
         const { assert!(BITS <= 30) };
         let r = &self.raw;
         let e = strain.to_bits();
         let f = if e <= r.strain_lo {
-            line_below::<true, S>(r, e)
+            if LOWER && e > r.corner_hi {
+                self.corner_force(e)
+            } else {
+                line_below::<true, S>(r, e)
+            }
         } else if e >= r.strain_hi {
             self.above_within(e)
         } else {
@@ -404,6 +455,9 @@ impl<const S: usize> ForceTable<S> {
         let r = &self.raw;
         let e = strain.to_bits();
         if e <= r.strain_lo {
+            if e > r.corner_hi {
+                return self.lower_corner_force_and_stiffness(e);
+            }
             let f = line_below::<false, S>(r, e);
             return (Force::from_bits(f), Stiffness::from_bits(r.stiffness_lo));
         }
@@ -434,7 +488,7 @@ impl<const S: usize> ForceTable<S> {
         }
     }
 
-    /// The force (Q20 N) in the graded corner (`strain_hi ≤ e < corner_hi`), out of line
+    /// The force (Q20 N) in the graded corner (in [`ForceTable::corner`]'s range), out of line
     /// and cold: the solver's loops keep the uniform part's registers.
     #[inline(never)]
     #[cold]
@@ -443,8 +497,16 @@ impl<const S: usize> ForceTable<S> {
         cubic_value(&self.raw, c, t)
     }
 
-    /// [`ForceTable::force_and_stiffness`] in the graded corner (`strain_hi ≤ e <
-    /// corner_hi`).
+    /// [`ForceTable::force_and_stiffness`] in a lower corner, out of line: inlined, its
+    /// registers would be saved on every path (the M4F's evaluation 27 → 31 instructions
+    /// over Table 2's lines and grid); a lower corner is a rare table's.
+    #[inline(never)]
+    fn lower_corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
+        self.corner_force_and_stiffness(e)
+    }
+
+    /// [`ForceTable::force_and_stiffness`] in the graded corner (in
+    /// [`ForceTable::corner`]'s range).
     #[inline(always)]
     fn corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
         let r = &self.raw;
@@ -461,7 +523,7 @@ impl<const S: usize> ForceTable<S> {
         )
     }
 
-    /// The graded corner's segment holding `e` (`strain_hi ≤ e < corner_hi`), the Q15
+    /// The graded corner's segment holding `e` (in [`ForceTable::corner`]'s range), the Q15
     /// position in it and the octave: `d = (A − e) · pre`, `z = clz(d)`; the two bits
     /// after `d`'s leading one are the segment in the octave, the next 15 `τ`. On a
     /// table that fails [`ForceTable::validate`] the segment is any (masked), never out

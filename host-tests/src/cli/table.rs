@@ -78,11 +78,16 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         } else {
             format!("OVER the product's bound ({promise}): emitted with --accept-error")
         };
-        let solid = mccs::Law::new(&p).ok().map(|l| l.strain_c());
+        let points = mccs::Law::new(&p).ok().map_or(vec![], |l| {
+            vec![
+                (l.strain_c(), "the solid point"),
+                (l.delta(l.preload), "the preload's kink"),
+            ]
+        });
         render_table(
             &format!("{header}// Accuracy, {figures}: {verdict}.\n"),
             &t,
-            solid,
+            &points,
         )
     });
     match a.out {
@@ -384,10 +389,14 @@ fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable
     })
 }
 
-/// Renders a table as a Rust expression for `include!`, preceded by `header`; `solid`,
-/// the law's solid point `Δ(F_C)` if known, names where a graded corner ends (the solid
-/// point, or the domain's end).
-pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>, solid: Option<f64>) -> String {
+/// Renders a table as a Rust expression for `include!`, preceded by `header`; `points`,
+/// the law's named strains if known (its solid point `Δ(F_C)`, a preload's kink
+/// `Δ(P)`), name where a graded corner ends (one of them, or the domain's end).
+pub fn render_table<const S: usize>(
+    header: &str,
+    t: &ForceTable<S>,
+    points: &[(f64, &str)],
+) -> String {
     let r = t.raw();
     let mut s = String::from(header);
     s.push_str("// Formats: strains Q24, forces Q20 N, stiffnesses Q16 N per unit strain.\n");
@@ -396,18 +405,22 @@ pub fn render_table<const S: usize>(header: &str, t: &ForceTable<S>, solid: Opti
         Some((a, b)) => {
             // The corner's exclusive end is within a few strain LSBs of its last knot.
             let end = b.to_num::<f64>();
-            let toward = match solid {
-                Some(e_c) if (end - e_c).abs() <= 4.0 * mccs::Strain::DELTA.to_num::<f64>() => {
-                    "the solid point"
-                }
-                Some(_) => "the domain's end",
-                None => "their end",
+            let near = 4.0 * mccs::Strain::DELTA.to_num::<f64>();
+            let toward = match points.iter().find(|(e, _)| (end - e).abs() <= near) {
+                Some((_, name)) => name,
+                None if points.is_empty() => "their end",
+                None => "the domain's end",
             };
-            s.push_str(&format!(
-                "// Layout: {} segments uniform over [{lo}, {a}), then {} graded toward {toward} over [{a}, {b}).\n",
-                t.segments_used(),
-                mccs::table::CORNER_SEGMENTS
-            ))
+            let (used, graded) = (t.segments_used(), mccs::table::CORNER_SEGMENTS);
+            s.push_str(&if t.lower_corner() {
+                format!(
+                    "// Layout: {graded} segments graded toward {toward} over [{a}, {b}), then {used} uniform over [{b}, {hi}).\n"
+                )
+            } else {
+                format!(
+                    "// Layout: {used} segments uniform over [{lo}, {a}), then {graded} graded toward {toward} over [{a}, {b}).\n"
+                )
+            })
         }
         None => s.push_str(&format!(
             "// Layout: {} segments uniform over [{lo}, {hi}).\n",

@@ -18,7 +18,9 @@
 
 use super::{Arith, ArithTable, StepSpec, SPRING_FORCE_BITS};
 use crate::q::{self, V3};
-use crate::state::{for_each_spring, Ends, Node, SpringEnds, SpringKernel, VEL_LIMIT_MM_S};
+use crate::state::{
+    for_each_spring, for_each_spring_checked, Ends, Node, SpringEnds, SpringKernel, VEL_LIMIT_MM_S,
+};
 use crate::table::ForceTable;
 use crate::topology::{Edge, Topology};
 use crate::units::{from_f64, Strain, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC, ONE};
@@ -27,7 +29,7 @@ mod step;
 mod table;
 
 pub use step::NarrowStep;
-pub use table::{table_force, NarrowTable};
+pub use table::{table_force, table_force_for, NarrowTable};
 
 /// Products with one 16-bit operand: the Cortex-M0's arithmetic.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -94,9 +96,9 @@ impl Arith for Narrow {
         warm: &mut i32,
     ) -> V3 {
         if c.damping.unit {
-            spring::<S, true>(table, edge, e.into(), warm, &c.damping)
+            spring::<S, true, true>(table, edge, e.into(), warm, &c.damping)
         } else {
-            spring::<S, false>(table, edge, e.into(), warm, &c.damping)
+            spring::<S, false, true>(table, edge, e.into(), warm, &c.damping)
         }
     }
 
@@ -109,10 +111,30 @@ impl Arith for Narrow {
         nodes: &mut [Node; NODES],
     ) {
         let damping = &c.damping;
-        if damping.unit {
-            for_each_spring(topo, warm, nodes, &Kernel::<S, true> { table, damping });
-        } else {
-            for_each_spring(topo, warm, nodes, &Kernel::<S, false> { table, damping });
+        // (A lower corner's check only in the loop of a table that has one.)
+        // (The loop of a table with a lower corner out of line.)
+        let edges = topo.edges();
+        match (damping.unit, table.table.lower_corner()) {
+            (true, false) => for_each_spring(
+                topo,
+                warm,
+                nodes,
+                &Kernel::<S, true, false> { table, damping },
+            ),
+            (false, false) => for_each_spring(
+                topo,
+                warm,
+                nodes,
+                &Kernel::<S, false, false> { table, damping },
+            ),
+            (true, true) => {
+                let kernel = Kernel::<S, true, true> { table, damping };
+                for_each_spring_checked(edges, warm, nodes, &kernel)
+            }
+            (false, true) => {
+                let kernel = Kernel::<S, false, true> { table, damping };
+                for_each_spring_checked(edges, warm, nodes, &kernel)
+            }
         }
     }
 
@@ -202,15 +224,17 @@ impl NarrowDamping {
 }
 
 /// [`spring`] with its table and damping, for the solver's loop.
-struct Kernel<'a, const S: usize, const UNIT: bool> {
+struct Kernel<'a, const S: usize, const UNIT: bool, const LOWER: bool> {
     table: &'a ArithTable<S, Narrow>,
     damping: &'a NarrowDamping,
 }
 
-impl<const S: usize, const UNIT: bool> SpringKernel for Kernel<'_, S, UNIT> {
+impl<const S: usize, const UNIT: bool, const LOWER: bool> SpringKernel
+    for Kernel<'_, S, UNIT, LOWER>
+{
     #[inline(always)]
     fn force(&self, edge: &Edge, ends: Ends<'_>, warm: &mut i32) -> V3 {
-        spring::<S, UNIT>(self.table, edge, ends, warm, self.damping)
+        spring::<S, UNIT, LOWER>(self.table, edge, ends, warm, self.damping)
     }
 }
 
@@ -220,14 +244,15 @@ impl<const S: usize, const UNIT: bool> SpringKernel for Kernel<'_, S, UNIT> {
 /// `C` is below [`NARROW_MIN_DAMPING`] (`UNIT`: the caller has checked that
 /// `damping.unit` holds, and the loop is compiled without the product). The ranges and
 /// the limits are those of the wide spring ([`super::Wide`]), except that `l0/l` stays
-/// below 7 (a spring crushed below `l0/7` keeps it at 7).
+/// below 7 (a spring crushed below `l0/7` keeps it at 7). `LOWER`: whether the table may
+/// have a lower corner ([`table_force_for`]).
 ///
 /// Newton for `r = l0/l = 1/√(1 + s)` runs on `ρ = r − 1`: `e = a r² − 1 = s + a ρ (2 + ρ)`,
 /// `ρ' = ρ − r e / 2`, and the strain is `ε = 1 − a r' = −(s + ρ' + s ρ')`. Each
 /// product's 16-bit operand (`1/l0`, `d + w`, `r`, `s`, `w`, `C/C_v`) is an order-one
 /// quantity rounded or truncated to at most 2⁻¹¹, so each term is within ~1e-4 of itself.
 #[inline(always)]
-fn spring<const S: usize, const UNIT: bool>(
+fn spring<const S: usize, const UNIT: bool, const LOWER: bool>(
     table: &ArithTable<S, Narrow>,
     edge: &Edge,
     ends: Ends<'_>,
@@ -278,7 +303,7 @@ fn spring<const S: usize, const UNIT: bool>(
     let lm1 = s.wrapping_add(rn >> 4).wrapping_add(srho);
     // (The shift behind a barrier: LLVM would make it a product by −16.)
     let strain = Strain::from_bits(q::opaque(lm1 << 4).wrapping_neg());
-    let f = table_force(table, strain);
+    let f = table_force_for::<S, LOWER>(table, strain);
     // −f r' (Q20 · Q12 / 2¹² = Q20, |f r'| < 448 N).
     let neg_fr = q::mul_s::<12>(f, q::narrow::<12>(rn.wrapping_add(ONE))).wrapping_neg();
 

@@ -109,11 +109,26 @@ impl NarrowLine {
 /// raw Q20 N out, within ±64 N.
 #[inline(always)]
 pub fn table_force<const S: usize>(table: &ArithTable<S, Narrow>, strain: Strain) -> i32 {
+    table_force_for::<S, true>(table, strain)
+}
+
+/// [`table_force`] where the caller knows whether the table may have a lower corner
+/// (`LOWER`, as [`ForceTable::force_within_for`](crate::table::ForceTable::force_within_for)).
+#[inline(always)]
+pub fn table_force_for<const S: usize, const LOWER: bool>(
+    table: &ArithTable<S, Narrow>,
+    strain: Strain,
+) -> i32 {
     let r = table.table.raw();
     let n = &table.aux;
     let e = strain.to_bits();
     let f = if e <= r.strain_lo {
-        n.lo.below(r.force_lo, e, r.anchor_lo)
+        if LOWER && e > r.corner_hi {
+            // A lower corner (`ForceTable::lower_corner`).
+            table.table.corner_force(e)
+        } else {
+            n.lo.below(r.force_lo, e, r.anchor_lo)
+        }
     } else if e >= r.strain_hi {
         if e >= r.corner_hi {
             n.hi.above(r.force_hi, e, r.corner_hi)

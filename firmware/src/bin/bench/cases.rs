@@ -38,7 +38,8 @@ pub fn force_and_stiffness(h: &Harness, table: &ForceTable64) -> u32 {
 }
 
 /// `force_and_stiffness` over strains sweeping a graded corner (`table` must have one:
-/// the stiff series spring's, `tables/stiff_series.rs`), harness taken off: what an
+/// the stiff series spring's, `tables/stiff_series.rs`, or the steep kink's lower one,
+/// `tables/steep_kink.rs`), harness taken off: what an
 /// evaluation costs there (its octave's `clz`, the stiffness's scale per octave).
 #[inline(never)]
 pub fn force_and_stiffness_corner(h: &Harness, table: &ForceTable64) -> u32 {
@@ -562,7 +563,7 @@ impl TablePath {
             Self::Below
         } else if e >= hi {
             Self::Above
-        } else if table.corner().is_some_and(|(a, _)| e >= a) {
+        } else if table.corner().is_some_and(|(a, b)| e >= a && e < b) {
             Self::Corner
         } else {
             Self::Uniform

@@ -8,15 +8,17 @@
 //!   stretched past the table's lower end and past the `±2 l0` hold, on its segments,
 //!   crushed past its upper end, below `l0/8` (the held `l0/l`) and through zero length.
 //!
-//! Each state takes one of six tables: Table 2's; the same with its coefficients 64
+//! Each state takes one of seven tables: Table 2's; the same with its coefficients 64
 //! times larger (forces past the ±64 N hold) and a shift past 31 (which wraps, as
 //! `wrapping_shr` does), and a graded corner of any contents above its uniform part
 //! (an index past the table, masked); one with the steepest slopes, the largest end
 //! forces and its upper line from an eighth of its range (the lines' products held,
 //! their sums saturated); one with its lower line's anchor at `i32::MAX` (the strain
 //! difference saturates); one whose range ends at `i32::MIN + 1` (the upper line's
-//! does); and the stiff series spring's (`tables/stiff_series.rs`), whose last 32
-//! segments are a graded corner, where a quarter of the single springs are put. The
+//! does); the stiff series spring's (`tables/stiff_series.rs`), whose last 32
+//! segments are a graded corner; and the steep kink's (`tables/steep_kink.rs`), whose
+//! corner lies under its grid (a lower corner). A quarter of the single springs are put
+//! in the corner of a table that has one. The
 //! second and fourth put each line's stiffness at either end of the range where its
 //! force takes the Q28 slope (`mccs::table::fine_line`), with the largest slopes.
 //!
@@ -24,8 +26,9 @@
 //! state runs a few loops in a row with the integrator between them (its velocity and
 //! displacement holds included), so that the warm start also converges. Prints
 //! `KERNEL core=<c> states=<n> springs=<n> mismatches=<n>`; a mismatch exits with
-//! failure. On the M3 both sides are the portable loop, so there its line shows only
-//! that the check runs; the M0's arithmetic is [`mccs::Narrow`], not checked here.
+//! failure. It runs on the M4F only: on the M3 both sides would be the same portable
+//! loop (its bench's flash, 256 KiB, has no room for a check that cannot fail there),
+//! and the M0's arithmetic is [`mccs::Narrow`], not checked here.
 
 use super::fw_common::exit;
 use super::rng::Rng;
@@ -38,6 +41,8 @@ use mccs_firmware::target::{Core, CORE};
 const STATES: u32 = 400;
 /// Loops run in a row on each state.
 const ROUNDS: usize = 3;
+/// The tables the states take in turn ([`variants`]).
+const VARIANTS: usize = 7;
 /// The single springs: half to the ground, half between two free nodes.
 const SINGLE: usize = 48;
 
@@ -89,10 +94,12 @@ fn stir<const N: usize, const E: usize>(
     }
 }
 
-/// Runs the check (not on the M0) and exits with failure on a mismatch.
+/// Runs the check (on the M4F, whose loops are assembly; elsewhere both sides would be
+/// the same portable loop, and the M3's flash has no room for it) and exits with
+/// failure on a mismatch.
 #[inline(never)]
 pub fn check(table: &ForceTable64) {
-    if CORE != Core::M0 {
+    if CORE == Core::M4F {
         run(table);
     }
 }
@@ -111,7 +118,7 @@ fn run(table: &ForceTable64) {
         exit(false)
     };
     for state in 0..STATES {
-        let table = &tables[((state / 3) % 6) as usize];
+        let table = &tables[((state / 3) % VARIANTS as u32) as usize];
         // The graded corner's range (of the stiff series spring's table), in strain.
         let corner = table
             .table
@@ -178,9 +185,9 @@ fn run(table: &ForceTable64) {
     }
 }
 
-/// Table 2's table, the four variants that reach the holds and saturations, and the
-/// stiff series spring's (module docs).
-fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
+/// Table 2's table, the four variants that reach the holds and saturations, the stiff
+/// series spring's and the steep kink's (module docs).
+fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; VARIANTS] {
     static STIFF_SERIES: ForceTable64 = include!("../../../../tables/stiff_series.rs");
     let raw = *table.raw();
     let mut large = raw;
@@ -222,8 +229,17 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; 6] {
     ends.strain_lo = i32::MIN;
     ends.strain_hi = i32::MIN + 1;
     ends.corner_hi = i32::MIN + 1;
-    [raw, large, steep, anchored, ends, *STIFF_SERIES.raw()]
-        .map(|r| ArithTable::new(ForceTable64::from_raw(r)))
+    static STEEP_KINK: ForceTable64 = include!("../../../../tables/steep_kink.rs");
+    [
+        raw,
+        large,
+        steep,
+        anchored,
+        ends,
+        *STIFF_SERIES.raw(),
+        *STEEP_KINK.raw(),
+    ]
+    .map(|r| ArithTable::new(ForceTable64::from_raw(r)))
 }
 
 /// One spring of the single set: its nodes, rest length (mm), rest direction and a unit

@@ -70,6 +70,11 @@ mod firmware {
             "force_and_stiffness_corner",
             cases::force_and_stiffness_corner(&h, black_box(&STIFF_SERIES)),
         );
+        static STEEP_KINK: ForceTable64 = include!("../../../../tables/steep_kink.rs");
+        figs.report(
+            "force_and_stiffness_lower_corner",
+            cases::force_and_stiffness_corner(&h, black_box(&STEEP_KINK)),
+        );
         figs.report("spring", cases::spring(&h, table));
         let probe = [Length::ZERO, Length::ZERO, Length::from_num(-0.5)];
         let sub = |h: &Harness, n, i| match n {
@@ -99,12 +104,14 @@ mod firmware {
         // One spring on each path of its arithmetic, in the loop (`cases::spring_path`):
         // the most it took over strains across the path (the corner's as fractions of it);
         // the spread is the most of all less the least of all.
-        let corner = |x: f64| {
-            STIFF_SERIES.corner().map_or(0.5, |(a, b)| {
+        let within = |t: &ForceTable64, x: f64| {
+            t.corner().map_or(0.5, |(a, b)| {
                 let (a, b) = (a.to_num::<f64>(), b.to_num::<f64>());
                 a + (b - a) * x
             })
         };
+        let corner = |x: f64| within(&STIFF_SERIES, x);
+        let lower_corner = |x: f64| within(&STEEP_KINK, x);
         let (mut fastest, mut slowest) = (u32::MAX, 0);
         for (name, t, strains, on) in [
             (
@@ -129,6 +136,12 @@ mod firmware {
                 "spring_path_corner",
                 &STIFF_SERIES,
                 [0.1, 0.3, 0.5, 0.7, 0.9].map(corner),
+                TablePath::Corner,
+            ),
+            (
+                "spring_path_lower_corner",
+                &STEEP_KINK,
+                [0.1, 0.3, 0.5, 0.7, 0.9].map(lower_corner),
                 TablePath::Corner,
             ),
             (
