@@ -506,6 +506,26 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             "{name}: {src}"
         );
     }
+    // A preload on the cone's steep rise toward its own solid point (spring 261 of
+    // table_bound.rs): refused before the lower corner, now within the bound, and the
+    // header says that the corner lies under the grid.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let steep = format!("{root}/params/steep-kink.toml");
+    let out = mccs(&["table", "--params", &steep, "--knots", "129"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let src = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = src.lines().collect();
+    assert!(
+        lines[1].ends_with("within the product's bound (force 2e-5, stiffness 1e-3).")
+            && lines[3]
+                .starts_with("// Layout: 32 segments graded toward the preload's kink over [")
+            && lines[3].contains("), then 96 uniform over ["),
+        "{src}"
+    );
     // With 33 knots the stiff series spring misses the bound, and the refusal names the
     // fewest knots it measured to meet it over the same domain (65, not 129).
     let f = temp_file("stiff-series.toml", &stiff_series);

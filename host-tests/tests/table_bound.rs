@@ -868,11 +868,11 @@ fn a_lower_corner_under_the_grid_from_a_steep_kink() {
         a <= e_t + lsb && (b - e_p).abs() < 4.0 * lsb,
         "the corner [{a}, {b}) from Δ(F_T) {e_t} to Δ(P) {e_p}"
     );
-    holds_on_the_reference("LOWERCORNER case=spring261 knots=129", &p, &t);
+    holds_on_the_reference("LOWERCORNER case=spring261 table=129knots", &p, &t);
     let t65 = ForceTable::<64>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
         .expect("within the bound");
     assert!(t65.lower_corner());
-    holds_on_the_reference("LOWERCORNER case=spring261 knots=65", &p, &t65);
+    holds_on_the_reference("LOWERCORNER case=spring261 table=65knots", &p, &t65);
 }
 
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device

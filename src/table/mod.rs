@@ -28,7 +28,14 @@
 //! corner takes the smooth part above the kink instead, up to `Δ(F_C)` or, when that
 //! lies well past the domain, to the domain's end (the line above then the law's tangent
 //! there), so that the uniform grid's segments all go below a little past `Δ(P)`. The
-//! evaluation is the same either way.
+//! evaluation is the same either way. Where still none does, the corner ends on `Δ(P)`,
+//! graded toward it from below: first with the uniform grid below it and the law's
+//! tangent above, then as a *lower* corner ([`ForceTable::lower_corner`]) from the law's
+//! first kink up to `Δ(P)`, under the uniform grid, which then covers the curved law
+//! above `Δ(P)` (a preload on the cone's steep rise toward its own solid point, with a
+//! series spring not much softer). A lower corner is marked by `corner_hi < strain_lo`
+//! and costs the line below's path one compare; the solver's loops make it only for a
+//! table that has one ([`ForceTable::force_within_for`]).
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
@@ -60,7 +67,8 @@
 //! unsigned high-word product (no search, no division); the value is three Horner steps
 //! (one `smmla` each on the M3/M4), the stiffness two more and one scaling product. No
 //! loop; the only branch is which of the four pieces the strain falls in (the graded
-//! corner's index adds a `clz`, a multiply and its shifts). Every product
+//! corner's index adds a `clz`, a multiply and its shifts; a lower corner's check, a
+//! compare on the line below's path). Every product
 //! has exact floor semantics, and the Cortex-M0 builds them from 16-bit pieces with the
 //! same bits ([`crate::q`]). Instruction counts per core: `docs/performance.md`.
 //!
