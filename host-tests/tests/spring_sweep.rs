@@ -5,7 +5,8 @@
 //! within the measured bound of the model's, and never points the wrong way: a
 //! stretched spring pulls its ends together, a compressed one pushes them apart.
 
-use mccs::arith::{ArithTable, StepSpec};
+use crate::common;
+use mccs::arith::ArithTable;
 use mccs::state::SpringEnds;
 use mccs::units::{from_f64, DIR_FRAC, FORCE_FRAC, INV_LEN_FRAC, LEN_FRAC};
 use mccs::{Arith, Edge, ForceTable64, Narrow, Params, Wide};
@@ -124,14 +125,7 @@ struct Sweep {
 fn sweep<A: Arith>(name: &str, lim: &Limits, states: usize, seed: u64) -> Sweep {
     let law = Reference::new(&Params::TABLE2).unwrap();
     let table = ArithTable::<64, A>::new(ForceTable64::new(&Params::TABLE2).unwrap());
-    let coeffs = A::coeffs(&StepSpec {
-        h: 1.0 / 6000.0,
-        node_mass: 0.005,
-        node_damping: 0.05,
-        spring_damping: 1.0,
-        integrator: mccs::Integrator::ImprovedEuler,
-        damping_factor: 1.0,
-    });
+    let coeffs = common::spring_coeffs::<A>();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut out = Sweep {
         states,
@@ -253,14 +247,7 @@ fn both_springs_recover_from_rest_after_any_jump() {
     fn from_rest<A: Arith>(lim: &Limits) {
         let law = Reference::new(&Params::TABLE2).unwrap();
         let table = ArithTable::<64, A>::new(ForceTable64::new(&Params::TABLE2).unwrap());
-        let coeffs = A::coeffs(&StepSpec {
-            h: 1.0 / 6000.0,
-            node_mass: 0.005,
-            node_damping: 0.05,
-            spring_damping: 1.0,
-            integrator: mccs::Integrator::ImprovedEuler,
-            damping_factor: 1.0,
-        });
+        let coeffs = common::spring_coeffs::<A>();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for _ in 0..10_000 {
             let l0: f64 = rng.random_range(1.0..20.0);

@@ -438,13 +438,21 @@ static STIFF_SERIES: ForceTable<64> = include!("../../tables/stiff_series.rs");
 /// are a lower corner, under the uniform grid.
 static STEEP_KINK: ForceTable<64> = include!("../../tables/steep_kink.rs");
 
+/// The committed near transition's table (`params/near-transition.toml`): its lower
+/// corner lies above its anchor, graded toward the law's first kink from above.
+static NEAR_TRANSITION: ForceTable<64> = include!("../../tables/near_transition.rs");
+
 /// The solver's `force_within` is `force` clamped, over the whole strain range, on the
 /// Table 2 spring, on springs with large forces (whose lines saturate), on the stiff
-/// series spring's graded corner and on the steep kink's lower one.
+/// series spring's graded corner and on the lower ones of the steep kink and the near
+/// transition.
 #[test]
 fn force_within_is_force_clamped() {
     let built = [Params::TABLE2, table2_scaled(30.0)].map(|p| ForceTable::<64>::new(&p).unwrap());
-    for t in built.into_iter().chain([STIFF_SERIES, STEEP_KINK]) {
+    for t in built
+        .into_iter()
+        .chain([STIFF_SERIES, STEEP_KINK, NEAR_TRANSITION])
+    {
         let mut bits = i32::MIN;
         loop {
             let e = Strain::from_bits(bits);
@@ -464,13 +472,17 @@ fn force_within_is_force_clamped() {
 /// uniform grid and the graded corner) the same bits as `force_within::<26>`; on the
 /// straight lines within 2⁻¹⁵ of the line's rise plus 1 LSB; over the whole strain
 /// range a solver's spring can reach (±8), for Table 2, a stiff and a soft spring, and
-/// the stiff series spring and the steep kink (their corners every 7 strain LSBs).
+/// the stiff series spring, the steep kink and the near transition (their corners every
+/// 7 strain LSBs).
 #[test]
 fn force_narrow_is_force_within_to_a_slope_lsb() {
     let mut worst = 0.0f64;
     let built = [Params::TABLE2, table2_scaled(30.0), table2_scaled(0.02)]
         .map(|p| ForceTable::<64>::new(&p).unwrap());
-    for t in built.into_iter().chain([STIFF_SERIES, STEEP_KINK]) {
+    for t in built
+        .into_iter()
+        .chain([STIFF_SERIES, STEEP_KINK, NEAR_TRANSITION])
+    {
         let narrow = ArithTable::<64, Narrow>::new(t);
         let (lo, hi) = t.tabulated_range();
         let (f_lo, f_hi) = (t.raw().force_lo as f64, t.raw().force_hi as f64);
@@ -511,8 +523,9 @@ fn force_narrow_is_force_within_to_a_slope_lsb() {
 /// The graded corner, every strain LSB from below its start to past its end: the force
 /// never decreases (across its own knots and octaves, and where it meets the uniform
 /// grid and the lines), and it stays within the bound of the law, with its stiffness,
-/// as the builder measured. The stiff series spring's corner above its grid, and the
-/// steep kink's lower corner under it.
+/// as the builder measured. The stiff series spring's corner above its grid, the steep
+/// kink's lower corner under it, and the near transition's, under its grid and graded
+/// toward its lower end.
 #[test]
 fn a_graded_corner_is_continuous_and_monotone() {
     let mut stiff_series = Params::TABLE2;
@@ -520,9 +533,12 @@ fn a_graded_corner_is_continuous_and_monotone() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let path = std::path::PathBuf::from(root).join("params/steep-kink.toml");
     let steep_kink = mccs_host::paramfile::read(&path).unwrap();
+    let path = std::path::PathBuf::from(root).join("params/near-transition.toml");
+    let near_transition = mccs_host::paramfile::read(&path).unwrap();
     for (name, t, p) in [
         ("stiff series", STIFF_SERIES, stiff_series),
         ("steep kink", STEEP_KINK, steep_kink),
+        ("near transition", NEAR_TRANSITION, near_transition),
     ] {
         let (a, b) = t.corner().unwrap();
         let (a, b) = (a.to_bits(), b.to_bits());
@@ -566,5 +582,78 @@ proptest! {
         }
         let (f, _) = t.force_and_stiffness(Strain::from_bits(start));
         prop_assert_eq!(t.force(Strain::from_bits(start)), f);
+    }
+}
+
+/// The solver's spring loop (`Arith::spring_forces`, which picks a loop with the lower
+/// corner's compare only for a table that has one) gives each node the sum of what the
+/// kernel alone (`Arith::spring`, which compares for every table) gives its springs, in
+/// both arithmetics, on Table 2's table and the two lower corners' committed tables,
+/// with springs put across every piece of each (the lower corner's among them). Without
+/// the loop's choice, a lower corner's strains would take the line below in the loop.
+#[test]
+fn the_spring_loop_runs_a_lower_corner_as_the_kernel_does() {
+    fn check<A: mccs::Arith>(t: &ForceTable<64>) -> usize {
+        const SPRINGS: usize = 24;
+        let table = ArithTable::<64, A>::new(*t);
+        let coeffs = common::spring_coeffs::<A>();
+        let mut topo = mccs::Topology::<{ 2 * SPRINGS + 1 }, SPRINGS>::new();
+        let mut nodes = [mccs::state::Node::ZERO; 2 * SPRINGS + 1];
+        // Strains across the table: below its range, through its corner, its grid and
+        // above it, each spring along x, 2 mm long, its end b moved by the strain.
+        let (lo, hi) = t.tabulated_range();
+        let (lo, hi) = (lo.to_num::<f64>(), hi.to_num::<f64>());
+        let (a, b) = t
+            .corner()
+            .map_or((lo, hi), |(a, b)| (a.to_num::<f64>(), b.to_num::<f64>()));
+        let mut in_corner = 0;
+        for i in 0..SPRINGS {
+            let x = i as f64 / (SPRINGS - 1) as f64;
+            let strain = match i % 3 {
+                0 => lo - 0.1 + (hi - lo + 0.2) * x,
+                _ => a + (b - a) * x,
+            };
+            in_corner += usize::from(strain > a && strain < b);
+            let na = topo.add_free_node([0.0, 0.0, 3.0 * i as f64]).unwrap();
+            let nb = topo.add_free_node([2.0, 0.0, 3.0 * i as f64]).unwrap();
+            topo.add_edge(mccs::End::Free(na), mccs::End::Free(nb))
+                .unwrap();
+            nodes[nb as usize].u = [mccs::Length::from_num(-2.0 * strain).to_bits(), 0, 0];
+        }
+        let mut warm = [A::REST; SPRINGS];
+        let mut expect = nodes;
+        let mut warm_expect = warm;
+        for (e, w) in topo.edges().iter().zip(warm_expect.iter_mut()) {
+            let (na, nb) = (expect[e.a as usize], expect[e.b as usize]);
+            let ends = mccs::state::SpringEnds {
+                ua: na.u,
+                ub: nb.u,
+                va: na.v,
+                vb: nb.v,
+            };
+            let f = A::spring(&table, &coeffs, e, &ends, w);
+            for k in 0..3 {
+                expect[e.a as usize].f[k] = expect[e.a as usize].f[k].wrapping_add(f[k]);
+                expect[e.b as usize].f[k] = expect[e.b as usize].f[k].wrapping_sub(f[k]);
+            }
+        }
+        A::spring_forces(&table, &coeffs, &topo, &mut warm, &mut nodes);
+        assert_eq!(warm, warm_expect);
+        for (n, m) in nodes.iter().zip(&expect) {
+            assert_eq!(n.f, m.f);
+        }
+        in_corner
+    }
+    let tables = [
+        ForceTable::<64>::new(&Params::TABLE2).unwrap(),
+        STEEP_KINK,
+        NEAR_TRANSITION,
+    ];
+    for t in tables {
+        let n = check::<mccs::Wide>(&t);
+        assert_eq!(n, check::<mccs::Narrow>(&t));
+        if t.lower_corner() {
+            assert!(n >= 10, "{n} springs in the corner");
+        }
     }
 }

@@ -140,7 +140,7 @@ fn a_table_of_no_segments_evaluates_without_panic() {
 /// below at `corner_hi`, the corner from one above it up to `strain_lo`, the grid above,
 /// the line above from `strain_hi`, anchored at `corner_hi`), and `validate` refuses a corner
 /// end between the grid's ends, a coordinate that leaves `[2²⁴, 2³²)` at either end,
-/// a corner past the last segment and a line above from a force below zero.
+/// a corner past the last segment and a line above from a force below −1024 N.
 #[test]
 fn a_lower_corner_is_valid_and_evaluated_on_its_own_range() {
     static STEEP_KINK: ForceTable<64> = include!("../../tables/steep_kink.rs");
@@ -163,7 +163,7 @@ fn a_lower_corner_is_valid_and_evaluated_on_its_own_range() {
         )
     );
     // The line above is anchored at corner_hi, below the table: its force there is the
-    // line extrapolated down, at least zero (a held product still saturates it).
+    // line extrapolated down (at least −1024 N: `validate`).
     let at_end = t.force(Strain::from_bits(r.strain_hi)).to_bits();
     assert!(r.force_hi >= 0 && r.force_hi < at_end);
     // Each piece's ends: the force never decreases across them, and force_within and the
@@ -191,7 +191,34 @@ fn a_lower_corner_is_valid_and_evaluated_on_its_own_range() {
     assert!(refused(&|x| x.corner_hi -= 1).is_err());
     assert!(refused(&|x| x.strain_lo += 1).is_err());
     assert!(refused(&|x| x.corner_base = 33).is_err());
-    assert!(refused(&|x| x.force_hi = -1).is_err());
+    assert!(refused(&|x| x.force_hi = -(1 << 30) - 1).is_err());
+}
+
+/// A lower corner graded toward its anchor from above (`tables/near_transition.rs`:
+/// a negative `corner_pre`): valid, its range from the law's first kink, and refused
+/// with a stiffness scale of the wrong sign or a coordinate past 2³² at its top.
+#[test]
+fn a_corner_above_its_anchor_is_valid_with_its_own_signs() {
+    static NEAR_TRANSITION: ForceTable<64> = include!("../../tables/near_transition.rs");
+    let t = NEAR_TRANSITION;
+    let r = *t.raw();
+    assert_eq!(t.validate(), Ok(()));
+    assert!(t.lower_corner() && (r.corner_pre as i32) < 0 && r.corner_scale > 0);
+    let refused = |edit: &dyn Fn(&mut RawTable<64>)| {
+        let mut raw = r;
+        edit(&mut raw);
+        ForceTable::from_raw(raw).validate()
+    };
+    assert!(refused(&|x| x.corner_scale = -x.corner_scale).is_err());
+    assert!(refused(&|x| x.strain_lo += 1).is_err());
+    assert!(refused(&|x| x.corner_hi -= 1).is_err());
+    // Its segments' ranges are ordered and tile the corner from its lower end up.
+    let (a, b) = t.corner().unwrap();
+    let lsb = 1.0 / (1u64 << 24) as f64;
+    let (lo, hi) = (t.corner_segment_range(28), t.corner_segment_range(3));
+    assert!(lo.0 < lo.1 && hi.0 < hi.1);
+    assert!((lo.0 - a.to_num::<f64>()).abs() < 2.0 * lsb);
+    assert!((hi.1 - b.to_num::<f64>()).abs() < 2.0 * lsb);
 }
 
 /// The repro: a domain ending a hair above the kink left 17 knots within one

@@ -31,6 +31,11 @@ fn committed_tables_are_what_the_cli_emits() {
         ("params/table2.toml", "65", "tables/table2.rs"),
         ("params/stiff-series.toml", "65", "tables/stiff_series.rs"),
         ("params/steep-kink.toml", "65", "tables/steep_kink.rs"),
+        (
+            "params/near-transition.toml",
+            "65",
+            "tables/near_transition.rs",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
             .args(["table", "--params", params, "--knots", knots])

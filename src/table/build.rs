@@ -4,9 +4,9 @@
 //! ([`stiffness_scale`]) and the straight lines beyond the table ([`lines`]).
 
 use super::{
-    corner_strain, fine_line, knot_bias, measure, slope_frac, ForceTable, RawTable, TableBound,
-    TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN,
-    FINE_SLOPE_FRAC, UNMEASURED,
+    corner_pre_signed, corner_strain, fine_line, format_floor, knot_bias, measure, slope_frac,
+    ForceTable, RawTable, TableBound, TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE,
+    CORNER_SEGMENTS, DEFAULT_DOMAIN, FINE_SLOPE_FRAC, UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -71,8 +71,10 @@ impl<const S: usize> ForceTable<S> {
     /// more than that. Where none meets the bound, a graded corner (the module docs):
     /// toward the solid point under each placement (up to 24 more), then above a
     /// preload's kink near `F_C` (up to 10 more), then toward that kink from below (up to
-    /// 12 more, the uniform grid below it; then 2, a *lower* corner under the grid), the
-    /// first within the bound kept. Up to 53 builds and measurements (5 for a spring the
+    /// 12 more, the uniform grid below it; then 1, a *lower* corner under the grid), then
+    /// toward the law's first kink from above, under the grid (up to 21 more), the first
+    /// within the bound kept; the last two only where the output formats could meet the
+    /// bound ([`format_floor`]). Up to 73 builds and measurements (5 for a spring the
     /// uniform grid serves): what `mccs table` and [`ForceTable::with_bound`] do, not for
     /// a device's start-up.
     #[inline(never)]
@@ -196,12 +198,38 @@ impl<const S: usize> ForceTable<S> {
         // from below over the whole curved part under it (down to Δ(F_T) or the domain's
         // start), the uniform grid above from Δ(P) (`CornerEnd::Lower`): the cone's steep
         // rise toward its own solid point below the kink, and a law still curved above it.
-        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        // (These two only where the output formats could meet the bound at all: not for
+        // a spring whose half LSB is over it, `format_floor`, which no knots serve.)
+        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0)
+            && format_floor(law, from, to).within(&TableBound::PRODUCT);
         if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
-            for align in [Align::Shortest, Align::Off] {
-                let len = (e_p - lo) * LOWER_CORNER_REACH;
-                let end = CornerEnd::Lower;
-                if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+            // (One build: the grid's place is the corner's end, whatever the alignment.)
+            let len = (e_p - lo) * LOWER_CORNER_REACH;
+            let end = CornerEnd::Lower;
+            if let Ok(t) = Self::on_grid::<false, true>(law, from, to, Align::Off, len, end) {
+                Self::keep_best(t, law, (from, to), &mut best);
+            }
+        }
+        // Still missed: a corner graded toward the law's first kink from above, under the
+        // grid (`CornerEnd::Onset`), over a fraction of the curved part, and then the
+        // lengths that put one of its knots on the cone's own transition Δ(F_T) where a
+        // preload just below F_T puts the first kink Δ(P) under it.
+        let missed = missed && best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        let e_first = law.strain_t();
+        let curved = libm::fmin(e_c, to) - e_first;
+        // (The kink inside the domain, as every other placement's table starts.)
+        if missed && S >= 2 * CORNER_SEGMENTS && e_first >= from && curved > 0.0 {
+            let e_ft = law.delta(law.f_t);
+            let on_transition = (0..CORNER_OCTAVES as u32)
+                .flat_map(|z| [(z, 0), (z, 2)])
+                .filter_map(|knot| {
+                    let len = kink_on_knot(e_ft - e_first, knot)?;
+                    (law.preload < law.f_t && e_ft > e_first && len < curved).then_some(len)
+                });
+            let lens = ONSET_FRACTIONS.map(|f| f * curved);
+            for len in lens.into_iter().chain(on_transition) {
+                let end = CornerEnd::Onset;
+                if let Ok(t) = Self::on_grid::<false, true>(law, from, to, Align::Off, len, end) {
                     if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                         break;
                     }
@@ -271,9 +299,10 @@ impl<const S: usize> ForceTable<S> {
         let n = if CORNER { S - CORNER_SEGMENTS } else { S };
         // A lower corner ends where the grid starts, at its first knot; any other ends
         // above the grid.
-        let lower = corner.filter(|c| c.end == CornerEnd::Lower);
+        let lower = corner.filter(Corner::under_grid);
+        // (The grid's first knot on a preload's kink above a lower corner toward it.)
         let (start, end) = match corner {
-            Some(c) if c.end == CornerEnd::Lower => (Some(c.hi - 1), None),
+            Some(c) if c.under_grid() => (Some((c.top, c.end == CornerEnd::Lower)), None),
             Some(c) => (None, Some(c.start)),
             None => (None, None),
         };
@@ -294,11 +323,17 @@ impl<const S: usize> ForceTable<S> {
         // Under a lower corner the line below meets the corner's first knot instead.
         let l = match (&lower, &corner_ends) {
             (Some(c), Some(ends)) => {
-                let first = knot_units(ends[CORNER_PER_OCTAVE - 1][1], shift) as i32;
+                // The corner's lowest knot: (0, 4), or (7, 0) where it lies above its
+                // anchor.
+                let lowest = if c.above_anchor() {
+                    ends[CORNER_SEGMENTS - CORNER_PER_OCTAVE][0]
+                } else {
+                    ends[CORNER_PER_OCTAVE - 1][1]
+                };
+                let first = knot_units(lowest, shift) as i32;
                 let unit = (1u64 << STRAIN_FRAC) as f64;
-                let bottom = c.bottom();
-                let at_kink = bottom as f64 / unit <= law.strain_t();
-                lines::<S>(law, &grid, (at_kink, bottom), first >> shift)?
+                let at_kink = c.lo as f64 / unit <= law.strain_t();
+                lines::<S>(law, &grid, (at_kink, c.lo), first >> shift)?
             }
             _ => lines::<S>(
                 law,
@@ -337,9 +372,12 @@ impl<const S: usize> ForceTable<S> {
             // The corner starts inside the uniform grid's last segment (its coordinate
             // below 2³² there) and ends past it; a lower one ends on the grid's first
             // strain (its coordinate at least 2²⁴ there) and starts below it.
-            let d = |e: i32| (c.anchor as i64 - e as i64) * c.pre as i64;
-            let fits = if c.end == CornerEnd::Lower {
-                d(grid.strain_lo) >= 1 << 24 && c.bottom() < grid.strain_lo
+            let pre = corner_pre_signed(c.pre) as i64;
+            let d = |e: i32| (c.anchor as i64 - e as i64) * pre;
+            let fits = if c.above_anchor() {
+                d(grid.strain_lo) < 1 << 32 && d(c.lo + 1) >= 1 << 24 && c.lo < grid.strain_lo
+            } else if c.under_grid() {
+                d(grid.strain_lo) >= 1 << 24 && c.lo < grid.strain_lo
             } else {
                 d(grid.strain_hi) < 1 << 32 && grid.strain_hi < c.hi
             };
@@ -348,11 +386,7 @@ impl<const S: usize> ForceTable<S> {
             }
             fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
             let (scale, post) = corner_scale(c.pre, shift)?;
-            raw.corner_hi = if c.end == CornerEnd::Lower {
-                c.bottom()
-            } else {
-                c.hi
-            };
+            raw.corner_hi = if c.under_grid() { c.lo } else { c.hi };
             raw.corner_anchor = c.anchor;
             raw.corner_pre = c.pre;
             raw.corner_base = n as u32;
@@ -367,7 +401,7 @@ impl<const S: usize> ForceTable<S> {
                     Some(1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0))))
                 }
                 CornerEnd::Kink => Some(1.0 / law.compliance_above(law.preload)),
-                CornerEnd::Lower => None,
+                CornerEnd::Lower | CornerEnd::Onset => None,
             };
             if let Some(above) = above {
                 (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
@@ -388,7 +422,8 @@ impl<const S: usize> ForceTable<S> {
         // (LSBs) at strain_hi and the product `a = slope_hi · (strain_hi − corner_hi)`
         // (LSBs), so that from strain_hi up the line is `⌊v + 1 − frac(a)⌋ + ⌊frac(a) +
         // b⌋` for the rise `b` beyond it: within (−1, 1] LSB of the law, as above. At
-        // least zero, so that a product held at ±2048 N (`line_at`) still saturates it.
+        // least −1024 N, so that the line is exact up to 1024 N at least: beyond
+        // `2048 N + force_hi` its product is held (`line_at`), and so is the force.
         let end = if lower.is_some() {
             raw.strain_hi
         } else {
@@ -401,7 +436,7 @@ impl<const S: usize> ForceTable<S> {
             let frac = (a & ((1i64 << p) - 1)) as f64 / (1u64 << p) as f64;
             let f = libm::floor(v + 1.0 - frac) - (a >> p) as f64;
             // (Also when it is NaN.)
-            if f.is_nan() || f < 0.0 {
+            if f.is_nan() || f < -((1u64 << 30) as f64) {
                 return Err(TableError::OutOfRange);
             }
             f
@@ -429,6 +464,10 @@ struct Corner {
     pre: u32,
     /// One past the last strain of the corner (Q24): the last knot is its end.
     hi: i32,
+    /// A corner under the grid ([`Corner::under_grid`]): the last strain below it (the
+    /// table's `corner_hi`) and its own last strain (the grid's first knot), Q24.
+    lo: i32,
+    top: i32,
     /// Where the uniform grid ends (a little past the corner's start), strain.
     start: f64,
     /// Where it ends: at the solid point, the last knot's force is `F_C` exactly.
@@ -461,16 +500,26 @@ enum CornerEnd {
     /// to the law's first kink (or the domain's start), the line below under it, and the
     /// grid follows the law above `Δ(P)` where the series spring is not much softer.
     Lower,
+    /// At the law's first kink `Δ(min(F_T, P))`, graded toward it from *above* (a
+    /// negative `pre`), under the grid, which starts where it ends: the line below up
+    /// to the kink, exact, and knots dense where the law starts to bend. For a preload
+    /// just below `F_T`, whose slope kink `Δ(P)` lies less than a segment below the
+    /// cone's own transition `Δ(F_T)` (a jump in curvature: the grid's first segment
+    /// across it missed the stiffness bound just above it).
+    Onset,
 }
 
 impl Corner {
     /// The corner of `len` strain ending at `end`; it must start inside the domain (which
     /// may end before the solid point).
     fn place(law: &Law, to: f64, len: f64, end: CornerEnd) -> Result<Self, TableError> {
+        if end == CornerEnd::Onset {
+            return Self::above(law, to, len);
+        }
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
-            CornerEnd::Kink | CornerEnd::Lower => law.delta(law.preload),
+            CornerEnd::Kink | CornerEnd::Lower | CornerEnd::Onset => law.delta(law.preload),
         };
         // Every other placement has knots up to the domain's end, each held within the
         // format's range (`Corner::knot`, `Grid::knot`); this one's line must be too.
@@ -516,22 +565,64 @@ impl Corner {
         } else {
             None
         };
+        // Under the grid: the last strain whose coordinate (A − e) · pre is 2³² or more
+        // (within the format: the corner's start is a strain below its anchor).
+        let lo = libm::floor(anchor as f64 - libm::ldexp(1.0, 32) / pre as f64);
         Ok(Self {
             anchor,
             pre,
             hi: hi as i32,
+            lo: lo.max(i32::MIN as f64) as i32,
+            top: hi as i32 - 1,
             start,
             end,
             kink,
         })
     }
 
-    /// A lower corner's `corner_hi` (Q24): the last strain below it, whose coordinate
-    /// `(A − e) · pre` is 2³² or more.
-    fn bottom(&self) -> i32 {
-        let e = libm::floor(self.anchor as f64 - libm::ldexp(1.0, 32) / self.pre as f64);
-        // (Within the format: the corner's start is a strain below its anchor.)
-        e.max(i32::MIN as f64) as i32
+    /// [`CornerEnd::Onset`]: `len` of strain above the law's first kink, graded toward it
+    /// from above: the anchor `A` lies the nearest octave's inner end below the kink,
+    /// and a strain `e` in the corner has `d = (e − A) · |pre|` in `[2²⁴, 2³²)`.
+    fn above(law: &Law, to: f64, len: f64) -> Result<Self, TableError> {
+        let unit = (1u64 << STRAIN_FRAC) as f64;
+        let e_kink = law.strain_t();
+        let p = libm::round(libm::ldexp(1.0, 32) / (len * unit));
+        if !(p >= 1.0 && p <= (1u64 << 24) as f64) {
+            return Err(TableError::TooNarrow);
+        }
+        let inner = libm::ldexp(1.0, 24) / p;
+        let anchor =
+            checked_from_f64(e_kink - inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
+        // The last strain with d < 2²⁴ (the line below's), and the last with d < 2³²
+        // (the corner's own last, the grid's first knot).
+        let lo = anchor as f64 + libm::ceil(inner) - 1.0;
+        let top = anchor as f64 + libm::ceil(libm::ldexp(1.0, 32) / p) - 1.0;
+        if !(top / unit < to && top <= i32::MAX as f64) {
+            return Err(TableError::TooNarrow);
+        }
+        Ok(Self {
+            anchor,
+            pre: (p as u32).wrapping_neg(),
+            hi: top as i32 + 1,
+            lo: lo as i32,
+            top: top as i32,
+            start: top / unit,
+            end: CornerEnd::Onset,
+            // Its nearest knot (7, 0) on the kink: the segment above it takes the law's
+            // slope from above.
+            kink: Some((CORNER_OCTAVES - 1, 0)),
+        })
+    }
+
+    /// Whether the corner lies under the grid (a lower corner,
+    /// [`ForceTable::lower_corner`]).
+    fn under_grid(&self) -> bool {
+        matches!(self.end, CornerEnd::Lower | CornerEnd::Onset)
+    }
+
+    /// Whether the corner lies above its anchor (graded toward it from above).
+    fn above_anchor(&self) -> bool {
+        self.end == CornerEnd::Onset
     }
 
     /// The strain of coordinate `(z, jj)` ([`corner_strain`]).
@@ -548,6 +639,7 @@ impl Corner {
         let f = match self.end {
             CornerEnd::Solid if last => law.f_c,
             CornerEnd::Kink | CornerEnd::Lower if last => law.preload,
+            CornerEnd::Onset if last => law.first_kink(),
             _ => law.force(self.strain(z, jj)),
         };
         let k = 1.0 / law.compliance(f);
@@ -574,10 +666,22 @@ impl Corner {
             };
         }
         // On a preload's kink: the slope from below for the segment under the knot, from
-        // above for the one over it (a knot is in both).
+        // above for the one over it (a knot is in both). A segment's first end `(z, j)`
+        // is its upper end, or its lower where the corner lies above its anchor (on the
+        // law's first kink).
         let unit = (1u64 << FORCE_FRAC) as f64;
-        let below = 1.0 / law.compliance(law.preload) * unit;
-        let above = 1.0 / law.compliance_above(law.preload) * unit;
+        let kink = if self.above_anchor() {
+            law.first_kink()
+        } else {
+            law.preload
+        };
+        let below = 1.0 / law.compliance(kink) * unit;
+        let above = 1.0 / law.compliance_above(kink) * unit;
+        let (below, above) = if self.above_anchor() {
+            (above, below)
+        } else {
+            (below, above)
+        };
         let is_kink = |z: usize, jj: usize| {
             self.kink == Some((z, jj))
                 || (jj == CORNER_PER_OCTAVE && z >= 1 && self.kink == Some((z - 1, 0)))
@@ -637,10 +741,12 @@ fn knot_units(value: f64, shift: u32) -> f64 {
 /// The corner's stiffness scale `(corner_scale, corner_post)`: in octave `z`,
 /// `dτ/dε = −pre · 2^(z − 5)`, so dF/dε (Q16) `= −D · pre · 2^(z − 10 − shift)` `=
 /// (D · scale) >> (32 − z)` with `scale = −pre · 2^(22 − shift)`, a power of two moved
-/// into the post-factor while it would not fit.
+/// into the post-factor while it would not fit (`pre` signed: positive for a corner
+/// above its anchor, [`corner_pre_signed`]).
 fn corner_scale(pre: u32, shift: u32) -> Result<(i32, i32), TableError> {
-    let (v, post) = with_post(libm::ldexp(pre as f64, 22 - shift as i32))?;
-    Ok((-v, post))
+    let pre = corner_pre_signed(pre) as f64;
+    let (v, post) = with_post(libm::ldexp(libm::fabs(pre), 22 - shift as i32))?;
+    Ok((if pre > 0.0 { -v } else { v }, post))
 }
 
 /// A positive scale `v` as `(⌊v / 2^p⌉, 2^p)`, the least power `p` (< 30) that brings it
@@ -677,6 +783,10 @@ fn kink_on_knot(below: f64, (z, jj): (u32, u32)) -> Option<f64> {
     let pre = libm::round((d - libm::ldexp(1.0, 24)) / (below * unit));
     (pre >= 1.0 && pre <= libm::ldexp(1.0, 24)).then(|| libm::ldexp(1.0, 32) / (pre * unit))
 }
+
+/// The lengths of a corner above the law's first kink ([`CornerEnd::Onset`]) that
+/// [`ForceTable::from_law_best`] tries first, as fractions of the law's curved part.
+const ONSET_FRACTIONS: [f64; 5] = [0.02, 0.05, 0.1, 0.2, 0.35];
 
 /// How far a lower corner reaches below `Δ(P)`, as a factor of the way down to the
 /// law's first kink (or the domain's start): its nearest octave's `1/256` lies past
@@ -745,7 +855,7 @@ impl Grid {
         to: f64,
         align: Align,
         n: usize,
-        start: Option<i32>,
+        start: Option<(i32, bool)>,
         end: Option<f64>,
     ) -> Result<Self, TableError> {
         if n == 0 {
@@ -762,7 +872,7 @@ impl Grid {
         let at_kink = from <= e_t && !from_domain && start.is_none();
         let at_solid = to >= e_c && end.is_none();
         let lo = match start {
-            Some(s) => s as f64 / (1u64 << STRAIN_FRAC) as f64,
+            Some((s, _)) => s as f64 / (1u64 << STRAIN_FRAC) as f64,
             None if at_kink => e_t,
             None => from,
         };
@@ -802,11 +912,11 @@ impl Grid {
         // The strain the aligned knot sits on: Δ(P) (Δ(F_T) without a preload, where
         // P = F_T) from the domain's start, else the inner corner.
         let mut knot_at = e_p;
-        if start.is_some() {
-            // Above a lower corner: the first knot on Δ(P) (the strain the corner ends
-            // on), the grid uniform from there.
+        if let Some((_, on_kink)) = start {
+            // Above a lower corner: the first knot where the corner ends (on Δ(P), for
+            // one graded toward it), the grid uniform from there.
             knot_at = lo;
-            kink_knot = Some(0);
+            kink_knot = on_kink.then_some(0);
         } else if from_domain {
             // j segments from the domain's start to that knot, the most that still
             // reach `hi` with S; the step grows by at most a factor 1 + 1/j.

@@ -60,7 +60,9 @@
 //!   ([`RawTable::slope_lo`], [`RawTable::slope_hi`]); the stiffness rounds to the
 //!   nearest Q16 value (outside the graded corner, which floors).
 //!
-//! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`).
+//! Evaluation saturates: a force beyond the format clamps to ±2048 N (`Force::MAX`/`MIN`);
+//! under a lower corner the line above is held where its product reaches 2048 N, at
+//! `2048 N + force_hi` (1024 N at least, [`RawTable::force_hi`]).
 //!
 //! # Cost
 //! The segment and `τ` come from one subtract, one multiply by a power of two and one
@@ -142,8 +144,9 @@ pub struct RawTable<const S: usize> {
     /// floor (the line within (−1, 1) LSB of the law). Under a lower corner
     /// ([`ForceTable::lower_corner`]) `corner_hi` lies below the table: `force_hi` is
     /// then the same line extrapolated down to it, exactly in the product's terms (so
-    /// that the line is the same from `strain_hi` up), and at least zero (so that a
-    /// product held at ±2048 N still saturates the force).
+    /// that the line is the same from `strain_hi` up), and at least −1024 N: the line
+    /// is exact up to `2048 N + force_hi` (1024 N at least), where its product is held,
+    /// and the force with it (monotone, never past 2048 N).
     pub force_hi: i32,
     /// Slope of the line above (Q16 N per unit strain): its stiffness (the nearest Q16
     /// value where `slope_hi` is Q28).
@@ -168,7 +171,8 @@ pub struct RawTable<const S: usize> {
     /// is then `(corner_hi, strain_lo]`, the line below at and under `corner_hi`.
     pub corner_hi: i32,
     /// The graded corner's anchor `A` (Q24), just past its end: a strain `e` in it has
-    /// the coordinate `d = (A − e) · corner_pre` (`u32`) in `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
+    /// the coordinate `d = (A − e) · corner_pre` (`u32`; `corner_pre` the negative of a
+    /// factor, as an `i32`, where the corner lies above its anchor) in `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
     pub corner_anchor: i32,
     /// See `corner_anchor`.
     pub corner_pre: u32,
@@ -178,7 +182,8 @@ pub struct RawTable<const S: usize> {
     /// The stiffness in the corner, in Q16: `⌊(D · 2^z) · corner_scale / 2³²⌋ ·
     /// corner_post` for `D = 2 dF/dτ` in the coefficients' unit, which the builder keeps
     /// within ±2²⁹ times `2^−z` in octave `z` (`τ` runs down in strain, so the scale is
-    /// negative; `corner_post` a power of two).
+    /// negative; positive where the corner lies above its anchor; `corner_post` a power
+    /// of two).
     pub corner_scale: i32,
     /// See `corner_scale`.
     pub corner_post: i32,
@@ -226,7 +231,7 @@ impl<const S: usize> ForceTable<S> {
     /// most 12, a power-of-two stiffness post-factor, non-negative slopes on the lines,
     /// and a graded corner's coordinate within its octaves over its range (above the
     /// grid, or under it as a lower corner, whose line above then starts from a force of
-    /// at least zero). Evaluation never panics either way; on a table that fails this check its
+    /// at least −1024 N). Evaluation never panics either way; on a table that fails this check its
     /// values mean nothing.
     pub fn validate(&self) -> Result<(), TableError> {
         let r = &self.raw;
@@ -245,7 +250,7 @@ impl<const S: usize> ForceTable<S> {
             && r.stiffness_hi >= 0
             && (r.corner_hi >= r.strain_hi || r.corner_hi < r.strain_lo)
             && (r.corner_hi == r.strain_hi || self.corner_fits())
-            && (!self.lower_corner() || r.force_hi >= 0);
+            && (!self.lower_corner() || r.force_hi >= -(1 << 30));
         if ok {
             Ok(())
         } else {
@@ -333,32 +338,36 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// Whether the graded corner's coordinate stays in `[2²⁴, 2³²)` over its range and
-    /// its segments are inside the table.
+    /// its segments are inside the table. `corner_pre` is signed (a corner graded toward
+    /// its anchor from above has a negative one: the evaluation's `u32` product is the
+    /// same), and the stiffness scale has the other sign.
     fn corner_fits(&self) -> bool {
         let r = &self.raw;
-        let d = |e: i64| (r.corner_anchor as i64 - e) * r.corner_pre as i64;
+        let pre = corner_pre_signed(r.corner_pre) as i64;
+        let d = |e: i64| (r.corner_anchor as i64 - e) * pre;
         let Some((first, last)) = self.corner_strains() else {
             return false;
         };
+        let (d0, d1) = (d(first), d(last));
         S >= CORNER_SEGMENTS
             && r.corner_base as usize <= S - CORNER_SEGMENTS
-            && d(first) < 1 << 32
-            && d(last) >= 1 << 24
+            && d0.max(d1) < 1 << 32
+            && d0.min(d1) >= 1 << 24
             && r.corner_post > 0
             && (r.corner_post as u32).is_power_of_two()
-            && r.corner_scale <= 0
+            && ((pre > 0 && r.corner_scale <= 0) || (pre < 0 && r.corner_scale >= 0))
     }
 
     /// The strain range of the graded corner's segment `i` (`4 z + j`, octave `z`,
-    /// segment `j` in it): `(lower, upper)`; `τ` runs from the upper end (nearer the
-    /// anchor) down. For measuring; `f64`.
+    /// segment `j` in it): `(lower, upper)`; `τ` runs from the end nearer the anchor
+    /// (the upper end, or the lower where the corner is graded toward its anchor from
+    /// above). For measuring; `f64`.
     pub fn corner_segment_range(&self, i: usize) -> (f64, f64) {
         let r = &self.raw;
         let (z, j) = (i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE);
-        (
-            corner_strain(r.corner_anchor, r.corner_pre, z, j + 1),
-            corner_strain(r.corner_anchor, r.corner_pre, z, j),
-        )
+        let a = corner_strain(r.corner_anchor, r.corner_pre, z, j + 1);
+        let b = corner_strain(r.corner_anchor, r.corner_pre, z, j);
+        (libm::fmin(a, b), libm::fmax(a, b))
     }
 
     /// The largest tangent stiffness anywhere on the curve (both lines, and every segment
@@ -584,10 +593,18 @@ pub(crate) fn segment_at<const S: usize>(r: &RawTable<S>, i: usize) -> &[i32; 4]
 
 /// The strain (`f64`) of the graded corner's coordinate `d = 2^(31 − z) (1 + jj/4)`
 /// (`jj` ≤ 4: `jj = 4` is the next octave's start), for a corner anchored at `anchor`
-/// (Q24) with `pre`.
+/// (Q24) with `pre` (signed: [`corner_pre_signed`]).
 pub(crate) fn corner_strain(anchor: i32, pre: u32, z: usize, jj: usize) -> f64 {
     let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
-    (anchor as f64 - d / pre as f64) / (1u64 << STRAIN_FRAC) as f64
+    (anchor as f64 - d / corner_pre_signed(pre) as f64) / (1u64 << STRAIN_FRAC) as f64
+}
+
+/// A corner's `pre` as the signed factor it is: a corner graded toward its anchor from
+/// below has one of 1 … 2²⁴, one graded toward it from above (its strains above the
+/// anchor) the negative of one, as a `u32` (the evaluation's wrapping product
+/// `(A − e) · pre` is `(e − A) · |pre|` then).
+pub(crate) const fn corner_pre_signed(pre: u32) -> i32 {
+    pre as i32
 }
 
 /// `D = 2 dF/dτ = C1 + C2 τ + ¾ C3 τ²` in the coefficients' unit, in the same halving

@@ -82,6 +82,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             vec![
                 (l.strain_c(), "the solid point"),
                 (l.delta(l.preload), "the preload's kink"),
+                (l.strain_t(), "the law's first kink"),
             ]
         });
         render_table(
@@ -391,7 +392,8 @@ fn solver_table_of<const S: usize>(p: &Params, file: &Path) -> Result<ForceTable
 
 /// Renders a table as a Rust expression for `include!`, preceded by `header`; `points`,
 /// the law's named strains if known (its solid point `Δ(F_C)`, a preload's kink
-/// `Δ(P)`), name where a graded corner ends (one of them, or the domain's end).
+/// `Δ(P)`, its first kink), name the end a graded corner is graded toward (one of them,
+/// or the domain's end).
 pub fn render_table<const S: usize>(
     header: &str,
     t: &ForceTable<S>,
@@ -403,8 +405,10 @@ pub fn render_table<const S: usize>(
     let (lo, hi) = t.tabulated_range();
     match t.corner() {
         Some((a, b)) => {
-            // The corner's exclusive end is within a few strain LSBs of its last knot.
-            let end = b.to_num::<f64>();
+            // The end it is graded toward: its upper (the exclusive end, within a few strain
+            // LSBs of its last knot), or its lower where it lies above its anchor (a
+            // negative `corner_pre`).
+            let end = if (r.corner_pre as i32) < 0 { a } else { b }.to_num::<f64>();
             let near = 4.0 * mccs::Strain::DELTA.to_num::<f64>();
             let toward = match points.iter().find(|(e, _)| (end - e).abs() <= near) {
                 Some((_, name)) => name,

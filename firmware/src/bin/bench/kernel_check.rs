@@ -8,7 +8,7 @@
 //!   stretched past the table's lower end and past the `±2 l0` hold, on its segments,
 //!   crushed past its upper end, below `l0/8` (the held `l0/l`) and through zero length.
 //!
-//! Each state takes one of seven tables: Table 2's; the same with its coefficients 64
+//! Each state takes one of eight tables: Table 2's; the same with its coefficients 64
 //! times larger (forces past the ±64 N hold) and a shift past 31 (which wraps, as
 //! `wrapping_shr` does), and a graded corner of any contents above its uniform part
 //! (an index past the table, masked); one with the steepest slopes, the largest end
@@ -16,8 +16,10 @@
 //! their sums saturated); one with its lower line's anchor at `i32::MAX` (the strain
 //! difference saturates); one whose range ends at `i32::MIN + 1` (the upper line's
 //! does); the stiff series spring's (`tables/stiff_series.rs`), whose last 32
-//! segments are a graded corner; and the steep kink's (`tables/steep_kink.rs`), whose
-//! corner lies under its grid (a lower corner). A quarter of the single springs are put
+//! segments are a graded corner; the steep kink's (`tables/steep_kink.rs`), whose
+//! corner lies under its grid (a lower corner); and the near transition's
+//! (`tables/near_transition.rs`), a lower corner above its anchor (a negative
+//! `corner_pre`). A quarter of the single springs are put
 //! in the corner of a table that has one. The
 //! second and fourth put each line's stiffness at either end of the range where its
 //! force takes the Q28 slope (`mccs::table::fine_line`), with the largest slopes.
@@ -42,7 +44,7 @@ const STATES: u32 = 400;
 /// Loops run in a row on each state.
 const ROUNDS: usize = 3;
 /// The tables the states take in turn ([`variants`]).
-const VARIANTS: usize = 7;
+const VARIANTS: usize = 8;
 /// The single springs: half to the ground, half between two free nodes.
 const SINGLE: usize = 48;
 
@@ -186,7 +188,7 @@ fn run(table: &ForceTable64) {
 }
 
 /// Table 2's table, the four variants that reach the holds and saturations, the stiff
-/// series spring's and the steep kink's (module docs).
+/// series spring's, the steep kink's and the near transition's (module docs).
 fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; VARIANTS] {
     static STIFF_SERIES: ForceTable64 = include!("../../../../tables/stiff_series.rs");
     let raw = *table.raw();
@@ -230,6 +232,7 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; VARIANTS] {
     ends.strain_hi = i32::MIN + 1;
     ends.corner_hi = i32::MIN + 1;
     static STEEP_KINK: ForceTable64 = include!("../../../../tables/steep_kink.rs");
+    static NEAR_TRANSITION: ForceTable64 = include!("../../../../tables/near_transition.rs");
     [
         raw,
         large,
@@ -238,6 +241,7 @@ fn variants(table: &ForceTable64) -> [ArithTable<64, Wide>; VARIANTS] {
         ends,
         *STIFF_SERIES.raw(),
         *STEEP_KINK.raw(),
+        *NEAR_TRANSITION.raw(),
     ]
     .map(|r| ArithTable::new(ForceTable64::from_raw(r)))
 }
