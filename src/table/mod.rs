@@ -33,9 +33,12 @@
 //! tangent above, then as a *lower* corner ([`ForceTable::lower_corner`]) from the law's
 //! first kink up to `Δ(P)`, under the uniform grid, which then covers the curved law
 //! above `Δ(P)` (a preload on the cone's steep rise toward its own solid point, with a
-//! series spring not much softer). A lower corner is marked by `corner_hi < strain_lo`
-//! and costs the line below's path one compare; the solver's loops make it only for a
-//! table that has one ([`ForceTable::force_within_for`]).
+//! series spring not much softer). Last, a lower corner graded toward the law's first
+//! kink from *above* (a negative `corner_pre`: the same evaluation), for a preload just
+//! below `F_T`, whose slope kink lies less than a segment under the cone's own transition.
+//! A lower corner is marked by `corner_hi < strain_lo` and costs the line below's path
+//! one compare; the solver's loops make it only for a table that has one
+//! ([`ForceTable::force_within_for`]).
 //!
 //! Each segment holds the cubic Hermite polynomial through its two knots with the exact
 //! analytic slopes `dF/dε` there (scaled down by the Fritsch–Carlson limiter only where
