@@ -175,7 +175,8 @@ pub struct RawTable<const S: usize> {
     pub corner_hi: i32,
     /// The graded corner's anchor `A` (Q24), just past its end: a strain `e` in it has
     /// the coordinate `d = (A − e) · corner_pre` (`u32`; `corner_pre` the negative of a
-    /// factor, as an `i32`, where the corner lies above its anchor) in `[2²⁴, 2³²)`, octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
+    /// factor, as an `i32`, where the corner lies above its anchor) in `[2²⁴, 2³²)`,
+    /// octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
     pub corner_anchor: i32,
     /// See `corner_anchor`.
     pub corner_pre: u32,
@@ -234,8 +235,8 @@ impl<const S: usize> ForceTable<S> {
     /// most 12, a power-of-two stiffness post-factor, non-negative slopes on the lines,
     /// and a graded corner's coordinate within its octaves over its range (above the
     /// grid, or under it as a lower corner, whose line above then starts from a force of
-    /// at least −1024 N). Evaluation never panics either way; on a table that fails this check its
-    /// values mean nothing.
+    /// at least −1024 N). Evaluation never panics either way; on a table that fails this
+    /// check its values mean nothing.
     pub fn validate(&self) -> Result<(), TableError> {
         let r = &self.raw;
         let span = r.strain_hi as i64 - r.strain_lo as i64;
@@ -294,8 +295,9 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// The graded corner's range `[lo, hi)`, if the table has one: knots graded
-    /// geometrically toward its anchor (the solid point `Δ(F_C)`, or a preload's kink
-    /// `Δ(P)`), where the law bends hardest (see the module docs). Above the uniform grid
+    /// geometrically toward its anchor (the solid point `Δ(F_C)`, a preload's kink
+    /// `Δ(P)`, or the law's first kink), where the law bends hardest (see the module
+    /// docs). Above the uniform grid
     /// `[strain_hi, corner_hi)`; a lower corner ([`ForceTable::lower_corner`])
     /// `[corner_hi + 1, strain_lo + 1)`.
     pub fn corner(&self) -> Option<(Strain, Strain)> {
@@ -320,7 +322,8 @@ impl<const S: usize> ForceTable<S> {
 
     /// Whether the graded corner lies below the uniform grid (`corner_hi < strain_lo`):
     /// over `(corner_hi, strain_lo]`, graded toward a preload's kink `Δ(P)` at the grid's
-    /// first knot, the line below under it and the line above anchored at `strain_hi`.
+    /// first knot, or from above toward the law's first kink at its own first, the line
+    /// below under it, and the line above anchored at `corner_hi` ([`RawTable::force_hi`]).
     pub fn lower_corner(&self) -> bool {
         self.raw.corner_hi < self.raw.strain_lo
     }
