@@ -519,6 +519,7 @@ impl Corner {
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
+            // (`Onset` is placed by `Corner::above`, before this.)
             CornerEnd::Kink | CornerEnd::Lower | CornerEnd::Onset => law.delta(law.preload),
         };
         // Every other placement has knots up to the domain's end, each held within the
@@ -652,8 +653,8 @@ impl Corner {
 
     /// Every segment's ends `[a0, a1, m0, m1]`, in segment order (`4 z + j`): the values
     /// `(a0, a1)` and slopes per `τ` `(m0, m1)` in Q20 N units, `τ` running from `(z, j)`
-    /// down in strain to `(z, j + 1)`. Each knot from the law once (`(z, 4)` is the next
-    /// octave's start, `(z − 1, 0)`).
+    /// down in strain to `(z, j + 1)` (up, where the corner lies above its anchor). Each
+    /// knot from the law once (`(z, 4)` is the next octave's start, `(z − 1, 0)`).
     fn segment_ends(&self, law: &Law) -> Result<[[f64; 4]; CORNER_SEGMENTS], TableError> {
         let mut knots = [[(0.0, 0.0); CORNER_PER_OCTAVE + 1]; CORNER_OCTAVES];
         for z in 0..CORNER_OCTAVES {
