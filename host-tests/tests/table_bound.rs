@@ -1225,3 +1225,121 @@ fn a_corner_graded_up_from_the_first_kink() {
         holds_on_the_reference(&format!("ONSETCORNER case=spring{i}"), &p, &t);
     }
 }
+
+/// Stiff series springs (`k_p/k` 1.6e3 to 9.8e3) whose solid point lies a little short of
+/// the domain's end: five of the 13 springs of the long run's draw, from the 1,000th to
+/// the 9,000th, refused for where their knots are (the scratch classification of
+/// `a_corner_graded_up_from_the_first_kink`), at 1.4 to 1.5 times the stiffness bound or
+/// 1.35 to 1.5 times the force bound. Of the corner lengths toward the solid point tried
+/// before, the shorter left the law's rise before the corner to the uniform grid, the
+/// longer coarsened its nearest octave. `from_law_best` now also tries the lengths
+/// between (`MORE_CORNER_FRACTIONS`, where the formats could meet the bound), and all
+/// five meet it on the independent reference.
+#[test]
+fn a_stiff_series_corner_between_the_usual_lengths() {
+    let springs = [
+        (
+            1714,
+            [
+                0.1125367421429508,
+                0.7930396476906881,
+                2.101408259634262,
+                4.7910615283457165,
+                0.9361836730541906,
+                205917.82601111845,
+            ],
+            [
+                0.035211265937625566,
+                0.34023926699805945,
+                14.065623903912162,
+                3663304679.0174365,
+                0.0,
+            ],
+        ),
+        (
+            2608,
+            [
+                0.058445234750307065,
+                0.5129536050668178,
+                1.1653834477917329,
+                6.9206181549648695,
+                0.9188326121202525,
+                256272.60534112208,
+            ],
+            [
+                0.06821443023994732,
+                0.06419491271737894,
+                21.63351475894102,
+                790742.7356762256,
+                0.09041373850551966,
+            ],
+        ),
+        (
+            3105,
+            [
+                0.05302673585640177,
+                0.17320009973685402,
+                0.36956223309823477,
+                2.455306628538259,
+                0.9026329259491532,
+                87974.36354745657,
+            ],
+            [
+                0.10195402840225319,
+                0.0693056524742061,
+                11.879905515502074,
+                2308772.490338243,
+                0.6156183958859325,
+            ],
+        ),
+        (
+            6978,
+            [
+                0.04581976181953741,
+                0.24733355123767636,
+                0.6601525319039631,
+                7.722577566165032,
+                0.910984115167573,
+                111173.23119794771,
+            ],
+            [
+                0.0936515024679479,
+                0.07714910705155407,
+                10.7084371770583,
+                353952.46235270693,
+                0.028359100621981204,
+            ],
+        ),
+        (
+            7590,
+            [
+                0.04949624855424559,
+                0.14403502331890455,
+                0.43694826212990817,
+                3.324798747543301,
+                0.9223125125779658,
+                188656.78210404405,
+            ],
+            [
+                0.031145302106027516,
+                0.4133779862859255,
+                19.572889740396,
+                120982402035.95169,
+                0.23213218207477518,
+            ],
+        ),
+    ];
+    for (i, cone, linear) in springs {
+        let mut p = spring_of(cone, linear);
+        // (Spring 1,714 has no preload.)
+        if p.linear.preload == Some(0.0) {
+            p.linear.preload = None;
+        }
+        let r = Reference::new(&p).unwrap();
+        let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+            .expect("within the bound");
+        let (_, b) = t.corner().expect("a graded corner");
+        assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
+        holds_on_the_reference(&format!("SOLIDCORNER case=spring{i}"), &p, &t);
+    }
+}

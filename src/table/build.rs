@@ -69,12 +69,13 @@ impl<const S: usize> ForceTable<S> {
     /// point's corner inside its last segment; a grid from the domain's start spends
     /// segments on the straight line, but a small spring's line slope in Q16 can cost
     /// more than that. Where none meets the bound, a graded corner (the module docs):
-    /// toward the solid point under each placement (up to 24 more), then above a
+    /// toward the solid point under each placement (up to 24 more, and 16 between where
+    /// the formats could meet the bound), then above a
     /// preload's kink near `F_C` (up to 10 more), then toward that kink from below (up to
     /// 12 more, the uniform grid below it; then 1, a *lower* corner under the grid), then
     /// toward the law's first kink from above, under the grid (up to 21 more), the first
     /// within the bound kept; the last two only where the output formats could meet the
-    /// bound ([`format_floor`]). Up to 73 builds and measurements (5 for a spring the
+    /// bound ([`format_floor`]). Up to 89 builds and measurements (5 for a spring the
     /// uniform grid serves): what `mccs table` and [`ForceTable::with_bound`] do, not for
     /// a device's start-up.
     #[inline(never)]
@@ -122,6 +123,12 @@ impl<const S: usize> ForceTable<S> {
         let solid_near = e_c <= to + 0.5 * (to - lo);
         if missed && S >= 2 * CORNER_SEGMENTS && solid_near {
             let curved = e_c - lo;
+            // (The lengths between, only where the formats could meet the bound.)
+            let more = if format_floor(law, from, to).within(&TableBound::PRODUCT) {
+                &MORE_CORNER_FRACTIONS[..]
+            } else {
+                &[]
+            };
             // A preload's kink Δ(P) inside such a corner needs a knot on it (a cubic
             // across a kink misses by the slope's jump times a fraction of the segment):
             // after the usual lengths, those that put a corner knot on Δ(P).
@@ -135,8 +142,8 @@ impl<const S: usize> ForceTable<S> {
                     (kinked && len < curved).then_some(len)
                 });
             'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
-                let lens = CORNER_FRACTIONS.map(|f| f * curved);
-                for len in lens.into_iter().chain(on_kink.clone()) {
+                let lens = CORNER_FRACTIONS.iter().chain(more).map(|f| f * curved);
+                for len in lens.chain(on_kink.clone()) {
                     let built = if align == Align::FromDomain {
                         Self::on_grid::<true, true>(law, from, to, align, len, CornerEnd::Solid)
                     } else {
@@ -767,6 +774,13 @@ fn with_post(mut v: f64) -> Result<(i32, i32), TableError> {
 /// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
 /// law's curved part.
 const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
+
+/// And the lengths between those it tries after them, toward the solid point, where the
+/// output formats could meet the bound at all: a stiff series spring whose solid point
+/// lies just short of the domain's end may need a corner long enough to take the law's
+/// rise before it and short enough to keep its nearest octave fine (five of the 13
+/// springs a scratch classification found refused for where their knots are, 2026-11-26).
+const MORE_CORNER_FRACTIONS: [f64; 4] = [0.03, 0.07, 0.14, 0.28];
 
 /// How near (Q24 LSBs) a corner knot must lie to a preload's kink to take the law's
 /// one-sided slopes there ([`Corner::kink`]).
