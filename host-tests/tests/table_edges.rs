@@ -135,6 +135,15 @@ fn a_table_of_no_segments_evaluates_without_panic() {
     assert_eq!(t.segments_used(), 0);
 }
 
+/// `validate` on `raw` with `edit` made to it.
+fn validate_edited(
+    mut raw: RawTable<64>,
+    edit: &dyn Fn(&mut RawTable<64>),
+) -> Result<(), TableError> {
+    edit(&mut raw);
+    ForceTable::from_raw(raw).validate()
+}
+
 /// A lower corner (`tables/steep_kink.rs`, `ForceTable::lower_corner`): the table is
 /// valid, each strain at the ends of its pieces takes the piece it belongs to (the line
 /// below at `corner_hi`, the corner from one above it up to `strain_lo`, the grid above,
@@ -180,11 +189,7 @@ fn a_lower_corner_is_valid_and_evaluated_on_its_own_range() {
             assert_eq!(table_force(&narrow, e), t.force_within::<26>(e));
         }
     }
-    let refused = |edit: &dyn Fn(&mut RawTable<64>)| {
-        let mut raw = r;
-        edit(&mut raw);
-        ForceTable::from_raw(raw).validate()
-    };
+    let refused = |edit: &dyn Fn(&mut RawTable<64>)| validate_edited(r, edit);
     assert!(refused(&|x| x.corner_hi = x.strain_lo).is_err());
     assert!(refused(&|x| x.corner_hi = x.strain_hi - 1).is_err());
     // The coordinate reaches 2³² one strain below the corner, 2²⁴ at its end.
@@ -204,11 +209,7 @@ fn a_corner_above_its_anchor_is_valid_with_its_own_signs() {
     let r = *t.raw();
     assert_eq!(t.validate(), Ok(()));
     assert!(t.lower_corner() && (r.corner_pre as i32) < 0 && r.corner_scale > 0);
-    let refused = |edit: &dyn Fn(&mut RawTable<64>)| {
-        let mut raw = r;
-        edit(&mut raw);
-        ForceTable::from_raw(raw).validate()
-    };
+    let refused = |edit: &dyn Fn(&mut RawTable<64>)| validate_edited(r, edit);
     assert!(refused(&|x| x.corner_scale = -x.corner_scale).is_err());
     assert!(refused(&|x| x.strain_lo += 1).is_err());
     assert!(refused(&|x| x.corner_hi -= 1).is_err());

@@ -309,7 +309,7 @@ impl<const S: usize> ForceTable<S> {
         let lower = corner.filter(Corner::under_grid);
         // (The grid's first knot on a preload's kink above a lower corner toward it.)
         let (start, end) = match corner {
-            Some(c) if c.under_grid() => (Some((c.top, c.end == CornerEnd::Lower)), None),
+            Some(c) if c.under_grid() => (Some((c.hi - 1, c.end == CornerEnd::Lower)), None),
             Some(c) => (None, Some(c.start)),
             None => (None, None),
         };
@@ -472,9 +472,8 @@ struct Corner {
     /// One past the last strain of the corner (Q24): the last knot is its end.
     hi: i32,
     /// A corner under the grid ([`Corner::under_grid`]): the last strain below it (the
-    /// table's `corner_hi`) and its own last strain (the grid's first knot), Q24.
+    /// table's `corner_hi`), Q24; its own last strain, `hi − 1`, is the grid's first knot.
     lo: i32,
-    top: i32,
     /// Where the uniform grid ends (a little past the corner's start), strain.
     start: f64,
     /// Where it ends: at the solid point, the last knot's force is `F_C` exactly.
@@ -581,7 +580,6 @@ impl Corner {
             pre,
             hi: hi as i32,
             lo: lo.max(i32::MIN as f64) as i32,
-            top: hi as i32 - 1,
             start,
             end,
             kink,
@@ -613,7 +611,6 @@ impl Corner {
             pre: (p as u32).wrapping_neg(),
             hi: top as i32 + 1,
             lo: lo as i32,
-            top: top as i32,
             start: top / unit,
             end: CornerEnd::Onset,
             // Its nearest knot (7, 0) on the kink: the segment above it takes the law's
