@@ -2,6 +2,8 @@
 # The test command: formatting, clippy, the thumb builds, the firmware on all three cores
 # in QEMU (the main job under a pseudo-terminal), the tick-path check, the bench and its
 # budgets, the firmware's size, the host tests, and the docs' figures against the code.
+# The host tests run in the background from the end of the host build on, beside the
+# firmware stages; their stage waits for them near the end.
 #
 # Every stage says what it does, ticks every 10 s while it runs and logs to
 # target/logs/test/<stage>.log (the path is printed when it fails). It ends with a
@@ -19,22 +21,21 @@ mkdir -p "$LOG_DIR" target/qemu
 
 THUMB=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
 
-# Linted per thumb target: the core alone (without and with defmt: it builds for every
-# target without any firmware module), then the firmware and the board crate.
+# Linted for the three thumb targets at once (one cargo run each: the targets' crates
+# build side by side): the core alone (without and with defmt: it builds for every
+# target without any firmware module), then the firmware; then the board crate.
+THUMB_ARGS=()
+for t in "${THUMB[@]}"; do THUMB_ARGS+=(--target "$t"); done
 clippy_thumb() {
-  for t in "${THUMB[@]}"; do
-    cargo clippy -p mccs --target "$t" -- -D warnings || return 1
-    cargo clippy -p mccs --target "$t" --features defmt -- -D warnings || return 1
-    cargo clippy -p mccs-firmware --target "$t" --lib --bins -- -D warnings || return 1
-  done
+  cargo clippy -p mccs "${THUMB_ARGS[@]}" -- -D warnings || return 1
+  cargo clippy -p mccs "${THUMB_ARGS[@]}" --features defmt -- -D warnings || return 1
+  cargo clippy -p mccs-firmware "${THUMB_ARGS[@]}" --lib --bins -- -D warnings || return 1
   cargo clippy -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins -- -D warnings || return 1
   cargo clippy -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu -- -D warnings
 }
 
 firmware_builds() {
-  for t in "${THUMB[@]}"; do
-    cargo build --release -p mccs-firmware --target "$t" --bins || return 1
-  done
+  cargo build --release -p mccs-firmware "${THUMB_ARGS[@]}" --bins
 }
 
 # The main job as a person runs it: scripts/demo.sh in a terminal (script(1) gives it a
@@ -136,10 +137,33 @@ host_tests() {
   cargo test --workspace --no-fail-fast -- --show-output
 }
 
+# The host tests need only the host build, and they run beside the firmware stages (a
+# QEMU run or a thumb link leaves a core idle; the tests keep both busy): started in the
+# background once the host build is done, their output in $HOST_BG.log and their exit
+# status in $HOST_BG.status. The host-tests stage waits for them.
+HOST_BG=$LOG_DIR/host-tests-background
+start_host_tests() {
+  (
+    host_tests > "$HOST_BG.log" 2>&1 < /dev/null
+    echo $? > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
+  ) &
+}
+
+# (Without the background run, as when the host build failed, the tests run here.)
+wait_host_tests() {
+  if [ ! -e "$HOST_BG.log" ]; then
+    host_tests
+    return
+  fi
+  while [ ! -e "$HOST_BG.status" ]; do sleep 1; done
+  cat "$HOST_BG.log"
+  return "$(cat "$HOST_BG.status")"
+}
+
 run_stage fmt cargo fmt --all -- --check
 run_stage clippy-host cargo clippy --workspace --all-targets -- -D warnings
+run_stage host-build cargo test --workspace --no-run && start_host_tests
 run_stage clippy-thumb clippy_thumb
-run_stage host-build cargo test --workspace --no-run
 run_stage firmware-builds firmware_builds
 run_stage demo-m4f-in-a-terminal demo_in_a_terminal
 run_stage demo-m3 demo_core m3
@@ -151,7 +175,7 @@ run_stage budget-breach-fails budget_test
 run_stage bench-truncated-fails bench_truncated
 run_stage firmware-size sizes
 run_stage board-f405 board_f405
-run_stage host-tests host_tests
+run_stage host-tests wait_host_tests
 run_stage docs-figures python3 scripts/figures.py check
 
 # The table, and the line CI reads.
