@@ -142,6 +142,16 @@ impl TwinConfig {
     }
 }
 
+/// The law's largest tangent stiffness over the default strain domain (N per unit
+/// strain), at 1,001 evenly spaced strains: the `k_max` of [`substeps`] for a twin of
+/// `law`.
+pub fn max_stiffness(law: &Reference) -> f64 {
+    let (lo, hi) = mccs::table::DEFAULT_DOMAIN;
+    (0..=1000)
+        .map(|i| law.stiffness(lo + (hi - lo) * i as f64 / 1000.0))
+        .fold(0.0, f64::max)
+}
+
 /// Substeps per tick for `mesh` with the law's largest tangent stiffness `k_max` (N per
 /// unit strain), from the conservative bound of the core's docs (`solver::stability`),
 /// computed independently: every spring at most `k_max / l0` stiff in every direction

@@ -16,7 +16,7 @@ mod replay;
 mod table;
 
 pub use demo::{parse_summary, FirmwareSummary};
-pub use patch::{reference_max_stiffness, PatchRun};
+pub use patch::PatchRun;
 pub use patch_args::MAX_GRID_REFERENCE;
 pub use table::render_table;
 

@@ -5,7 +5,7 @@ use super::patch_args::{config_error, PatchArgs};
 use super::table::solver_table;
 use super::{arg_error, file_error, fmt_strain, io_error, CliError};
 use crate::paramfile;
-use crate::patch::{substeps, Mesh, Twin, TwinConfig};
+use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig};
 use crate::reference::Reference;
 use crate::replay::{Engine, FIXED_EDGES, FIXED_NODES};
 use mccs::{Arith, Length, Params, Solver, SolverConfig, Topology};
@@ -115,7 +115,7 @@ impl PatchRun {
         let law = Reference::new(p).map_err(|e| file_error(file, e))?;
         let mesh = Mesh::standard(self.patch.grid, self.patch.spacing);
         let mut tc = TwinConfig::from_solver(cfg, 0);
-        let k_max = reference_max_stiffness(&law);
+        let k_max = max_stiffness(&law);
         let n = substeps(&mesh, k_max, &tc)
             .ok_or_else(|| config_error(mccs::SolverError::NoDamping, cfg))?;
         if n > cfg.max_substeps {
@@ -149,12 +149,4 @@ impl PatchRun {
             Engine::Narrow => self.fixed(p, file, &cfg, mccs::Narrow),
         }
     }
-}
-
-/// The law's largest tangent stiffness over the default strain domain (N per unit strain).
-pub fn reference_max_stiffness(law: &Reference) -> f64 {
-    let (lo, hi) = mccs::table::DEFAULT_DOMAIN;
-    (0..=1000)
-        .map(|i| law.stiffness(lo + (hi - lo) * i as f64 / 1000.0))
-        .fold(0.0, f64::max)
 }
