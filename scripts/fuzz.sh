@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every fuzz target (fuzz/fuzz_targets/) for SECONDS each (default 60) with
 # cargo-fuzz on the nightly toolchain, and prints the executions each reached:
-#   FUZZ target=<name> seconds=<s> executions=<n> crashes=<n>
+#   FUZZ target=<name> seconds=<s> executions=<n> crashes=<n> slow_units=<n>
 # A crash leaves its input in fuzz/artifacts/<target>/; turn it into a regression test
 # (host-tests) before fixing it. Not part of the test command (see docs/reliability.md).
 set -euo pipefail
@@ -28,8 +28,11 @@ for target in $(sed -n 's/^name = "\(.*\)"$/\1/p' fuzz/Cargo.toml | grep -v mccs
   rc=$?
   set -e
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
-  crashes=$(ls "fuzz/artifacts/$target" 2>/dev/null | wc -l)
-  echo "FUZZ target=$target seconds=$seconds executions=${execs:-0} crashes=$crashes"
+  # libFuzzer's artifacts: crash-, leak-, oom-, timeout- (failures) and slow-unit- (an
+  # input over its 10 s report threshold, under the sanitizer: not a failure, but kept).
+  crashes=$(ls "fuzz/artifacts/$target" 2>/dev/null | grep -vc '^slow-unit-' || true)
+  slow=$(ls "fuzz/artifacts/$target" 2>/dev/null | grep -c '^slow-unit-' || true)
+  echo "FUZZ target=$target seconds=$seconds executions=${execs:-0} crashes=$crashes slow_units=$slow"
   if [ "$rc" != 0 ]; then
     echo "fuzz.sh: $target failed (exit $rc): see $log" >&2
     grep -E "panicked|ERROR|SUMMARY" "$log" | head -n 5 >&2 || true
