@@ -495,8 +495,8 @@ impl<const S: usize> ForceTable<S> {
         let (sum, d) = (cubic_sum(c, t), slope(c, t));
         // (The header's shift and scales are read only now: loaded before the cubic, they
         // held registers across it, and the M4F's frame saved one more register and an
-        // alignment slot on every path: 30 instructions here, 27 now. A compiler fence
-        // emits no instruction.)
+        // alignment slot on every path; docs/performance.md, "The evaluation's frame". A
+        // compiler fence emits no instruction.)
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         let f = sum.wrapping_shr(r.shift);
         // Rounded to the nearest Q16 value (one `smmulr` on the M4F; an instruction more
