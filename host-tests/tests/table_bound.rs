@@ -181,7 +181,7 @@ fn independent_dense<const S: usize>(p: &Params, t: &ForceTable<S>, dense: usize
     // The lines between the table and the domain's ends, 257 points on each (the
     // builder's 65 there; the uniform sweep alone may put only a few on a short one, and
     // on a small spring the error there is the output's rounding, a sawtooth of an LSB:
-    // the long run's spring 55,889, on a line above 0.0017 wide).
+    // `a_refusal_on_a_short_line_above_is_confirmed`).
     let per = 256 * dense;
     let lines = [(DOMAIN.0, lo), (hi, DOMAIN.1)]
         .into_iter()
@@ -356,7 +356,8 @@ fn a_refusal_just_over_the_bound_is_confirmed() {
     );
 }
 
-/// Spring 55,889 of the long run (`TABLE_BOUND_SPRINGS=100000`, 2026-11-27): 28 mN at
+/// A spring of the long run (`TABLE_BOUND_SPRINGS=100000`, 2026-11-27, just past its
+/// 55,889th, the last progress line before it failed there): 28 mN at
 /// `F(0.95)`, so that one Q20 output LSB is 3.4e-5 of it, and its table ends at the
 /// solid point, 0.0017 strain short of the domain's end. The builder refused it at
 /// 2.29e-5 in force, on the line above, where the error is the output's rounding (a
