@@ -364,8 +364,8 @@ fn a_refusal_just_over_the_bound_is_confirmed() {
 /// sawtooth of an LSB) beside the line's own. The reference's sweep put only its uniform
 /// points there (nine) and found 1.94e-5: the refusal went unconfirmed, and the long
 /// run failed. Its sweep now puts 257 points on each line beyond the table, and finds
-/// what the builder found (a dense sweep of 4·10⁶ strains puts it at 2.294e-5, at strain
-/// 0.94925).
+/// what the builder found, 2.294e-5 (at strain 0.94925, where a scratch sweep of 4·10⁶
+/// strains put it too).
 #[test]
 fn a_refusal_on_a_short_line_above_is_confirmed() {
     let p = spring_of(
@@ -394,7 +394,7 @@ fn a_refusal_on_a_short_line_above_is_confirmed() {
     assert!(DOMAIN.1 - top < 2e-3, "{top}");
     let m = independent(&p, &t);
     assert!(
-        m.force >= 0.9 * reported.force,
+        m.force >= 0.99 * reported.force,
         "{m:?} against {reported:?}"
     );
     assert!(refusal_confirmed(&p, &reported, &bound).is_ok());
