@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the project needs on a fresh machine and says so: the three thumb
-# targets and rustup's llvm-tools (for the tick-path check), and Debian's qemu-system-arm
-# (as root). Sourced by scripts/demo.sh and scripts/test.sh.
+# targets, rustup's clippy and rustfmt (the test command's lints and format check) and
+# llvm-tools (for the tick-path check), and Debian's qemu-system-arm (as root).
+# Sourced by scripts/demo.sh and scripts/test.sh.
 set -euo pipefail
 
 need_targets=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
@@ -14,6 +15,13 @@ if [ "${#missing[@]}" -gt 0 ]; then
   echo "setup: rustup target add ${missing[*]}" >&2
   rustup target add "${missing[@]}" >&2
 fi
+
+for component in clippy rustfmt; do
+  if ! rustup component list --installed | grep -q "^$component"; then
+    echo "setup: rustup component add $component (the test command's lints and format check)" >&2
+    rustup component add "$component" >&2
+  fi
+done
 
 if ! rustup component list --installed | grep -q '^llvm-tools'; then
   echo "setup: rustup component add llvm-tools (llvm-objdump and llvm-size)" >&2
