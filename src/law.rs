@@ -109,35 +109,6 @@ impl Law {
         self.b * (pow4(dc) - pow4(self.d1))
     }
 
-    /// [`Law::delta`] and [`Law::compliance`] at `f`, the same bits, from one cube root
-    /// (the root is most of a table build's time).
-    fn delta_and_compliance(&self, f: f64) -> (f64, f64) {
-        let (cone, cone_compliance) = if f <= self.f_t {
-            (f / self.k, 1.0 / self.k)
-        } else if f <= self.f_c {
-            let dc = self.closed_diameter(f);
-            let compliance = self.b * (pow4(dc) - pow4(self.d1));
-            let delta = if f < self.f_c {
-                self.b * f * (pow4(dc) - pow4(self.d1))
-                    + self.h * (self.d2 - dc) / (self.d2 - self.d1)
-            } else {
-                self.h
-            };
-            (delta, compliance)
-        } else {
-            (self.h, 0.0)
-        };
-        let series = if f > self.preload {
-            1.0 / self.k_p
-        } else {
-            0.0
-        };
-        (
-            cone + libm::fmax(f - self.preload, 0.0) / self.k_p,
-            cone_compliance + series,
-        )
-    }
-
     /// `dΔ/dF` at force `f`, analytic; at a kink, the derivative from below.
     pub fn compliance(&self, f: f64) -> f64 {
         let cone = if f <= self.f_t {
@@ -199,11 +170,11 @@ impl Law {
             f = 0.5 * (lo + hi);
         }
         for steps in 1..=200 {
-            let (delta, compliance) = self.delta_and_compliance(f);
-            let r = delta - strain;
+            let r = self.delta(f) - strain;
             if r == 0.0 {
                 // On the root: done. (Taken for a step of zero, it would leave the
-                // bracket's end and bisect from the far one: 25 steps on average, not 6.)
+                // bracket's end and bisect on from the far one:
+                // `the_inverse_takes_few_newton_steps`.)
                 return (f, steps);
             }
             if r > 0.0 {
@@ -211,7 +182,7 @@ impl Law {
             } else {
                 lo = f;
             }
-            let mut next = f - r / compliance;
+            let mut next = f - r / self.compliance(f);
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
@@ -233,34 +204,6 @@ fn pow4(x: f64) -> f64 {
 mod tests {
     use super::Law;
     use crate::Params;
-
-    /// `delta_and_compliance` is `delta` and `compliance`, to the bit, on each side of
-    /// every kink and at it (`F_T`, a preload's `P` below and above `F_T`, `F_C`), and
-    /// across the whole range of forces.
-    #[test]
-    fn delta_and_compliance_are_delta_and_compliance() {
-        let mut below = Params::TABLE2;
-        below.linear.preload = Some(0.5 * Law::new(&Params::TABLE2).unwrap().f_t);
-        let mut above = Params::TABLE2;
-        above.linear.preload = Some(4.0);
-        for p in [Params::TABLE2, below, above] {
-            let law = Law::new(&p).unwrap();
-            let kinks = [law.f_t, law.preload, law.f_c];
-            let near = kinks.iter().flat_map(|&k| {
-                [-2i64, -1, 0, 1, 2].map(|u| f64::from_bits((k.to_bits() as i64 + u) as u64))
-            });
-            let sweep = (0..=4000).map(|i| -1.0 + 1.5 * law.f_c * i as f64 / 4000.0);
-            for f in near.chain(sweep) {
-                let (d, c) = law.delta_and_compliance(f);
-                assert_eq!(d.to_bits(), law.delta(f).to_bits(), "delta at {f}");
-                assert_eq!(
-                    c.to_bits(),
-                    law.compliance(f).to_bits(),
-                    "compliance at {f}"
-                );
-            }
-        }
-    }
 
     /// Newton steps of [`Law::force`] over the nonlinear phase: at most `max` and
     /// `mean` on average, on strains spread evenly and on strains that are `Δ(F)` of a

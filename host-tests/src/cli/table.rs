@@ -110,8 +110,8 @@ enum Tried {
 }
 
 /// Tables a refusal's [`remedy`] may build, at most: each that misses the bound takes
-/// about half a second with 129 knots for a spring with a preload (the builder tries
-/// every placement), so that a refusal comes within about 9 s.
+/// longest with 129 knots for a spring with a preload (the builder tries every
+/// placement): `docs/cli.md` gives the time of one refusal.
 const REMEDY_BUILDS: usize = 16;
 
 /// [`remedy`]'s first steps in the domain: sixths of it.
