@@ -1130,3 +1130,55 @@ fn patch_runs_either_integrator_to_the_same_settled_force() {
         &["--integrator"],
     );
 }
+
+/// A run that takes long says how far it is on stderr, every period (2 s; here 1 ms, by
+/// `MCCS_PROGRESS_MS`), and its stdout is the same; a short run says nothing.
+#[test]
+fn long_runs_report_progress_on_stderr() {
+    let runs: [&[&str]; 2] = [
+        &[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/stroke.csv",
+        ],
+        &[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--duration",
+            "0.5",
+        ],
+    ];
+    for (args, command, total) in [(runs[0], "replay", "3.0"), (runs[1], "patch", "0.5")] {
+        let quiet = mccs(args);
+        assert!(quiet.status.success());
+        assert!(
+            quiet.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&quiet.stderr)
+        );
+        let told = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(args)
+            .current_dir(root())
+            .env("MCCS_PROGRESS_MS", "1")
+            .output()
+            .expect("run mccs");
+        assert!(told.status.success());
+        assert_eq!(told.stdout, quiet.stdout, "{command}: the same output");
+        let err = String::from_utf8_lossy(&told.stderr);
+        let lines: Vec<&str> = err.lines().collect();
+        let prefix = format!("mccs {command}: ");
+        let of = format!(" of {total} s simulated, ");
+        assert!(
+            !lines.is_empty()
+                && lines
+                    .iter()
+                    .all(|l| l.starts_with(&prefix) && l.contains(&of) && l.ends_with(" s so far")),
+            "{command}: {err}"
+        );
+    }
+}

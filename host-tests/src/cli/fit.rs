@@ -5,12 +5,12 @@
 //! measured on all of them; a fit that runs for more than 2 s says where it is on stderr
 //! every 2 s.
 
+use super::progress::Ticker;
 use super::{arg_error, io_error, CliError};
 use crate::fit::{self, ModelKind, Progress};
 use crate::paramfile;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 #[derive(clap::Args, Debug)]
 pub(super) struct Args {
@@ -83,11 +83,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             fit::FIT_ROWS
         );
     }
-    let started = Instant::now();
-    let mut next_report = Duration::from_secs(2);
+    let mut ticker = Ticker::new();
     let mut progress = |p: Progress| {
-        let t = started.elapsed();
-        if t >= next_report {
+        if let Some(t) = ticker.due() {
             eprintln!(
                 "mccs: fitting {} (starting point {} of {}), {:.0} s so far",
                 p.kind.name(),
@@ -95,7 +93,6 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 p.starts,
                 t.as_secs_f64()
             );
-            next_report = t + Duration::from_secs(2);
         }
     };
     let mut fits = Vec::new();

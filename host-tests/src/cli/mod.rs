@@ -12,6 +12,7 @@ mod demo;
 mod fit;
 mod patch;
 mod patch_args;
+mod progress;
 mod replay;
 mod table;
 

@@ -2,6 +2,7 @@
 //! fixed-point core.
 
 use super::patch_args::{config_error, PatchArgs};
+use super::progress::Simulated;
 use super::table::solver_table;
 use super::{arg_error, file_error, fmt_strain, io_error, CliError};
 use crate::paramfile;
@@ -80,6 +81,12 @@ impl PatchRun {
         (i + 1) as f64 / self.patch.rate
     }
 
+    /// Progress lines on stderr for a run that takes long (a large reference patch: the
+    /// 40 × 40 twin over 60 s takes most of a minute).
+    fn progress(&self) -> Simulated {
+        Simulated::new("patch", self.time(self.ticks - 1))
+    }
+
     /// `(time_s, reaction_n)` per tick of the fixed-point core in arithmetic `A`.
     fn fixed<A: Arith>(
         &self,
@@ -96,8 +103,10 @@ impl PatchRun {
         .map_err(|e| arg_error("--grid", &e.to_string()))?;
         let mut s =
             Solver::with_arith(topo, table, cfg, arith).map_err(|e| config_error(e, cfg))?;
+        let mut progress = self.progress();
         Ok((0..self.ticks)
             .map(|i| {
+                progress.at(self.time(i));
                 let z = Length::from_num(-self.depth_at(i));
                 let r = s.step_held([Length::ZERO, Length::ZERO, z]);
                 (self.time(i), r[2].to_num::<f64>())
@@ -126,8 +135,10 @@ impl PatchRun {
         }
         tc.substeps = n;
         let mut twin = Twin::new(mesh, law, tc);
+        let mut progress = self.progress();
         Ok((0..self.ticks)
             .map(|i| {
+                progress.at(self.time(i));
                 (
                     self.time(i),
                     twin.step_held([0.0, 0.0, -self.depth_at(i)])[2],

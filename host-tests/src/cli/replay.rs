@@ -2,6 +2,7 @@
 //! per tick; with `--tissue`, against the `f64` roaming probe (docs/roaming.md).
 
 use super::patch_args::{config_error, PatchArgs, TuningArgs};
+use super::progress::Simulated;
 use super::table::solver_table;
 use super::{arg_error, file_error, io_error, CliError};
 use crate::paramfile;
@@ -129,6 +130,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         engine: a.patch.engine(),
     };
     let w = std::io::BufWriter::new(out);
+    // Progress lines on stderr for a replay that takes long (a long trajectory on a large
+    // reference patch: 600 s on the 8 × 8 twin takes 14 s).
+    let mut progress = Simulated::new("replay", traj.span().1);
     let fail = |e| match e {
         ReplayError::Solver(s) => config_error(s, &cfg),
         ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
@@ -141,6 +145,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts",
             |row| {
                 replay.roam(&p, &traj, &roaming, |r: RoamRow| {
+                    progress.at(r.time);
                     row(format!(
                         "{},{},{},{},{},{},{},{},{},{}",
                         fmt_time(r.time),
@@ -163,6 +168,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm",
             |row| {
                 replay.run(&p, &traj, |r| {
+                    progress.at(r.time);
                     row(format!(
                         "{},{},{},{},{},{},{},{}",
                         fmt_time(r.time),
