@@ -171,8 +171,10 @@ impl Law {
         }
         for steps in 1..=200 {
             let r = self.delta(f) - strain;
-            if r == 0.0 {
-                // On the root: done. (Taken for a step of zero, it would leave the
+            let mut next = f - r / self.compliance(f);
+            if next == f {
+                // On the root to the last bit (a residual of zero, or a step below half
+                // of `f`'s last bit): done. (Taken for a step, it would sit on the
                 // bracket's end and bisect on from the far one:
                 // `the_inverse_takes_few_newton_steps`.)
                 return (f, steps);
@@ -182,10 +184,10 @@ impl Law {
             } else {
                 lo = f;
             }
-            let mut next = f - r / self.compliance(f);
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
+
             if libm::fabs(next - f) <= 1e-15 * f || hi - lo <= 1e-15 * hi {
                 return (next, steps);
             }
@@ -225,8 +227,10 @@ mod tests {
         (max, sum as f64 / n as f64)
     }
 
-    /// An exact root ends the search. It once bisected on from the bracket's far end
-    /// instead: 30 steps on average here, up to 61 (now 6 to 7, up to 18).
+    /// A Newton step that leaves the iterate where it is ends the search: on the root to
+    /// its last bit. It once bisected on from the bracket's far end instead: 30 steps on
+    /// average over Table 2's nonlinear phase (up to 61), and over these 1,003 springs 67
+    /// at most and 41 on average on the worst (now 26 and 8.3; Table 2 about 6).
     #[test]
     fn the_inverse_takes_few_newton_steps() {
         let mut preloaded = Params::TABLE2;
@@ -234,12 +238,44 @@ mod tests {
         let mut stiff_series = Params::TABLE2;
         stiff_series.cone.shear_modulus *= 0.1;
         stiff_series.linear.shear_modulus *= 28.2;
-        for p in [Params::TABLE2, preloaded, stiff_series] {
+        // Random springs: the cone's wire, modulus and coils within a decade of Table
+        // 2's each way, `D2/D1` 1.05 … 4.05, the series spring's modulus 1e-3 … 1e4
+        // times Table 2's, and half of them preloaded at 0.3 … 3 `F_T` (below 0.9 `F_C`).
+        let mut seed = 12345u64;
+        let mut uniform = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let random = core::iter::repeat_with(|| {
+            let mut p = Params::TABLE2;
+            let decade = |u: f64| libm::pow(10.0, 2.0 * u - 1.0);
+            p.cone.wire_diameter *= decade(uniform());
+            p.cone.shear_modulus *= decade(uniform());
+            p.cone.active_coils *= decade(uniform());
+            p.cone.large_diameter = p.cone.small_diameter * (1.05 + 3.0 * uniform());
+            p.linear.shear_modulus *= libm::pow(10.0, 7.0 * uniform() - 3.0);
+            let (preloaded, load) = (uniform() < 0.5, 0.3 + 2.7 * uniform());
+            if let (true, Ok(law)) = (preloaded, Law::new(&p)) {
+                p.linear.preload = Some(libm::fmin(load * law.f_t, 0.9 * law.f_c));
+            }
+            p
+        })
+        .filter(|p| Law::new(p).is_ok())
+        .take(1000);
+        let mut checked = 0;
+        for p in [Params::TABLE2, preloaded, stiff_series]
+            .into_iter()
+            .chain(random)
+        {
             let (max, mean) = steps(&p);
             assert!(
-                max <= 24 && mean <= 8.0,
-                "{max} steps at most, {mean} on average"
+                max <= 32 && mean <= 10.0,
+                "{max} steps at most, {mean} on average: {p:?}"
             );
+            checked += 1;
         }
+        assert_eq!(checked, 1003);
     }
 }
