@@ -354,12 +354,23 @@ proptest! {
         // transition Δ(F_T) (a jump in curvature; see the test below). The largest errors
         // left are where a cubic cannot follow the law: the transition inside the first
         // segment (Δ(P) closer to it), or the cone's steep rise just below Δ(P) when P is
-        // close to F_C. Up to 1.9e-3 seen; 5e-3 asserted.
+        // close to F_C (`a_devices_table_below_a_late_preload`): a device's table
+        // (`ForceTable::new`, one placement, unmeasured) promises no bound. 1.3e-2 seen
+        // (2,000 cases, PROPTEST_RNG_SEED=2); 3e-2 asserted, and its own measure
+        // (`ForceTable::measured`, what a device can log) must see it.
         let r = Reference::new(&p).unwrap();
         let t = ForceTable::<64>::new(&p).unwrap();
         let s = sweep(&r, &t);
-        prop_assert!(s.max_force <= 5e-3, "max {:e}", s.max_force);
+        prop_assert!(s.max_force <= 3e-2, "max {:e}", s.max_force);
         prop_assert_eq!(s.decreases, 0);
+        let law = mccs::Law::new(&p).unwrap();
+        let own = t.measured(&law, DOMAIN.0, DOMAIN.1).max_error().unwrap();
+        prop_assert!(
+            own.force >= 0.5 * s.max_force - 2e-6,
+            "measured {:e}, the sweep {:e}",
+            own.force,
+            s.max_force
+        );
     }
 
     #[test]
@@ -656,4 +667,50 @@ fn the_spring_loop_runs_a_lower_corner_as_the_kernel_does() {
             assert!(n >= 10, "{n} springs in the corner");
         }
     }
+}
+
+/// Found by `random_springs_any_preload` (2026-11-27): a preload at 0.85 `F_C` puts its
+/// kink `Δ(P)` on the cone's steep rise toward its solid point. A device's table (one
+/// placement, `ForceTable::new`) misses the product's bound there by far (8.2e-3 of
+/// `F(0.95)` just below `Δ(P)`), and says so when measured; the builder's best
+/// (`ForceTable::with_bound`, what `mccs table` emits) meets it.
+#[test]
+fn a_devices_table_below_a_late_preload() {
+    let p = Params {
+        cone: mccs::Cone {
+            wire_diameter: 0.10737573340468612,
+            small_diameter: 0.29062719347039323,
+            large_diameter: 0.43594079020558985,
+            active_coils: 4.602471888946101,
+            compressible_height: 0.18,
+            shear_modulus: 546026.959406312,
+        },
+        linear: mccs::Linear {
+            wire_diameter: 0.09454553423059836,
+            mean_diameter: 0.49454811640774426,
+            active_coils: 22.812925752197483,
+            shear_modulus: 1365425.0570464788,
+            preload: Some(12.328781291269372),
+        },
+    };
+    let r = Reference::new(&p).unwrap();
+    let law = mccs::Law::new(&p).unwrap();
+    let device = ForceTable::<64>::new(&p).unwrap();
+    let s = sweep(&r, &device);
+    let own = device
+        .measured(&law, DOMAIN.0, DOMAIN.1)
+        .max_error()
+        .unwrap();
+    println!(
+        "DEVICETABLE force={:.1e} measured={:.1e}",
+        s.max_force, own.force
+    );
+    assert!(
+        s.max_force > 1e-3 && own.force >= 0.5 * s.max_force,
+        "{s:?} {own:?}"
+    );
+    let best = ForceTable::<64>::with_bound(&p, DOMAIN.0, DOMAIN.1, &mccs::TableBound::PRODUCT)
+        .expect("the builder's best meets the bound");
+    let s = sweep(&r, &best);
+    assert!(s.max_force <= 2e-5 * 1.02 + 1e-6, "{s:?}");
 }
