@@ -187,7 +187,6 @@ impl Law {
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
-
             if libm::fabs(next - f) <= 1e-15 * f || hi - lo <= 1e-15 * hi {
                 return (next, steps);
             }
