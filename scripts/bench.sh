@@ -6,6 +6,7 @@
 # `scripts/bench.sh --update` rewrites the baseline instead of comparing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/lib.sh  # core_target
 mode=${1:-check}
 # Whether a bench log ran to its end: the firmware's last act is its budget check.
 complete() { grep -q "^BUDGET core=$1 " "$2"; }
@@ -19,7 +20,6 @@ out=target/qemu/bench.txt
 : > "$out"
 status=0
 cargo build --quiet -p defmt-log
-target_of() { case $1 in m4f) echo thumbv7em-none-eabihf ;; m3) echo thumbv7m-none-eabi ;; m0) echo thumbv6m-none-eabi ;; esac; }
 echo "bench: building the bench firmware for m4f, m3 and m0" >&2
 cargo build --quiet --release -p mccs-firmware --bin bench \
   --target thumbv7em-none-eabihf --target thumbv7m-none-eabi --target thumbv6m-none-eabi
@@ -27,7 +27,7 @@ cargo build --quiet --release -p mccs-firmware --bin bench \
 # do not depend on the host's load); each one's exit status in its .rc file.
 echo "bench: running m4f, m3 and m0 in QEMU side by side (about 30 s)" >&2
 for core in m4f m3 m0; do
-  t=$(target_of "$core")
+  t=$(core_target "$core")
   log="target/qemu/bench-$core.log"
   rm -f "$log.rc"
   (
