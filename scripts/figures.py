@@ -14,6 +14,11 @@ or `SWEEP.wide.max_error_rel`; a SUMMARY line of a demo log is keyed by its core
   figures.py update   rewrite the marked values from the logs
   figures.py list     print every figure the logs hold
 
+A log excerpt in a doc is marked `<!-- excerpt:LOG -->` just above its fenced block:
+each of the block's lines but those with `…` (elided) must be a line of
+target/qemu/LOG as it was printed, in the same order (`check` and `update` both fail
+otherwise: an excerpt is copied by hand, from the log).
+
 The logs: target/qemu/*.txt and *.log (the firmware, the bench, the sizes) and
 target/logs/test/host-tests.log (the host tests, run with --show-output).
 """
@@ -22,6 +27,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+EXCERPT = re.compile(r"<!-- excerpt:([A-Za-z0-9_.\-]+) -->\n```[a-z]*\n(.*?)\n```", re.S)
 MARK = re.compile(r"<!-- fig:([A-Za-z0-9_.\-]+) -->(.*?)<!-- /fig -->")
 LINE = re.compile(r"^(?:INFO\s+)?([A-Z][A-Z_]+) ((?:\S+=\S+ ?)+)$")
 NUMBER = re.compile(r"^-?[0-9][0-9.]*(e[-+]?[0-9]+)?(/100)?$")
@@ -79,6 +85,28 @@ def same(key: str, doc: str, printed: str) -> bool:
     return abs(a - b) <= max(1.0, 0.002 * abs(b))
 
 
+def excerpts(doc: Path, text: str) -> int:
+    """The excerpts of `doc` that its logs do not print: one line each; their count."""
+    bad = 0
+    for m in EXCERPT.finditer(text):
+        log = ROOT / "target/qemu" / m.group(1)
+        if not log.exists():
+            print(f"{doc.relative_to(ROOT)}: excerpt of {m.group(1)}: no such log (run the test command)")
+            bad += 1
+            continue
+        printed = [l.rstrip("\r") for l in log.read_text(errors="replace").splitlines()]
+        at = 0
+        for line in m.group(2).splitlines():
+            if "…" in line or not line.strip():
+                continue
+            try:
+                at = printed.index(line, at) + 1
+            except ValueError:
+                print(f"{doc.relative_to(ROOT)}: excerpt of {m.group(1)}: not printed there (in this order): {line}")
+                bad += 1
+    return bad
+
+
 def docs():
     return [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
@@ -92,6 +120,7 @@ def main() -> int:
         return 0
     bad = 0
     marks = 0
+    stale = 0
     for doc in docs():
         text = doc.read_text()
         def repl(m):
@@ -107,11 +136,12 @@ def main() -> int:
                 bad += 1
             return f"<!-- fig:{key} -->{figs[key]}<!-- /fig -->"
         new = MARK.sub(repl, text)
+        stale += excerpts(doc, text)
         if mode == "update" and new != text:
             doc.write_text(new)
             print(f"updated {doc.relative_to(ROOT)}")
-    print(f"figures: {marks} quoted, {marks - bad} as printed, {bad} not")
-    return 1 if bad else 0
+    print(f"figures: {marks} quoted, {marks - bad} as printed, {bad} not; {stale} excerpt lines not printed")
+    return 1 if bad or stale else 0
 
 
 if __name__ == "__main__":
