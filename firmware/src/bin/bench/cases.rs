@@ -272,6 +272,34 @@ fn float_substep<T: Real, const N: usize, const E: usize>(
     p.substep(probe)
 }
 
+/// The solver's start-up for this core's demo configuration (`Solver::new`: the patch's
+/// coefficients and its stability bound, whose estimate runs the linearised step in
+/// `f32`, software on the M3 and M0), once, in instructions.
+#[inline(never)]
+pub fn startup(h: &Harness, table: &ForceTable64) -> u64 {
+    match demo::spec_for(CORE).grid {
+        8 => startup_in::<37, 214>(h, table),
+        5 => startup_in::<10, 61>(h, table),
+        _ => startup_in::<5, 30>(h, table),
+    }
+}
+
+#[inline(never)]
+fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u64 {
+    let spec = demo::spec_for(CORE);
+    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, 2.5) else {
+        exit(false)
+    };
+    let mut ok = false;
+    let n = h.measure_long(|| {
+        ok = black_box(Solver::new(black_box(topo), *table, &spec.config())).is_ok();
+    });
+    if !ok {
+        exit(false)
+    }
+    n
+}
+
 /// One tick of this core's demo configuration, pressed in, averaged over 4.
 #[inline(never)]
 pub fn tick(h: &Harness, table: &ForceTable64, probe: [Length; 3]) -> u32 {

@@ -38,7 +38,7 @@ mod firmware {
     use super::report::{
         check_budgets, fits, largest_patch, substep_case, Figures, Steps, SPRING_PATH_SPREAD,
     };
-    use super::{cases, harness, hold_check, kernel_check};
+    use super::{cases, harness, hold_check, kernel_check, report};
     use cases::TablePath;
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -200,6 +200,9 @@ mod firmware {
         figs.report("tick", cases::tick(&h, table, probe) - empty);
         // One tick of the demo's patch through a sliding proxy (issue #19).
         figs.report("tick_proxy", cases::tick_proxy(&h, table) - empty);
+        // The solver's start-up for the demo's patch, once (millions of instructions).
+        let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
+        report::startup(&mut figs, grid, cases::startup(&h, table));
         // The demo's roaming: the longest tick without and with a window shift, and a
         // shift's own cost (the most a shift tick took over the tick before).
         let roam = cases::roaming(&h, table, empty);

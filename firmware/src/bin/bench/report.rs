@@ -95,6 +95,21 @@ fn tick_of(figs: &Figures, steps: &Steps, n: u32, tick_hz: u32) -> Option<(u32, 
     ))
 }
 
+/// The solver's start-up for this core's demo patch, `n` × `n` ([`crate::cases::startup`]):
+/// a `BENCH` line, `case=startup n= instructions= ms_at_clock=` (the time at `CLOCK`
+/// with its cycles-per-instruction estimate).
+pub fn startup(figs: &mut Figures, n: u32, instructions: u64) {
+    let ms = instructions * CLOCK.1 as u64 / 100 / (CLOCK.0 as u64 * 1000);
+    figs.record("startup", u32::try_from(instructions).unwrap_or(u32::MAX));
+    defmt::println!(
+        "BENCH core={=str} case=startup n={=u32} instructions={=u64} ms_at_clock={=u64}",
+        CORE.name(),
+        n,
+        instructions,
+        ms
+    );
+}
+
 /// The largest standard patch whose tick's bound over every state ([`tick_of`]) fits in
 /// `half_tick` instructions: `(n, substeps, tick, worst)`, or `None` where none fits.
 fn largest(
