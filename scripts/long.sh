@@ -4,8 +4,9 @@
 #      (default 50,000: ten times the test command's, about 10⁷ ticks in all), and the
 #      settling properties at CASES / 100;
 #   2. the roaming probe over random caps and paths at CASES / 10 cases
-#      (host-tests/tests/cap.rs), and the force-table bound over 10⁵ random springs
-#      (host-tests/tests/table_bound.rs);
+#      (host-tests/tests/cap.rs), the stability bound against the exact one on CASES / 2
+#      random configurations (host-tests/tests/stability.rs), and the force-table bound
+#      over 10⁵ random springs (host-tests/tests/table_bound.rs);
 #   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
 # First, the whole host test suite in a release build (link-time optimisation, as
 # docs/cli.md builds the CLI), and that build's stack probes
@@ -47,6 +48,14 @@ PROPTEST_CASES=$caps cargo test --release -p mccs-host --test host \
     -- cap::robust > target/logs/long/cap.log 2>&1 \
   || { echo "long.sh: the cap property failed; see target/logs/long/cap.log" >&2; exit 1; }
 echo "PROPERTY case=cap_paths cases=$caps result=ok"
+configs=$(( cases / 2 ))
+# (A new seed each run unless PROPTEST_RNG_SEED is set; the STABILITY line names it.)
+seed=${PROPTEST_RNG_SEED:-$RANDOM$RANDOM}
+echo "long.sh: the stability bound on $configs random configurations, seed $seed (about 3 minutes at 25,000)" >&2
+PROPTEST_RNG_SEED=$seed PROPTEST_CASES=$configs cargo test --release -p mccs-host --test host \
+    -- --nocapture stability::the_chosen_bound_is_never_optimistic_on_random > target/logs/long/stability.log 2>&1 \
+  || { echo "long.sh: the stability property failed; see target/logs/long/stability.log" >&2; exit 1; }
+grep -E "^STABILITY " target/logs/long/stability.log
 echo "long.sh: the force-table bound over 10^5 random springs (about 2 h: 7,179 s on 2 cores on 2026-11-26; its progress every 10 s)" >&2
 # The log keeps everything; the progress lines also go to the terminal.
 TABLE_BOUND_SPRINGS=100000 cargo test --release -p mccs-host --test host \
