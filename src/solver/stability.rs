@@ -306,6 +306,16 @@ fn estimate<const NODES: usize, const EDGES: usize>(
     lo
 }
 
+/// Steps of each run of the linearised step ([`Linearised::growth`]). 768 until
+/// 2026-11-27: a lightly damped patch's slowly growing mode stayed hidden under its
+/// slowly decaying ones, and the estimate reached 1.30 times the exact bound, the
+/// substep taken 0.975 of it (`host-tests/tests/stability.rs`, random configurations);
+/// at 1536, 1.12 and 0.84 on the same draw.
+const RUN_STEPS: usize = 1536;
+
+/// The last steps of a run, over which its growth is measured.
+const RUN_WINDOW: usize = RUN_STEPS / 3;
+
 /// The fraction bits of the fixed-point step's coefficients ([`Linearised::growth`]).
 const COEFF_FRAC: u32 = 24;
 
@@ -433,9 +443,9 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
 
     /// How much the configured integrator's step `h` grows a perturbation: the ratio of its
     /// energy (kinetic and elastic, which an oscillation trades without changing their
-    /// sum, so that the ratio does not depend on the phase it stops at) over the last 256
-    /// of 768 steps (the first 512 let the decaying modes fall behind the growing one, as
-    /// in a power iteration); infinite where it overflows.
+    /// sum, so that the ratio does not depend on the phase it stops at) over the last
+    /// [`RUN_WINDOW`] of [`RUN_STEPS`] steps (the first let the decaying modes fall behind
+    /// the growing one, as in a power iteration); infinite where it overflows.
     ///
     /// In block fixed point, so that a core without an FPU runs it at integer speed (in
     /// software `f32` the M3's and M0's start-up took 22 s at their clocks): the
@@ -450,8 +460,6 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// coefficient is at most one of those) or a step grows a component past
     /// [`STATE_LIMIT`].
     fn growth(&self, h: f64) -> f32 {
-        const STEPS: usize = 768;
-        const WINDOW: usize = 256;
         let n = self.topo.node_count().min(NODES);
         let symplectic = self.integrator == Integrator::SymplecticDamped;
         let d = if symplectic {
@@ -505,8 +513,8 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         }
         let c = self.topo.contact() as usize;
         let mut at_window = (0.0f32, 0);
-        for step in 0..STEPS {
-            if step == STEPS - WINDOW {
+        for step in 0..RUN_STEPS {
+            if step == RUN_STEPS - RUN_WINDOW {
                 at_window = (self.energy(&x, &v, hf, g), exp);
             }
             let mut dv = [[0i32; 3]; NODES];
@@ -635,7 +643,7 @@ mod tests {
     use crate::{ForceTable64, Params};
 
     /// The linearised step of [`Linearised::growth`] in plain `f64` from the same start:
-    /// the energy ratio over the last 256 of 768 steps.
+    /// the energy ratio over the last [`RUN_WINDOW`] of [`RUN_STEPS`] steps.
     fn growth_f64<const NODES: usize, const EDGES: usize>(
         lin: &Linearised<'_, NODES, EDGES>,
         h: f64,
@@ -679,8 +687,8 @@ mod tests {
                 .sum::<f64>()
         };
         let (mut at_window, mut scale) = (0.0, 0.0);
-        for step in 0..768 {
-            if step == 512 {
+        for step in 0..RUN_STEPS {
+            if step == RUN_STEPS - RUN_WINDOW {
                 at_window = energy(&x, &v);
                 scale = 0.0;
             }
@@ -723,8 +731,8 @@ mod tests {
     /// The fixed-point step's growth is the `f64` step's, on the standard N = 3 and
     /// N = 4 patches with the defaults and a light and a heavy damping, both integrators,
     /// from a sixteenth of the closed form to four times it: the same side of 1 wherever
-    /// the `f64` growth is not within 1 % of it, and the same logarithm within 5e-3 and
-    /// 1e-3 of its magnitude (measured: 3.5e-3 near 1, 2.8e-4 relative far from it);
+    /// the `f64` growth is not within 1 % of it, and the same logarithm within 1e-2 and
+    /// 1e-3 of its magnitude (measured: 5.1e-3 near 1, 5.6e-4 relative far from it);
     /// infinite (unstable) only where the `f64` step grows.
     #[test]
     fn the_fixed_point_growth_is_the_f64_steps() {
@@ -754,7 +762,7 @@ mod tests {
                             assert_eq!(fixed <= 1.0, float <= 1.0, "{what}: {fixed} vs {float}");
                         }
                         assert!(
-                            (lf - lg).abs() <= 5e-3 + 1e-3 * lg.abs(),
+                            (lf - lg).abs() <= 1e-2 + 1e-3 * lg.abs(),
                             "{what}: {fixed} vs {float}"
                         );
                     }
