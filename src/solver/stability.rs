@@ -86,8 +86,8 @@ pub enum Bound {
 /// The fraction of the estimated exact bound a solver takes.
 pub const ESTIMATE_MARGIN: f64 = 0.75;
 
-/// The largest growth (energy at the end of the estimate's run over that halfway) at the
-/// estimated step with its margin for which the estimate is taken; above it, the
+/// The largest growth (energy at the end of the estimate's run over that two thirds in:
+/// [`RUN_WINDOW`]) at the estimated step with its margin for which the estimate is taken; above it, the
 /// patch is too lightly damped for the estimate to see the edge, and the solver takes
 /// the conservative bound.
 pub const TRUSTED_DECAY: f32 = 0.5;
