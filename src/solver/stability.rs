@@ -33,7 +33,7 @@
 //! - [`Bound::Estimated`], the default: the largest `h` with `ρ(G(h)) < 1`, estimated
 //!   matrix-free by running the linearised step (in block fixed point: `i32` state
 //!   under one exponent, exact high-word products, so that a core without an FPU runs
-//!   it at integer speed; [`Linearised::growth`]) from a fixed start and measuring its
+//!   it at integer speed; `Linearised::growth`) from a fixed start and measuring its
 //!   growth, bisected (geometrically, 7 steps) between a quarter of the
 //!   closed form and four times it; then [`ESTIMATE_MARGIN`] of it, where the motion at
 //!   that step visibly dies out (energy growth at most [`TRUSTED_DECAY`] over the last
@@ -87,7 +87,7 @@ pub enum Bound {
 pub const ESTIMATE_MARGIN: f64 = 0.75;
 
 /// The largest growth (energy at the end of the estimate's run over that two thirds in:
-/// [`RUN_WINDOW`]) at the estimated step with its margin for which the estimate is taken; above it, the
+/// `RUN_WINDOW`) at the estimated step with its margin for which the estimate is taken; above it, the
 /// patch is too lightly damped for the estimate to see the edge, and the solver takes
 /// the conservative bound.
 pub const TRUSTED_DECAY: f32 = 0.5;
