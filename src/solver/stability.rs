@@ -86,8 +86,8 @@ pub enum Bound {
 /// The fraction of the estimated exact bound a solver takes.
 pub const ESTIMATE_MARGIN: f64 = 0.75;
 
-/// The largest growth (energy at the end of the estimate's run over that two thirds in:
-/// `RUN_WINDOW`) at the estimated step with its margin for which the estimate is taken; above it, the
+/// The largest growth (energy at the end of the estimate's run over that two thirds in)
+/// at the estimated step with its margin for which the estimate is taken; above it, the
 /// patch is too lightly damped for the estimate to see the edge, and the solver takes
 /// the conservative bound.
 pub const TRUSTED_DECAY: f32 = 0.5;
@@ -449,15 +449,16 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     ///
     /// In block fixed point, so that a core without an FPU runs it at integer speed (in
     /// software `f32` the M3's and M0's start-up took 22 s at their clocks): the
-    /// displacements `X` and the velocities as displacements per step `V = v h` share
-    /// one exponent, `i32` components renormalised after each step to at most
-    /// 2^[`STATE_BITS`], `i64` products. With `q = h² D / m`, a spring adds
-    /// `κ (x_b − x_a)·d` along `d` and `χ (V_b − V_a)` to its end's velocity change per
-    /// step (`κ = q k`, `χ = q C / h`; the node damping and the coupling likewise), so
-    /// that `V' = V + ΔV` and `X' = X + (V + V')/2` (`X + V'` symplectic) need no other
-    /// product. Infinite (unstable) where a coefficient reaches [`COEFF_LIMIT`] (a
-    /// one-mode step is stable only while `h²ω²D < 4` and `h γ D < 2`, and each
-    /// coefficient is at most one of those) or a step grows a component past
+    /// displacements `X` (in half units) and the velocities as displacements per step
+    /// `V = 2^g v h` share one exponent, `i32` components renormalised after each step to
+    /// below 2^[`STATE_BITS`], every product the rounded high word of a long multiply.
+    /// With `q = h² D / m`, a spring adds `κ ((X_b − X_a)·d) d` and `χ (V_b − V_a)` to its
+    /// end's velocity change per step (`κ = 2^g q k / 2`, `χ = q C / h`; the node damping
+    /// and the coupling likewise), so that `V' = V + ΔV` and `X' = X + (V + V') / 2^g`
+    /// (`X + 2 V' / 2^g` symplectic, rounded) need no other product. Infinite (unstable)
+    /// where a coefficient reaches [`COEFF_LIMIT`] or a node's sum of them [`ROW_LIMIT`]
+    /// (a one-mode step is stable only while `h²ω²D < 4` and `h γ D < 2`, and each
+    /// coefficient is at most one of those), or where a step grows a component past
     /// [`STATE_LIMIT`].
     fn growth(&self, h: f64) -> f32 {
         let n = self.topo.node_count().min(NODES);
