@@ -167,7 +167,14 @@ wait_host_tests() {
 
 run_stage fmt cargo fmt --all -- --check
 run_stage clippy-host cargo clippy --workspace --all-targets -- -D warnings
-run_stage host-build cargo test --workspace --no-run && start_host_tests
+# The host build: the tests, then the log decoder (a bin without tests, which the test
+# build leaves out; the demo stages need it, and built here, before the host tests start
+# in the background, it has both cores).
+host_build() {
+  cargo test --workspace --no-run && cargo build -p defmt-log
+}
+
+run_stage host-build host_build && start_host_tests
 run_stage clippy-thumb clippy_thumb
 run_stage firmware-builds firmware_builds
 run_stage demo-m4f-in-a-terminal demo_in_a_terminal
