@@ -18,6 +18,7 @@
 //!
 //! `PROPTEST_CASES` scales both (the long run of `docs/reliability.md`: `scripts/long.sh`).
 
+use crate::common::{cases, run_cases};
 use mccs::arith::Arith;
 use mccs::units::{DIR_FRAC, INV_LEN_FRAC};
 use mccs::{
@@ -267,41 +268,6 @@ fn drive<A: Arith, C: Contact<10, 61, 64, A>>(
         .force_of_max
         .max(peak.to_num::<f64>() / case.config.coupling.max_force);
     Ok(())
-}
-
-/// The number of cases: `PROPTEST_CASES` times `scale`, or `default`.
-fn cases(default: u32, scale: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse::<u32>().ok())
-        .map_or(default, |c| c.saturating_mul(scale))
-}
-
-/// Runs `property` on `cases` accepted inputs of `strategy` (rejections regenerate).
-fn run_cases<S: Strategy>(
-    cases: u32,
-    strategy: S,
-    property: impl Fn(S::Value) -> Result<(), TestCaseError>,
-) where
-    S::Value: std::fmt::Debug,
-{
-    // A fixed seed (so that the figures these runs print are the same every time), or
-    // PROPTEST_RNG_SEED's.
-    let seed = std::env::var("PROPTEST_RNG_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(2026);
-    let config = ProptestConfig {
-        cases,
-        max_global_rejects: cases.saturating_mul(20),
-        failure_persistence: None,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
-        ..ProptestConfig::default()
-    };
-    let mut runner = proptest::test_runner::TestRunner::new(config);
-    if let Err(e) = runner.run(&strategy, property) {
-        panic!("{e}");
-    }
 }
 
 /// What the short runs saw.

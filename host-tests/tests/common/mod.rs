@@ -74,3 +74,41 @@ pub fn spring_coeffs<A: mccs::Arith>() -> A::Coeffs {
         damping_factor: 1.0,
     })
 }
+
+/// The seed of [`run_cases`]: fixed, 2026 (so that the figures these runs print are the
+/// same every time), or `PROPTEST_RNG_SEED`'s.
+pub fn seed() -> u64 {
+    std::env::var("PROPTEST_RNG_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2026)
+}
+
+/// The number of cases: `PROPTEST_CASES` times `scale`, or `default`.
+pub fn cases(default: u32, scale: u32) -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+        .map_or(default, |c| c.saturating_mul(scale))
+}
+
+/// Runs `property` on `cases` accepted inputs of `strategy` (rejections regenerate).
+pub fn run_cases<S: Strategy>(
+    cases: u32,
+    strategy: S,
+    property: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) where
+    S::Value: std::fmt::Debug,
+{
+    let config = ProptestConfig {
+        cases,
+        max_global_rejects: cases.saturating_mul(20),
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed()),
+        ..ProptestConfig::default()
+    };
+    let mut runner = proptest::test_runner::TestRunner::new(config);
+    if let Err(e) = runner.run(&strategy, property) {
+        panic!("{e}");
+    }
+}

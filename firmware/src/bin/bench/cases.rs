@@ -272,6 +272,27 @@ fn float_substep<T: Real, const N: usize, const E: usize>(
     p.substep(probe)
 }
 
+/// This core's demo patch (`spec`'s grid at the demo's spacing); exits with failure if it
+/// cannot be built.
+fn demo_topology<const N: usize, const E: usize>(spec: &DemoSpec) -> Topology<N, E> {
+    match Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) {
+        Ok(topo) => topo,
+        Err(_) => exit(false),
+    }
+}
+
+/// A solver of `table` on this core's demo patch with `spec`'s configuration; exits with
+/// failure if it cannot be built.
+fn demo_solver<const N: usize, const E: usize>(
+    spec: &DemoSpec,
+    table: &ForceTable64,
+) -> Solver<N, E, 64> {
+    match Solver::new(demo_topology(spec), *table, &spec.config()) {
+        Ok(s) => s,
+        Err(_) => exit(false),
+    }
+}
+
 /// The solver's start-up for this core's demo configuration (`Solver::new`: the patch's
 /// coefficients and its stability bound, whose estimate runs the linearised step about
 /// ten times 1,536 steps, in block fixed point), once, in instructions.
@@ -287,9 +308,7 @@ pub fn startup(h: &Harness, table: &ForceTable64) -> u64 {
 #[inline(never)]
 fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u64 {
     let spec = demo::spec_for(CORE);
-    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, 2.5) else {
-        exit(false)
-    };
+    let topo = demo_topology::<N, E>(&spec);
     let mut ok = false;
     let n = h.measure_long(|| {
         ok = black_box(Solver::new(black_box(topo), *table, &spec.config())).is_ok();
@@ -317,12 +336,7 @@ fn tick_in<const N: usize, const E: usize>(
     probe: [Length; 3],
 ) -> u32 {
     let spec = demo::spec_for(CORE);
-    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, 2.5) else {
-        exit(false)
-    };
-    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
-        exit(false)
-    };
+    let mut s = demo_solver::<N, E>(&spec, table);
     for _ in 0..200 {
         e::tick(&mut s, probe);
     }
@@ -346,12 +360,7 @@ pub fn tick_proxy(h: &Harness, table: &ForceTable64) -> u32 {
 #[inline(never)]
 fn tick_proxy_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u32 {
     let spec = demo::spec_for(CORE);
-    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, 2.5) else {
-        exit(false)
-    };
-    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
-        exit(false)
-    };
+    let mut s = demo_solver::<N, E>(&spec, table);
     let cfg = ProxyConfig {
         grid: spec.grid,
         spacing: 2.5,
@@ -435,12 +444,7 @@ fn roaming_in<const N: usize, const E: usize, const CAP: bool>(
     empty: u32,
     spec: &DemoSpec,
 ) -> RoamingTicks {
-    let Ok(topo) = Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) else {
-        exit(false)
-    };
-    let Ok(mut s) = Solver::new(topo, *table, &spec.config()) else {
-        exit(false)
-    };
+    let mut s = demo_solver::<N, E>(spec, table);
     let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
     let Ok(mut proxy) = s.proxy(&spec.proxy_config()) else {
         exit(false)
