@@ -89,8 +89,9 @@ budget_test() {
     echo "the bench firmware passed an impossible budget"
     return 1
   fi
-  grep "result=OVER" target/qemu/budget-test.log || return 1
-  cargo build --release -p mccs-firmware --target "$t" --bin bench
+  grep "result=OVER" target/qemu/budget-test.log
+  # (No rebuild without the feature: nothing after this stage runs the bench, and
+  # scripts/bench.sh builds its own; cargo sees the features changed.)
 }
 
 # A bench run that stops before its budget check fails the bench, whatever QEMU's exit

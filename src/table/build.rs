@@ -75,9 +75,10 @@ impl<const S: usize> ForceTable<S> {
     /// 12 more, the uniform grid below it; then 1, a *lower* corner under the grid), then
     /// toward the law's first kink from above, under the grid (up to 21 more), the first
     /// within the bound kept; the last two only where the output formats could meet the
-    /// bound ([`format_floor`]). Up to 89 builds and measurements (5 for a spring the
-    /// uniform grid serves): what `mccs table` and [`ForceTable::with_bound`] do, not for
-    /// a device's start-up.
+    /// bound ([`format_floor`]). Up to 153 builds and measurements (5 for a spring the
+    /// uniform grid serves; the corner toward the solid point tries up to 26 lengths
+    /// under each of four placements, 16 of them putting a knot on a preload's kink):
+    /// what `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
