@@ -488,6 +488,9 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
     // header says that the corner lies under the grid.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let steep = std::fs::read_to_string(format!("{root}/params/steep-kink.toml")).unwrap();
+    // A stiff series spring whose solid point lies 8e-5 strain short of the domain's end
+    // (spring 43,342 of table_bound.rs's long draw): its corner has twelve octaves.
+    let deep = "[cone]\nwire_diameter = 0.08841261262983599\nsmall_diameter = 0.8856937931006725\nlarge_diameter = 2.1354017962062777\nactive_coils = 1.7330631953425195\ncompressible_height = 0.9491764266538272\nshear_modulus = 75368.21771890546\n\n[linear]\nwire_diameter = 0.021732733900039335\nmean_diameter = 0.2840336966862483\nactive_coils = 3.353250298619566\nshear_modulus = 1566611236.3573682\n";
     for (name, params, layout) in [
         (
             "stiff-series.toml",
@@ -498,6 +501,14 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             "near-solid.toml",
             near_solid,
             &["then 32 graded toward the domain's end"],
+        ),
+        (
+            "deep-corner.toml",
+            deep,
+            &[
+                "// Layout: 80 segments uniform over [",
+                "then 48 graded toward the solid point",
+            ],
         ),
         (
             "steep-kink.toml",
@@ -567,19 +578,11 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             ],
         );
         let err = String::from_utf8_lossy(&out.stderr);
-        let to = err
-            .split("meets it: --to ")
-            .nth(1)
-            .and_then(|r| r.split(' ').next())
-            .unwrap();
+        let to = word_after(&err, "meets it: --to ");
         let measured = err.split("(measured: ").nth(1).unwrap();
         let measured = measured.split(") or --from").next().unwrap();
         assert!(to.parse::<f64>().unwrap() < 0.95, "{err}");
-        let from = err
-            .split(" or --from ")
-            .nth(1)
-            .and_then(|r| r.split(' ').next())
-            .unwrap();
+        let from = word_after(&err, " or --from ");
         assert!(from.parse::<f64>().unwrap() > -0.5, "{err}");
         let ok = mccs(&["table", "--params", path, "--knots", knots, "--from", from]);
         assert!(
@@ -680,6 +683,43 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("misses the accuracy bound"));
 }
 
+/// The word after `marker` in `text` (an option's value in a refusal's advice).
+fn word_after<'a>(text: &'a str, marker: &str) -> &'a str {
+    text.split(marker)
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap_or_else(|| panic!("no {marker:?} in {text}"))
+}
+
+/// A large spring (spring 3,375 of table_bound.rs's long draw: 808 N at `F(0.95)`) whose
+/// tension line leaves the force format, ±2048 N, inside the default domain (−2066 N at
+/// −0.5): the table saturates there, and the refusal names the narrower domain that
+/// meets the bound, whose command builds it.
+#[test]
+fn a_large_springs_refusal_names_a_narrower_domain() {
+    let big = "[cone]\nwire_diameter = 0.17501070207013303\nsmall_diameter = 0.09615100550108081\nlarge_diameter = 0.19637874923178744\nactive_coils = 2.778251175114531\ncompressible_height = 0.3673528334865556\nshear_modulus = 342260.1536697008\n\n[linear]\nwire_diameter = 0.1110636377590376\nmean_diameter = 0.16621659605281017\nactive_coils = 10.998570469449042\nshear_modulus = 376093.43190201226\n";
+    let f = temp_file("big.toml", big);
+    let path = f.to_str().unwrap();
+    let out = mccs(&["table", "--params", path, "--knots", "129"]);
+    assert_one_line_error(
+        &out,
+        &[
+            "big.toml",
+            "the 129-knot table misses the bound",
+            "a narrower domain meets it: --from ",
+            "--accept-error",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let from = word_after(&err, "meets it: --from ");
+    assert!(from.parse::<f64>().unwrap() > -0.5, "{err}");
+    let ok = mccs(&["table", "--params", path, "--knots", "129", "--from", from]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+}
 #[test]
 fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
     let dir = std::env::temp_dir().join(format!("mccs-fit-{}", std::process::id()));

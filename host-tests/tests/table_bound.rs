@@ -170,7 +170,7 @@ fn independent_dense<const S: usize>(p: &Params, t: &ForceTable<S>, dense: usize
     let uniform = (0..=SWEEP).map(|i| DOMAIN.0 + (DOMAIN.1 - DOMAIN.0) * i as f64 / SWEEP as f64);
     // The graded corner's segments, 37 points in each (other strains than the builder's
     // 64).
-    let graded = t.corner().map_or(0, |_| mccs::table::CORNER_SEGMENTS);
+    let graded = t.corner_segments();
     let per = 37 * dense;
     let graded = (0..graded * per).map(move |i| {
         let (a, b) = t.corner_segment_range(i / per);
@@ -262,7 +262,20 @@ struct Tally {
     /// Met although the bound is below what the output formats resolve: by the luck of
     /// rounding.
     met_format_limited: usize,
+    /// Refused, the formats resolving the bound, where the law leaves the force format's
+    /// range inside the domain (see [`range_limited`]).
+    range_limited: usize,
     other: usize,
+}
+
+/// Whether the law leaves the force format's range, ±2048 N (`mccs::Force`), inside the
+/// domain: a large spring's tension line (`F(−0.5)` beyond −2048 N where `F(0.95)` is
+/// some 500 N or more). The table saturates there; `mccs table` names the narrower
+/// domain that meets the bound (`a_large_springs_refusal_names_a_narrower_domain`).
+fn range_limited(p: &Params) -> bool {
+    let r = Reference::new(p).unwrap();
+    let max = mccs::Force::MAX.to_num::<f64>();
+    r.force(DOMAIN.0).abs() > max || r.force(DOMAIN.1).abs() > max
 }
 
 /// Whether the bound is below what the output formats resolve: one Q20 force LSB
@@ -520,7 +533,9 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
                 d.refused += 1;
                 d.over_force += usize::from(reported.force > bound.force);
                 d.over_stiffness += usize::from(reported.stiffness > bound.stiffness);
-                d.format_limited += usize::from(format_limited(&p, &bound));
+                let resolution = format_limited(&p, &bound);
+                d.format_limited += usize::from(resolution);
+                d.range_limited += usize::from(!resolution && range_limited(&p));
             }
             Err(TableError::NoNonlinearPhase | TableError::OutOfRange | TableError::TooNarrow) => {
                 d.other += 1;
@@ -546,6 +561,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         );
         all.format_limited += d.format_limited;
         all.met_format_limited += d.met_format_limited;
+        all.range_limited += d.range_limited;
         all.over_force += d.over_force;
         all.over_stiffness += d.over_stiffness;
         all.springs += d.springs;
@@ -553,8 +569,10 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         all.refused += d.refused;
         all.other += d.other;
     }
+    // Refused for where the knots are: neither the formats' resolution nor their range.
+    let placement = all.refused - all.format_limited - all.range_limited;
     println!(
-        "TABLEBOUND kp_k=all springs={} met={} refused={} refused_pct={:.1} over_force={} over_stiffness={} format_limited={} met_format_limited={} placement_limited={} placement_pct={:.1} other={} worst_met_force={:.1e} worst_met_stiffness={:.1e}",
+        "TABLEBOUND kp_k=all springs={} met={} refused={} refused_pct={:.1} over_force={} over_stiffness={} format_limited={} met_format_limited={} range_limited={} placement_limited={} placement_pct={:.1} other={} worst_met_force={:.1e} worst_met_stiffness={:.1e}",
         all.springs,
         all.met,
         all.refused,
@@ -563,8 +581,9 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
         all.over_stiffness,
         all.format_limited,
         all.met_format_limited,
-        all.refused - all.format_limited,
-        100.0 * (all.refused - all.format_limited) as f64 / all.springs as f64,
+        all.range_limited,
+        placement,
+        100.0 * placement as f64 / all.springs as f64,
         all.other,
         worst_met.force,
         worst_met.stiffness
@@ -1016,6 +1035,7 @@ fn named_springs_report_their_bound() {
         let t65 = ForceTable::<64>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
         let t129 = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
         let graded = (t65.corner().is_some(), t129.corner().is_some());
+        let segments = (t65.corner_segments(), t129.corner_segments());
         assert_eq!(
             ForceTable::<128>::new(&p).unwrap().max_error(),
             None,
@@ -1028,10 +1048,9 @@ fn named_springs_report_their_bound() {
         // the bound is claimed with one, 16 times as many points confirm it too.
         let dense = graded.1.then(|| independent_dense(&p, &t129, 16));
         let (t65, t129) = (t65.max_error().unwrap(), t129.max_error().unwrap());
-        let segments = |g: bool| if g { mccs::table::CORNER_SEGMENTS } else { 0 };
         println!(
             "TABLEBOUND case={name} force_65={:.1e} stiffness_65={:.1e} force_129={:.1e} stiffness_129={:.1e} graded_65={} graded_129={}",
-            t65.force, t65.stiffness, t129.force, t129.stiffness, segments(graded.0), segments(graded.1)
+            t65.force, t65.stiffness, t129.force, t129.stiffness, segments.0, segments.1
         );
         assert!(
             m.force <= 1.1 * t129.force + 1e-9 && m.stiffness <= 1.1 * t129.stiffness + 1e-9,
@@ -1410,5 +1429,82 @@ fn a_stiff_series_corner_between_the_usual_lengths() {
         let (_, b) = t.corner().expect("a graded corner");
         assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
         holds_on_the_reference(&format!("SOLIDCORNER case=spring{i}"), &p, &t);
+    }
+}
+
+/// Stiff series springs whose solid point lies at or just short of the domain's end
+/// (`Δ(F_C)` 0.94992 and 0.94875; `k_p/k` 6.9e3 and 2.2e3): two of the 35 springs of the
+/// long run's 10⁵ refused for where their knots are on 2026-11-27, at 1.7e-3 to 4.9e-3 in
+/// stiffness and up to 1.5e-4 in force. The law rises into the solid point faster than
+/// the nearest octave of an eight-octave corner (1/256 of its length) follows; 65 knots
+/// have no room for more. At 129 knots `from_law_best` tries, last, the corner toward
+/// the solid point of twelve octaves (its nearest 1/4096 of its length), and both meet
+/// the bound on the independent reference, also on a sweep 16 times as dense; the
+/// 65-knot tables stay refused.
+#[test]
+fn a_twelve_octave_corner_into_a_solid_point_at_the_domains_end() {
+    let springs = [
+        (
+            43342,
+            [
+                0.08841261262983599,
+                0.8856937931006725,
+                2.1354017962062777,
+                1.7330631953425195,
+                0.9491764266538272,
+                75368.21771890546,
+            ],
+            [
+                0.021732733900039335,
+                0.2840336966862483,
+                3.353250298619566,
+                1566611236.3573682,
+                0.0,
+            ],
+        ),
+        (
+            5745,
+            [
+                0.03832370387882633,
+                0.26886037535686025,
+                0.33521991847344074,
+                1.9654717888570803,
+                0.9484861781855722,
+                133036.47879638162,
+            ],
+            [
+                0.09326697897431227,
+                0.5180012350989908,
+                19.425297942108926,
+                402640382.7092041,
+                0.5158896248283963,
+            ],
+        ),
+    ];
+    for (i, cone, linear) in springs {
+        let mut p = spring_of(cone, linear);
+        // (Spring 43,342 has no preload.)
+        if p.linear.preload == Some(0.0) {
+            p.linear.preload = None;
+        }
+        let r = Reference::new(&p).unwrap();
+        assert!(
+            r.strain_c() > 0.948 && r.strain_c() < DOMAIN.1,
+            "{}",
+            r.strain_c()
+        );
+        let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+            .expect("within the bound");
+        let (_, b) = t.corner().expect("a graded corner");
+        assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
+        assert_eq!(t.corner_octaves(), mccs::table::CORNER_OCTAVES_MAX);
+        assert_eq!(t.corner_segments(), 48);
+        holds_on_the_reference(&format!("DEEPCORNER case=spring{i}"), &p, &t);
+        let dense = independent_dense(&p, &t, 16);
+        assert!(dense.within(&TableBound::PRODUCT), "{dense:?}");
+        assert!(matches!(
+            ForceTable::<64>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT),
+            Err(TableError::BoundNotMet { .. })
+        ));
     }
 }

@@ -18,7 +18,7 @@
 //!
 //! `f64` and a loop over the segments: start-up or host, never per tick.
 
-use super::{ForceTable, CORNER_SEGMENTS};
+use super::ForceTable;
 use crate::law::Law;
 use crate::units::{Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
@@ -169,7 +169,7 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
         }
     }
     if table.corner().is_some() {
-        for i in 0..CORNER_SEGMENTS {
+        for i in 0..table.corner_segments() {
             let (a, b) = table.corner_segment_range(i);
             for j in 0..=n {
                 at(a + (b - a) * j as f64 / n as f64);

@@ -5,8 +5,8 @@
 
 use super::{
     corner_pre_signed, corner_strain, fine_line, format_floor, knot_bias, measure, slope_frac,
-    ForceTable, RawTable, TableBound, TableError, CORNER_OCTAVES, CORNER_PER_OCTAVE,
-    CORNER_SEGMENTS, DEFAULT_DOMAIN, FINE_SLOPE_FRAC, UNMEASURED,
+    ForceTable, RawTable, TableBound, TableError, CORNER_OCTAVES, CORNER_OCTAVES_MAX,
+    CORNER_PER_OCTAVE, CORNER_SEGMENTS, DEFAULT_DOMAIN, FINE_SLOPE_FRAC, UNMEASURED,
 };
 use crate::law::Law;
 use crate::params::Params;
@@ -73,12 +73,14 @@ impl<const S: usize> ForceTable<S> {
     /// the formats could meet the bound), then above a
     /// preload's kink near `F_C` (up to 10 more), then toward that kink from below (up to
     /// 12 more, the uniform grid below it; then 1, a *lower* corner under the grid), then
-    /// toward the law's first kink from above, under the grid (up to 21 more), the first
-    /// within the bound kept; the last two only where the output formats could meet the
-    /// bound ([`format_floor`]). Up to 153 builds and measurements (5 for a spring the
-    /// uniform grid serves; the corner toward the solid point tries up to 26 lengths
-    /// under each of four placements, 16 of them putting a knot on a preload's kink):
-    /// what `mccs table` and [`ForceTable::with_bound`] do, not for a device's start-up.
+    /// toward the law's first kink from above, under the grid (up to 21 more), then, at
+    /// 129 knots, toward the solid point again with [`CORNER_OCTAVES_MAX`] octaves (up to
+    /// 136 more), the first within the bound kept; the last three only where the output
+    /// formats could meet the bound ([`format_floor`]). Up to 289 builds and measurements
+    /// (5 for a spring the uniform grid serves; the corner toward the solid point tries
+    /// up to 26 lengths under each of four placements, 16 of them putting a knot on a
+    /// preload's kink, 34 and 24 with twelve octaves): what `mccs table` and
+    /// [`ForceTable::with_bound`] do, not for a device's start-up.
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
@@ -98,9 +100,9 @@ impl<const S: usize> ForceTable<S> {
             // The placement from the domain's start is its own instance of the builder,
             // so that a device's (`from_law`, which never takes it) carries no code for it.
             let built = if align == Align::FromDomain {
-                Self::on_grid::<true, false>(law, from, to, align, 0.0, CornerEnd::Solid)
+                Self::on_grid::<true, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0)
             } else {
-                Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid)
+                Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0)
             };
             match built {
                 Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
@@ -118,47 +120,11 @@ impl<const S: usize> ForceTable<S> {
         // fraction of the curved part, under each placement of the uniform grid below it.
         let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
         let e_c = law.strain_c();
-        // The solid point may lie a little past the domain's end: the rise toward it is
-        // then inside the domain.
         let lo = libm::fmax(law.strain_t(), from);
+        // (The solid point inside the domain or a little past its end: `solid_corner`.)
         let solid_near = e_c <= to + 0.5 * (to - lo);
-        if missed && S >= 2 * CORNER_SEGMENTS && solid_near {
-            let curved = e_c - lo;
-            // (The lengths between, only where the formats could meet the bound.)
-            let more = if format_floor(law, from, to).within(&TableBound::PRODUCT) {
-                &MORE_CORNER_FRACTIONS[..]
-            } else {
-                &[]
-            };
-            // A preload's kink Δ(P) inside such a corner needs a knot on it (a cubic
-            // across a kink misses by the slope's jump times a fraction of the segment):
-            // after the usual lengths, those that put a corner knot on Δ(P).
-            let e_p = law.delta(law.preload);
-            let kinked = law.preload > law.f_t && e_p > lo && e_p < e_c;
-            // (Each octave's outer end and midpoint.)
-            let on_kink = (0..CORNER_OCTAVES as u32)
-                .flat_map(|z| [(z, 0), (z, 2)])
-                .filter_map(|knot| {
-                    let len = kink_on_knot(e_c - e_p, knot)?;
-                    (kinked && len < curved).then_some(len)
-                });
-            'graded: for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
-                let lens = CORNER_FRACTIONS.iter().chain(more).map(|f| f * curved);
-                for len in lens.chain(on_kink.clone()) {
-                    let built = if align == Align::FromDomain {
-                        Self::on_grid::<true, true>(law, from, to, align, len, CornerEnd::Solid)
-                    } else {
-                        Self::on_grid::<false, true>(law, from, to, align, len, CornerEnd::Solid)
-                    };
-                    // The first within the bound is kept (each try is a build and a
-                    // measurement).
-                    if let Ok(t) = built {
-                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
-                            break 'graded;
-                        }
-                    }
-                }
-            }
+        if missed {
+            Self::solid_corner(law, (from, to), CORNER_OCTAVES, &mut best);
         }
         // Still missed, with a preload's slope kink Δ(P) inside the domain (a preload near
         // F_C: below Δ(P) the cone rises steeply toward its own solid point, which the
@@ -177,7 +143,9 @@ impl<const S: usize> ForceTable<S> {
             'above_kink: for align in [Align::Shortest, Align::Off] {
                 for margin in ABOVE_KINK_MARGINS {
                     let len = (e_end - e_p) * (1.0 - margin);
-                    if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+                    if let Ok(t) =
+                        Self::on_grid::<false, true>(law, from, to, align, len, end, CORNER_OCTAVES)
+                    {
                         if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                             break 'above_kink;
                         }
@@ -194,7 +162,9 @@ impl<const S: usize> ForceTable<S> {
                 for fraction in CORNER_FRACTIONS {
                     let len = fraction * (e_p - lo);
                     let end = CornerEnd::Kink;
-                    if let Ok(t) = Self::on_grid::<false, true>(law, from, to, align, len, end) {
+                    if let Ok(t) =
+                        Self::on_grid::<false, true>(law, from, to, align, len, end, CORNER_OCTAVES)
+                    {
                         if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                             break 'to_kink;
                         }
@@ -214,7 +184,9 @@ impl<const S: usize> ForceTable<S> {
             // (One build: the grid's place is the corner's end, whatever the alignment.)
             let len = (e_p - lo) * LOWER_CORNER_REACH;
             let end = CornerEnd::Lower;
-            if let Ok(t) = Self::on_grid::<false, true>(law, from, to, Align::Off, len, end) {
+            if let Ok(t) =
+                Self::on_grid::<false, true>(law, from, to, Align::Off, len, end, CORNER_OCTAVES)
+            {
                 Self::keep_best(t, law, (from, to), &mut best);
             }
         }
@@ -231,23 +203,104 @@ impl<const S: usize> ForceTable<S> {
             let on_transition = (0..CORNER_OCTAVES as u32)
                 .flat_map(|z| [(z, 0), (z, 2)])
                 .filter_map(|knot| {
-                    let len = kink_on_knot(e_ft - e_first, knot)?;
+                    let len = kink_on_knot(e_ft - e_first, knot, CORNER_OCTAVES)?;
                     (law.preload < law.f_t && e_ft > e_first && len < curved).then_some(len)
                 });
             let lens = ONSET_FRACTIONS.map(|f| f * curved);
             for len in lens.into_iter().chain(on_transition) {
                 let end = CornerEnd::Onset;
-                if let Ok(t) = Self::on_grid::<false, true>(law, from, to, Align::Off, len, end) {
+                if let Ok(t) = Self::on_grid::<false, true>(
+                    law,
+                    from,
+                    to,
+                    Align::Off,
+                    len,
+                    end,
+                    CORNER_OCTAVES,
+                ) {
                     if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
                         break;
                     }
                 }
             }
         }
+        // Still missed, where the formats could meet the bound: the corner toward the
+        // solid point again with more octaves, its nearest 1/4096 of its length instead
+        // of 1/256 (a stiff series spring whose solid point lies at or just short of the
+        // domain's end rises into it faster than the nearest octave of eight follows).
+        // Last, so that every spring another placement serves keeps its table.
+        let missed = missed && best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        if missed {
+            Self::solid_corner(law, (from, to), CORNER_OCTAVES_MAX, &mut best);
+        }
         // Without a table every placement failed (a duplicate implies one built).
         match (best, first_err) {
             (Some((_, t)), _) => Ok(t),
             (None, e) => Err(e.unwrap_or(TableError::OutOfRange)),
+        }
+    }
+
+    /// The graded corner toward the solid point (`CornerEnd::Solid`) of `octaves` under
+    /// each placement of the uniform grid below it: the usual lengths, the lengths
+    /// between them where the output formats could meet the bound, then those that put a
+    /// corner knot on a preload's kink inside it; the first within the bound kept in
+    /// `best`. Only where the solid point lies inside the domain or a little past its end
+    /// and the table has room (`2 · octaves` octaves of segments).
+    fn solid_corner(
+        law: &Law,
+        (from, to): (f64, f64),
+        octaves: usize,
+        best: &mut Option<(f64, Self)>,
+    ) {
+        let e_c = law.strain_c();
+        // The solid point may lie a little past the domain's end: the rise toward it is
+        // then inside the domain.
+        let lo = libm::fmax(law.strain_t(), from);
+        let solid_near = e_c <= to + 0.5 * (to - lo);
+        if S < 2 * octaves * CORNER_PER_OCTAVE || !solid_near {
+            return;
+        }
+        let curved = e_c - lo;
+        // (The lengths between, and the corner of more octaves, only where the formats
+        // could meet the bound.)
+        let reachable = format_floor(law, from, to).within(&TableBound::PRODUCT);
+        if octaves > CORNER_OCTAVES && !reachable {
+            return;
+        }
+        let more = if reachable {
+            &MORE_CORNER_FRACTIONS[..]
+        } else {
+            &[]
+        };
+        // A preload's kink Δ(P) inside such a corner needs a knot on it (a cubic
+        // across a kink misses by the slope's jump times a fraction of the segment):
+        // after the usual lengths, those that put a corner knot on Δ(P).
+        let e_p = law.delta(law.preload);
+        let kinked = law.preload > law.f_t && e_p > lo && e_p < e_c;
+        // (Each octave's outer end and midpoint.)
+        let on_kink = (0..octaves as u32)
+            .flat_map(|z| [(z, 0), (z, 2)])
+            .filter_map(|knot| {
+                let len = kink_on_knot(e_c - e_p, knot, octaves)?;
+                (kinked && len < curved).then_some(len)
+            });
+        for align in [Align::Shortest, Align::Off, Align::Plain, Align::FromDomain] {
+            let lens = CORNER_FRACTIONS.iter().chain(more).map(|f| f * curved);
+            for len in lens.chain(on_kink.clone()) {
+                let end = CornerEnd::Solid;
+                let built = if align == Align::FromDomain {
+                    Self::on_grid::<true, true>(law, from, to, align, len, end, octaves)
+                } else {
+                    Self::on_grid::<false, true>(law, from, to, align, len, end, octaves)
+                };
+                // The first within the bound is kept (each try is a build and a
+                // measurement).
+                if let Ok(t) = built {
+                    if Self::keep_best(t, law, (from, to), best) <= 1.0 {
+                        return;
+                    }
+                }
+            }
         }
     }
 
@@ -274,7 +327,7 @@ impl<const S: usize> ForceTable<S> {
         // the solid point, then the grid on Δ(P) alone.
         let mut built = Err(TableError::OutOfRange);
         for align in [Align::Shortest, Align::NearSolid, Align::Off] {
-            built = Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid);
+            built = Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0);
             if !matches!(built, Err(TableError::OutOfRange)) {
                 break;
             }
@@ -284,7 +337,7 @@ impl<const S: usize> ForceTable<S> {
 
     /// The table on the grid [`Grid::place`] puts over `[from, to]` (one copy of the
     /// builder in flash, however many placements are tried; `TENSION`: `align` is
-    /// [`Align::FromDomain`]). With `CORNER`, the last [`CORNER_SEGMENTS`] segments are a
+    /// [`Align::FromDomain`]). With `CORNER`, the last `4 · octaves` segments are a
     /// graded corner of `corner_len` strain ending at the solid point ([`Corner`]), and
     /// the uniform grid ends where it starts.
     #[inline(never)]
@@ -295,16 +348,18 @@ impl<const S: usize> ForceTable<S> {
         align: Align,
         corner_len: f64,
         corner_end: CornerEnd,
+        octaves: usize,
     ) -> Result<Self, TableError> {
+        let corner_segments = octaves * CORNER_PER_OCTAVE;
         let corner = if CORNER {
-            if S < 2 * CORNER_SEGMENTS {
+            if octaves == 0 || octaves > CORNER_OCTAVES_MAX || S < 2 * corner_segments {
                 return Err(TableError::TooNarrow);
             }
-            Some(Corner::place(law, to, corner_len, corner_end)?)
+            Some(Corner::place(law, to, corner_len, corner_end, octaves)?)
         } else {
             None
         };
-        let n = if CORNER { S - CORNER_SEGMENTS } else { S };
+        let n = if CORNER { S - corner_segments } else { S };
         // A lower corner ends where the grid starts, at its first knot; any other ends
         // above the grid.
         let lower = corner.filter(Corner::under_grid);
@@ -321,7 +376,8 @@ impl<const S: usize> ForceTable<S> {
             Some(c) => Some(c.segment_ends(law)?),
             None => None,
         };
-        let magnitude = corner_ends.as_ref().map_or((0.0, 0.0), magnitude);
+        let corner_ends = corner_ends.as_ref().map(|e| &e[..corner_segments]);
+        let magnitude = corner_ends.map_or((0.0, 0.0), magnitude);
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
@@ -334,7 +390,7 @@ impl<const S: usize> ForceTable<S> {
                 // The corner's lowest knot: (0, 4), or (7, 0) where it lies above its
                 // anchor.
                 let lowest = if c.above_anchor() {
-                    ends[CORNER_SEGMENTS - CORNER_PER_OCTAVE][0]
+                    ends[corner_segments - CORNER_PER_OCTAVE][0]
                 } else {
                     ends[CORNER_PER_OCTAVE - 1][1]
                 };
@@ -382,17 +438,18 @@ impl<const S: usize> ForceTable<S> {
             // strain (its coordinate at least 2²⁴ there) and starts below it.
             let pre = corner_pre_signed(c.pre) as i64;
             let d = |e: i32| (c.anchor as i64 - e as i64) * pre;
+            let inner = 1i64 << (32 - octaves);
             let fits = if c.above_anchor() {
-                d(grid.strain_lo) < 1 << 32 && d(c.lo + 1) >= 1 << 24 && c.lo < grid.strain_lo
+                d(grid.strain_lo) < 1 << 32 && d(c.lo + 1) >= inner && c.lo < grid.strain_lo
             } else if c.under_grid() {
-                d(grid.strain_lo) >= 1 << 24 && c.lo < grid.strain_lo
+                d(grid.strain_lo) >= inner && c.lo < grid.strain_lo
             } else {
                 d(grid.strain_hi) < 1 << 32 && grid.strain_hi < c.hi
             };
             if !fits {
                 return Err(TableError::TooNarrow);
             }
-            fill_corner(&ends, shift, &mut segs.coefficients[n..])?;
+            fill_corner(ends, shift, &mut segs.coefficients[n..])?;
             let (scale, post) = corner_scale(c.pre, shift)?;
             raw.corner_hi = if c.under_grid() { c.lo } else { c.hi };
             raw.corner_anchor = c.anchor;
@@ -406,7 +463,7 @@ impl<const S: usize> ForceTable<S> {
             let above = match c.end {
                 CornerEnd::Solid => Some(law.k_p),
                 CornerEnd::DomainEnd => {
-                    Some(1.0 / law.compliance(law.force(c.strain(CORNER_OCTAVES - 1, 0))))
+                    Some(1.0 / law.compliance(law.force(c.strain(octaves - 1, 0))))
                 }
                 CornerEnd::Kink => Some(1.0 / law.compliance_above(law.preload)),
                 CornerEnd::Lower | CornerEnd::Onset => None,
@@ -460,9 +517,9 @@ impl<const S: usize> ForceTable<S> {
     }
 }
 
-/// A graded corner: [`CORNER_SEGMENTS`] segments toward its end ([`CornerEnd`]: the
-/// solid point `Δ(F_C)`, or the domain's end), each octave of distance from it
-/// ([`CORNER_OCTAVES`] of them, the nearest `len/256` wide) cut into
+/// A graded corner: `4 · octaves` segments toward its end ([`CornerEnd`]: the solid
+/// point `Δ(F_C)`, or the domain's end), each octave of distance from it ([`CORNER_OCTAVES`]
+/// of them, the nearest `len/256` wide, or up to [`CORNER_OCTAVES_MAX`]) cut into
 /// [`CORNER_PER_OCTAVE`]: segments about a tenth of their distance from the corner, where
 /// a soft cone against a stiff series spring rises like a square root.
 #[derive(Clone, Copy)]
@@ -483,6 +540,9 @@ struct Corner {
     /// [`KINK_ON_KNOT_LSB`]), if one does: the segments on either side of it take the
     /// law's slope from their own side.
     kink: Option<(usize, usize)>,
+    /// Its octaves ([`CORNER_OCTAVES`] … [`CORNER_OCTAVES_MAX`]), the nearest
+    /// `2^−octaves` of its length.
+    octaves: usize,
 }
 
 /// Where a graded corner ends: its last knot, where the line above starts.
@@ -519,10 +579,18 @@ enum CornerEnd {
 impl Corner {
     /// The corner of `len` strain ending at `end`; it must start inside the domain (which
     /// may end before the solid point).
-    fn place(law: &Law, to: f64, len: f64, end: CornerEnd) -> Result<Self, TableError> {
+    fn place(
+        law: &Law,
+        to: f64,
+        len: f64,
+        end: CornerEnd,
+        octaves: usize,
+    ) -> Result<Self, TableError> {
         if end == CornerEnd::Onset {
-            return Self::above(law, to, len);
+            return Self::above(law, to, len, octaves);
         }
+        // The nearest octave's inner end, as a coordinate: 2^(32 − octaves).
+        let inner_bits = 32 - octaves as i32;
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
@@ -548,13 +616,13 @@ impl Corner {
             libm::round(pre)
         };
         // The nearest octave's inner end at least a strain LSB from the anchor.
-        if !(pre >= 1.0 && pre <= (1u64 << 24) as f64) {
+        if !(pre >= 1.0 && pre <= libm::ldexp(1.0, inner_bits)) {
             return Err(TableError::TooNarrow);
         }
-        let inner = libm::ldexp(1.0, 24) / pre;
+        let inner = libm::ldexp(1.0, inner_bits) / pre;
         let anchor =
             checked_from_f64(e_end + inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        // The last strain e with (A − e) · pre ≥ 2²⁴, plus one.
+        // The last strain e with (A − e) · pre ≥ 2^(32 − octaves), plus one.
         let hi = libm::floor(anchor as f64 - inner) + 1.0;
         let start = (anchor as f64 - libm::ldexp(1.0, 32) / pre + 2.0) / unit;
         // (Also when either is NaN.)
@@ -564,7 +632,7 @@ impl Corner {
         let pre = pre as u32;
         let kink = if law.preload > law.f_t {
             let e_p = law.delta(law.preload) * unit;
-            (0..CORNER_OCTAVES)
+            (0..octaves)
                 .flat_map(|z| (0..CORNER_PER_OCTAVE).map(move |jj| (z, jj)))
                 .find(|&(z, jj)| {
                     let e = corner_strain(anchor, pre, z, jj) * unit;
@@ -584,23 +652,26 @@ impl Corner {
             start,
             end,
             kink,
+            octaves,
         })
     }
 
     /// [`CornerEnd::Onset`]: `len` of strain above the law's first kink, graded toward it
     /// from above: the anchor `A` lies the nearest octave's inner end below the kink,
-    /// and a strain `e` in the corner has `d = (e − A) · |pre|` in `[2²⁴, 2³²)`.
-    fn above(law: &Law, to: f64, len: f64) -> Result<Self, TableError> {
+    /// and a strain `e` in the corner has `d = (e − A) · |pre|` in
+    /// `[2^(32 − octaves), 2³²)`.
+    fn above(law: &Law, to: f64, len: f64, octaves: usize) -> Result<Self, TableError> {
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let e_kink = law.strain_t();
+        let inner_bits = 32 - octaves as i32;
         let p = libm::round(libm::ldexp(1.0, 32) / (len * unit));
-        if !(p >= 1.0 && p <= (1u64 << 24) as f64) {
+        if !(p >= 1.0 && p <= libm::ldexp(1.0, inner_bits)) {
             return Err(TableError::TooNarrow);
         }
-        let inner = libm::ldexp(1.0, 24) / p;
+        let inner = libm::ldexp(1.0, inner_bits) / p;
         let anchor =
             checked_from_f64(e_kink - inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        // The last strain with d < 2²⁴ (the line below's), and the last with d < 2³²
+        // The last strain with d < 2^(32 − octaves) (the line below's), and the last with d < 2³²
         // (the corner's own last, the grid's first knot).
         let lo = anchor as f64 + libm::ceil(inner) - 1.0;
         let top = anchor as f64 + libm::ceil(libm::ldexp(1.0, 32) / p) - 1.0;
@@ -614,9 +685,10 @@ impl Corner {
             lo: lo as i32,
             start: top / unit,
             end: CornerEnd::Onset,
-            // Its nearest knot (7, 0) on the kink: the segment above it takes the law's
-            // slope from above.
-            kink: Some((CORNER_OCTAVES - 1, 0)),
+            // Its nearest knot (octaves − 1, 0) on the kink: the segment above it takes
+            // the law's slope from above.
+            kink: Some((octaves - 1, 0)),
+            octaves,
         })
     }
 
@@ -641,7 +713,7 @@ impl Corner {
     /// slope from below; at a preload's kink (the last knot of [`CornerEnd::Kink`]) `P`
     /// and the slope from below.
     fn knot(&self, law: &Law, z: usize, jj: usize) -> Result<(f64, f64), TableError> {
-        let last = z == CORNER_OCTAVES - 1 && jj == 0;
+        let last = z == self.octaves - 1 && jj == 0;
         let f = match self.end {
             CornerEnd::Solid if last => law.f_c,
             CornerEnd::Kink | CornerEnd::Lower if last => law.preload,
@@ -660,9 +732,10 @@ impl Corner {
     /// `(a0, a1)` and slopes per `τ` `(m0, m1)` in Q20 N units, `τ` running from `(z, j)`
     /// down in strain to `(z, j + 1)` (up, where the corner lies above its anchor). Each
     /// knot from the law once (`(z, 4)` is the next octave's start, `(z − 1, 0)`).
-    fn segment_ends(&self, law: &Law) -> Result<[[f64; 4]; CORNER_SEGMENTS], TableError> {
-        let mut knots = [[(0.0, 0.0); CORNER_PER_OCTAVE + 1]; CORNER_OCTAVES];
-        for z in 0..CORNER_OCTAVES {
+    /// The first `4 · octaves` are the corner's; the rest zeros.
+    fn segment_ends(&self, law: &Law) -> Result<[[f64; 4]; CORNER_SEGMENTS_MAX], TableError> {
+        let mut knots = [[(0.0, 0.0); CORNER_PER_OCTAVE + 1]; CORNER_OCTAVES_MAX];
+        for z in 0..self.octaves {
             for jj in 0..CORNER_PER_OCTAVE {
                 knots[z][jj] = self.knot(law, z, jj)?;
             }
@@ -694,6 +767,9 @@ impl Corner {
         };
         Ok(core::array::from_fn(|i| {
             let (z, j) = (i / CORNER_PER_OCTAVE, i % CORNER_PER_OCTAVE);
+            if z >= self.octaves {
+                return [0.0; 4];
+            }
             let ((a0, mut k0), (a1, mut k1)) = (knots[z][j], knots[z][j + 1]);
             if is_kink(z, j) {
                 k0 = below;
@@ -710,7 +786,7 @@ impl Corner {
 /// The corner's largest knot and `(|C1| + |C2| + |C3|) · 2^z` in Q20 N units, from its
 /// segments' ends (for the coefficients' shift: the stiffness in octave `z` takes
 /// `D << z`).
-fn magnitude(ends: &[[f64; 4]; CORNER_SEGMENTS]) -> (f64, f64) {
+fn magnitude(ends: &[[f64; 4]]) -> (f64, f64) {
     let (mut value, mut poly) = (0.0f64, 0.0f64);
     for (i, &[a0, a1, m0, m1]) in ends.iter().enumerate() {
         let c = hermite(a0, a1, m0, m1);
@@ -723,11 +799,7 @@ fn magnitude(ends: &[[f64; 4]; CORNER_SEGMENTS]) -> (f64, f64) {
 
 /// The corner's coefficients in the unit of `shift`, rounded as [`segments`] rounds
 /// them ([`rounded_cubic`], with octave `z`'s `2^z`).
-fn fill_corner(
-    ends: &[[f64; 4]; CORNER_SEGMENTS],
-    shift: u32,
-    out: &mut [[i32; 4]],
-) -> Result<(), TableError> {
+fn fill_corner(ends: &[[f64; 4]], shift: u32, out: &mut [[i32; 4]]) -> Result<(), TableError> {
     let scale = (1u64 << shift) as f64;
     for (i, (c, &[a0, a1, m0, m1])) in out.iter_mut().zip(ends).enumerate() {
         let (a0, a1) = (knot_units(a0, shift), knot_units(a1, shift));
@@ -769,6 +841,9 @@ fn with_post(mut v: f64) -> Result<(i32, i32), TableError> {
     Ok((libm::round(v) as i32, 1i32 << post))
 }
 
+/// Segments of a graded corner of [`CORNER_OCTAVES_MAX`].
+const CORNER_SEGMENTS_MAX: usize = CORNER_OCTAVES_MAX * CORNER_PER_OCTAVE;
+
 /// The graded corner's lengths [`ForceTable::from_law_best`] tries, as fractions of the
 /// law's curved part.
 const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
@@ -790,11 +865,12 @@ const KINK_ON_KNOT_LSB: f64 = 64.0;
 /// (rounded: the knot then lies within a few strain LSBs of the kink), and the length
 /// `2³²/pre` LSBs. `None` where `pre` is out of [`Corner::place`]'s range.
 /// [`ForceTable::from_law_best`] tries each octave's outer end and midpoint.
-fn kink_on_knot(below: f64, (z, jj): (u32, u32)) -> Option<f64> {
+fn kink_on_knot(below: f64, (z, jj): (u32, u32), octaves: usize) -> Option<f64> {
     let unit = (1u64 << STRAIN_FRAC) as f64;
+    let inner = libm::ldexp(1.0, 32 - octaves as i32);
     let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
-    let pre = libm::round((d - libm::ldexp(1.0, 24)) / (below * unit));
-    (pre >= 1.0 && pre <= libm::ldexp(1.0, 24)).then(|| libm::ldexp(1.0, 32) / (pre * unit))
+    let pre = libm::round((d - inner) / (below * unit));
+    (pre >= 1.0 && pre <= inner).then(|| libm::ldexp(1.0, 32) / (pre * unit))
 }
 
 /// The lengths of a corner above the law's first kink ([`CornerEnd::Onset`]) that

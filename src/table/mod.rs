@@ -23,6 +23,9 @@
 //! `Δ(F_C)`: [`CORNER_OCTAVES`] octaves of distance from it, [`CORNER_PER_OCTAVE`]
 //! segments each, indexed by the leading zeros of `d = (A − e) · pre`
 //! ([`RawTable::corner_anchor`]), the uniform grid below it ([`ForceTable::corner`]).
+//! Where every placement below missed too, a 129-knot table tries that corner again
+//! with [`CORNER_OCTAVES_MAX`] octaves (its nearest `1/4096` of its length: a solid point
+//! at the domain's end); the evaluation is the same ([`ForceTable::corner_octaves`]).
 //! Where still none does and a preload above `F_T` puts its slope kink `Δ(P)` inside the
 //! domain (near `F_C` the cone rises steeply below it toward its own solid point), the graded
 //! corner takes the smooth part above the kink instead, up to `Δ(F_C)` or, when that
@@ -94,11 +97,18 @@ mod error;
 pub use bound::{format_floor, measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
 pub use error::TableError;
 
-/// Octaves of the graded corner ([`RawTable::corner_anchor`]).
+/// Octaves of a graded corner ([`RawTable::corner_anchor`]), as the builder first tries
+/// it (every corner of a 65-knot table).
 pub const CORNER_OCTAVES: usize = 8;
+/// The most octaves a graded corner may have: the builder's last try toward the solid
+/// point, where [`CORNER_OCTAVES`] missed, on a table of at least
+/// `2 · CORNER_OCTAVES_MAX · CORNER_PER_OCTAVE` segments (129 knots); its nearest octave
+/// `1/4096` of its length. The evaluation is the same for any count: the octave is the
+/// coordinate's leading zeros ([`ForceTable::corner_octaves`]).
+pub const CORNER_OCTAVES_MAX: usize = 12;
 /// Segments in each octave of the graded corner (a power of two).
 pub const CORNER_PER_OCTAVE: usize = 4;
-/// Segments of the graded corner.
+/// Segments of a graded corner of [`CORNER_OCTAVES`].
 pub const CORNER_SEGMENTS: usize = CORNER_OCTAVES * CORNER_PER_OCTAVE;
 /// `log2(CORNER_PER_OCTAVE)`.
 const CORNER_BITS: u32 = CORNER_PER_OCTAVE.trailing_zeros();
@@ -175,8 +185,9 @@ pub struct RawTable<const S: usize> {
     pub corner_hi: i32,
     /// The graded corner's anchor `A` (Q24), just past its end: a strain `e` in it has
     /// the coordinate `d = (A − e) · corner_pre` (`u32`; `corner_pre` the negative of a
-    /// factor, as an `i32`, where the corner lies above its anchor) in `[2²⁴, 2³²)`,
-    /// octave `z = clz(d)` (0 … 7), [`CORNER_PER_OCTAVE`] segments in each.
+    /// factor, as an `i32`, where the corner lies above its anchor) in
+    /// `[2^(32 − octaves), 2³²)`, octave `z = clz(d)` (0 … octaves − 1, at most
+    /// [`CORNER_OCTAVES_MAX`]), [`CORNER_PER_OCTAVE`] segments in each.
     pub corner_anchor: i32,
     /// See `corner_anchor`.
     pub corner_pre: u32,
@@ -310,6 +321,24 @@ impl<const S: usize> ForceTable<S> {
         ))
     }
 
+    /// The graded corner's octaves: its segments are the table's last, from
+    /// `corner_base` on, [`CORNER_PER_OCTAVE`] in each ([`CORNER_OCTAVES`] as the builder
+    /// first places it, up to [`CORNER_OCTAVES_MAX`] where that missed). Meaningful only
+    /// for a table with a corner ([`ForceTable::corner`]).
+    pub fn corner_octaves(&self) -> usize {
+        S.saturating_sub(self.raw.corner_base as usize) / CORNER_PER_OCTAVE
+    }
+
+    /// The graded corner's segments: [`CORNER_PER_OCTAVE`] in each of its
+    /// [`ForceTable::corner_octaves`]; 0 without a corner.
+    pub fn corner_segments(&self) -> usize {
+        if self.corner_strains().is_some() {
+            self.corner_octaves() * CORNER_PER_OCTAVE
+        } else {
+            0
+        }
+    }
+
     /// The graded corner's first and last strains (Q24, `first ≤ last`), if it has one.
     fn corner_strains(&self) -> Option<(i64, i64)> {
         let r = &self.raw;
@@ -343,8 +372,9 @@ impl<const S: usize> ForceTable<S> {
         fits(r.slope_lo, r.stiffness_lo) && fits(r.slope_hi, r.stiffness_hi)
     }
 
-    /// Whether the graded corner's coordinate stays in `[2²⁴, 2³²)` over its range and
-    /// its segments are inside the table. `corner_pre` is signed (a corner graded toward
+    /// Whether the graded corner's coordinate stays in `[2^(32 − octaves), 2³²)` over its
+    /// range and its segments are the table's last ones, 1 to [`CORNER_OCTAVES_MAX`]
+    /// octaves of them ([`ForceTable::corner_octaves`]). `corner_pre` is signed (a corner graded toward
     /// its anchor from above has a negative one: the evaluation's `u32` product is the
     /// same), and the stiffness scale has the other sign.
     fn corner_fits(&self) -> bool {
@@ -355,10 +385,11 @@ impl<const S: usize> ForceTable<S> {
             return false;
         };
         let (d0, d1) = (d(first), d(last));
-        S >= CORNER_SEGMENTS
-            && r.corner_base as usize <= S - CORNER_SEGMENTS
+        let octaves = self.corner_octaves();
+        (1..=CORNER_OCTAVES_MAX).contains(&octaves)
+            && r.corner_base as usize + octaves * CORNER_PER_OCTAVE == S
             && d0.max(d1) < 1 << 32
-            && d0.min(d1) >= 1 << 24
+            && d0.min(d1) >= 1i64 << (32 - octaves)
             && r.corner_post > 0
             && (r.corner_post as u32).is_power_of_two()
             && ((pre > 0 && r.corner_scale <= 0) || (pre < 0 && r.corner_scale >= 0))
@@ -390,7 +421,7 @@ impl<const S: usize> ForceTable<S> {
             max = max.max(k.to_bits());
         }
         if let Some((first, last)) = self.corner_strains() {
-            for i in 0..CORNER_SEGMENTS {
+            for i in 0..self.corner_segments() {
                 let (a, b) = self.corner_segment_range(i);
                 for x in [a, (a + b) / 2.0, b] {
                     let e = libm::round(x * (1u64 << STRAIN_FRAC) as f64) as i64;
@@ -544,7 +575,7 @@ impl<const S: usize> ForceTable<S> {
         // (The header's fields after the cubic, as in the uniform part.)
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         let f = sum.wrapping_shr(r.shift);
-        // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 7 on a
+        // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 11 on a
         // valid table; the shift wraps at 32 on any other, without a panic). Floored, not
         // rounded as the uniform part's: a graded corner's stiffness (a stiff series
         // spring's) is thousands of LSBs, and rounding costs the M0 nine instructions.
@@ -615,7 +646,7 @@ pub(crate) fn corner_strain(anchor: i32, pre: u32, z: usize, jj: usize) -> f64 {
 }
 
 /// A corner's `pre` as the signed factor it is: a corner graded toward its anchor from
-/// below has one of 1 … 2²⁴, one graded toward it from above (its strains above the
+/// below has one of 1 … 2^(32 − octaves), one graded toward it from above (its strains above the
 /// anchor) the negative of one, as a `u32` (the evaluation's wrapping product
 /// `(A − e) · pre` is `(e − A) · |pre|` then).
 pub(crate) const fn corner_pre_signed(pre: u32) -> i32 {

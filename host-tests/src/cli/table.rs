@@ -415,7 +415,7 @@ pub fn render_table<const S: usize>(
                 None if points.is_empty() => "their end",
                 None => "the domain's end",
             };
-            let (used, graded) = (t.segments_used(), mccs::table::CORNER_SEGMENTS);
+            let (used, graded) = (t.segments_used(), t.corner_segments());
             s.push_str(&if t.lower_corner() {
                 format!(
                     "// Layout: {graded} segments graded toward {toward} over [{a}, {b}), then {used} uniform over [{b}, {hi}).\n"
