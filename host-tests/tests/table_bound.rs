@@ -472,7 +472,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
     }
     let mut said = std::time::Instant::now();
     for i in 0..n {
-        // Progress every 10 s (the long run's 10⁵ springs take about two hours).
+        // Progress every 10 s (the long run's 10⁵ springs take about 40 minutes).
         if said.elapsed().as_secs() >= 10 {
             eprintln!("table_bound: {i} of {n} springs");
             said = std::time::Instant::now();
