@@ -671,8 +671,8 @@ impl Corner {
         let inner = libm::ldexp(1.0, inner_bits) / p;
         let anchor =
             checked_from_f64(e_kink - inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
-        // The last strain with d < 2^(32 − octaves) (the line below's), and the last with d < 2³²
-        // (the corner's own last, the grid's first knot).
+        // The last strain with d < 2^(32 − octaves) (the line below's), and the last
+        // with d < 2³² (the corner's own last, the grid's first knot).
         let lo = anchor as f64 + libm::ceil(inner) - 1.0;
         let top = anchor as f64 + libm::ceil(libm::ldexp(1.0, 32) / p) - 1.0;
         if !(top / unit < to && top <= i32::MAX as f64) {

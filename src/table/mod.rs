@@ -374,9 +374,9 @@ impl<const S: usize> ForceTable<S> {
 
     /// Whether the graded corner's coordinate stays in `[2^(32 − octaves), 2³²)` over its
     /// range and its segments are the table's last ones, 1 to [`CORNER_OCTAVES_MAX`]
-    /// octaves of them ([`ForceTable::corner_octaves`]). `corner_pre` is signed (a corner graded toward
-    /// its anchor from above has a negative one: the evaluation's `u32` product is the
-    /// same), and the stiffness scale has the other sign.
+    /// octaves of them ([`ForceTable::corner_octaves`]). `corner_pre` is signed (a corner
+    /// graded toward its anchor from above has a negative one: the evaluation's `u32`
+    /// product is the same), and the stiffness scale has the other sign.
     fn corner_fits(&self) -> bool {
         let r = &self.raw;
         let pre = corner_pre_signed(r.corner_pre) as i64;
@@ -646,8 +646,8 @@ pub(crate) fn corner_strain(anchor: i32, pre: u32, z: usize, jj: usize) -> f64 {
 }
 
 /// A corner's `pre` as the signed factor it is: a corner graded toward its anchor from
-/// below has one of 1 … 2^(32 − octaves), one graded toward it from above (its strains above the
-/// anchor) the negative of one, as a `u32` (the evaluation's wrapping product
+/// below has one of 1 … 2^(32 − octaves), one graded toward it from above (its strains
+/// above the anchor) the negative of one, as a `u32` (the evaluation's wrapping product
 /// `(A − e) · pre` is `(e − A) · |pre|` then).
 pub(crate) const fn corner_pre_signed(pre: u32) -> i32 {
     pre as i32
