@@ -1314,6 +1314,22 @@ fn a_corner_graded_up_from_the_first_kink() {
     }
 }
 
+/// The spring of [`spring_of`] (a preload of 0: none) and its 129-knot table from
+/// `ForceTable::with_bound`, which must meet the bound with a graded corner ending on the
+/// solid point `Δ(F_C)` (not under the grid).
+fn met_toward_the_solid_point(cone: [f64; 6], linear: [f64; 5]) -> (Params, ForceTable<128>) {
+    let mut p = spring_of(cone, linear);
+    if p.linear.preload == Some(0.0) {
+        p.linear.preload = None;
+    }
+    let r = Reference::new(&p).unwrap();
+    let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
+        .expect("within the bound");
+    let (_, b) = t.corner().expect("a graded corner");
+    assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
+    (p, t)
+}
+
 /// Stiff series springs (`k_p/k` 1.6e3 to 9.8e3) whose solid point lies a little short of
 /// the domain's end: five of the 13 springs of the long run's draw, from the 1,000th to
 /// the 9,000th, refused for where their knots are (the scratch classification of
@@ -1418,16 +1434,7 @@ fn a_stiff_series_corner_between_the_usual_lengths() {
         ),
     ];
     for (i, cone, linear) in springs {
-        let mut p = spring_of(cone, linear);
-        // (Spring 1,714 has no preload.)
-        if p.linear.preload == Some(0.0) {
-            p.linear.preload = None;
-        }
-        let r = Reference::new(&p).unwrap();
-        let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
-            .expect("within the bound");
-        let (_, b) = t.corner().expect("a graded corner");
-        assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
+        let (p, t) = met_toward_the_solid_point(cone, linear);
         holds_on_the_reference(&format!("SOLIDCORNER case=spring{i}"), &p, &t);
     }
 }
@@ -1482,21 +1489,9 @@ fn a_twelve_octave_corner_into_a_solid_point_at_the_domains_end() {
         ),
     ];
     for (i, cone, linear) in springs {
-        let mut p = spring_of(cone, linear);
-        // (Spring 43,342 has no preload.)
-        if p.linear.preload == Some(0.0) {
-            p.linear.preload = None;
-        }
-        let r = Reference::new(&p).unwrap();
-        assert!(
-            r.strain_c() > 0.948 && r.strain_c() < DOMAIN.1,
-            "{}",
-            r.strain_c()
-        );
-        let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)
-            .expect("within the bound");
-        let (_, b) = t.corner().expect("a graded corner");
-        assert!(!t.lower_corner() && (b.to_num::<f64>() - r.strain_c()).abs() < 1e-6);
+        let (p, t) = met_toward_the_solid_point(cone, linear);
+        let e_c = Reference::new(&p).unwrap().strain_c();
+        assert!(e_c > 0.948 && e_c < DOMAIN.1, "{e_c}");
         assert_eq!(t.corner_octaves(), mccs::table::CORNER_OCTAVES_MAX);
         assert_eq!(t.corner_segments(), 48);
         holds_on_the_reference(&format!("DEEPCORNER case=spring{i}"), &p, &t);

@@ -121,8 +121,7 @@ impl<const S: usize> ForceTable<S> {
         let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
         let e_c = law.strain_c();
         let lo = libm::fmax(law.strain_t(), from);
-        // (The solid point inside the domain or a little past its end: `solid_corner`.)
-        let solid_near = e_c <= to + 0.5 * (to - lo);
+        let solid_near = solid_near(law, from, to);
         if missed {
             Self::solid_corner(law, (from, to), CORNER_OCTAVES, &mut best);
         }
@@ -252,14 +251,11 @@ impl<const S: usize> ForceTable<S> {
         octaves: usize,
         best: &mut Option<(f64, Self)>,
     ) {
-        let e_c = law.strain_c();
-        // The solid point may lie a little past the domain's end: the rise toward it is
-        // then inside the domain.
-        let lo = libm::fmax(law.strain_t(), from);
-        let solid_near = e_c <= to + 0.5 * (to - lo);
-        if S < 2 * octaves * CORNER_PER_OCTAVE || !solid_near {
+        if S < 2 * octaves * CORNER_PER_OCTAVE || !solid_near(law, from, to) {
             return;
         }
+        let e_c = law.strain_c();
+        let lo = libm::fmax(law.strain_t(), from);
         let curved = e_c - lo;
         // (The lengths between, and the corner of more octaves, only where the formats
         // could meet the bound.)
@@ -387,8 +383,8 @@ impl<const S: usize> ForceTable<S> {
         // Under a lower corner the line below meets the corner's first knot instead.
         let l = match (&lower, &corner_ends) {
             (Some(c), Some(ends)) => {
-                // The corner's lowest knot: (0, 4), or (7, 0) where it lies above its
-                // anchor.
+                // The corner's lowest knot: (0, 4), or (octaves − 1, 0) where it lies
+                // above its anchor.
                 let lowest = if c.above_anchor() {
                     ends[corner_segments - CORNER_PER_OCTAVE][0]
                 } else {
@@ -435,7 +431,7 @@ impl<const S: usize> ForceTable<S> {
         if let (Some(c), Some(ends)) = (corner, corner_ends) {
             // The corner starts inside the uniform grid's last segment (its coordinate
             // below 2³² there) and ends past it; a lower one ends on the grid's first
-            // strain (its coordinate at least 2²⁴ there) and starts below it.
+            // strain (its coordinate at least 2^(32 − octaves) there) and starts below it.
             let pre = corner_pre_signed(c.pre) as i64;
             let d = |e: i32| (c.anchor as i64 - e as i64) * pre;
             let inner = 1i64 << (32 - octaves);
@@ -855,13 +851,22 @@ const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
 /// springs a scratch classification found refused for where their knots are, 2026-11-26).
 const MORE_CORNER_FRACTIONS: [f64; 4] = [0.03, 0.07, 0.14, 0.28];
 
+/// Whether the solid point `Δ(F_C)` lies inside `[from, to]` or a little past its end
+/// (within half the curved part's reach into the domain): the rise toward it is then
+/// inside the domain, and a corner toward it ([`CornerEnd::Solid`]) is worth trying.
+fn solid_near(law: &Law, from: f64, to: f64) -> bool {
+    let lo = libm::fmax(law.strain_t(), from);
+    law.strain_c() <= to + 0.5 * (to - lo)
+}
+
 /// How near (Q24 LSBs) a corner knot must lie to a preload's kink to take the law's
 /// one-sided slopes there ([`Corner::kink`]).
 const KINK_ON_KNOT_LSB: f64 = 64.0;
 
 /// The corner length (strain) whose knot `(z, jj)` lies `below` (strain) under its end:
-/// with `D` = `below` in Q24 LSBs, the anchor `2²⁴/pre` past the end and the knot at
-/// `2^(31 − z) (1 + jj/4) / pre` under the anchor, `pre = (2^(31 − z)(1 + jj/4) − 2²⁴)/D`
+/// with `D` = `below` in Q24 LSBs, `I = 2^(32 − octaves)`, the anchor `I/pre` past the end
+/// and the knot at `2^(31 − z) (1 + jj/4) / pre` under the anchor,
+/// `pre = (2^(31 − z)(1 + jj/4) − I)/D`
 /// (rounded: the knot then lies within a few strain LSBs of the kink), and the length
 /// `2³²/pre` LSBs. `None` where `pre` is out of [`Corner::place`]'s range.
 /// [`ForceTable::from_law_best`] tries each octave's outer end and midpoint.
