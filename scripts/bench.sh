@@ -19,7 +19,7 @@ mkdir -p target/qemu
 out=target/qemu/bench.txt
 : > "$out"
 status=0
-cargo build --quiet -p defmt-log
+build_decoder --quiet
 echo "bench: building the bench firmware for m4f, m3 and m0" >&2
 cargo build --quiet --release -p mccs-firmware --bin bench \
   --target thumbv7em-none-eabihf --target thumbv7m-none-eabi --target thumbv6m-none-eabi
@@ -34,7 +34,7 @@ for core in m4f m3 m0; do
     set +e
     timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin bench \
         < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
-      | target/debug/defmt-log "target/$t/release/bench" > "$log"
+      | "$DECODER" "target/$t/release/bench" > "$log"
     echo "${PIPESTATUS[0]}" > "$log.rc"
   ) &
 done

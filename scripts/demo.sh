@@ -8,7 +8,7 @@ source scripts/setup.sh
 source scripts/lib.sh
 LOG_DIR=target/logs/demo
 mkdir -p "$LOG_DIR"
-run_stage build-decoder cargo build -p defmt-log
+run_stage build-decoder build_decoder
 run_stage build-firmware cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
 say "...  running the firmware in QEMU (Cortex-M4F, 4 s of simulated ticks: a palpation)"
 start=$SECONDS

@@ -8,11 +8,11 @@ source scripts/lib.sh
 core=${1:-m4f}
 shift || true
 target=$(core_target "$core")
-cargo build --quiet -p defmt-log
+build_decoder --quiet
 cargo build --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@"
 elf="target/$target/release/haptic"
 # The runner from .cargo/config.toml (QEMU with -icount, off the terminal), output
 # decoded. A hung firmware fails after 5 minutes instead of stalling the caller.
 timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@" \
     < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
-  | target/debug/defmt-log "$elf"
+  | "$DECODER" "$elf"

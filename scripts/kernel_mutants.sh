@@ -9,10 +9,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 T=thumbv7em-none-eabihf
 root=$(pwd)
+source scripts/lib.sh  # build_decoder, $DECODER
+DECODER="$root/$DECODER"
 work=$(mktemp -d)
 trap 'git worktree remove --force "$work" >/dev/null 2>&1 || rm -rf "$work"' EXIT
 git worktree add --detach "$work" HEAD >/dev/null
-cargo build --quiet -p defmt-log
+build_decoder --quiet
 export CARGO_TARGET_DIR="$root/target/mutants"
 src="$work/src/arith/wide_dsp.rs"
 cp "$src" "$work/wide_dsp.rs.orig"
@@ -65,7 +67,7 @@ EOF
   (cd "$work" && cargo build --quiet --release -p mccs-firmware --target $T --bin bench)
   line=$( (cd "$work" && timeout --foreground 300 cargo run --quiet --release -p mccs-firmware \
       --target $T --bin bench < /dev/null 2>/dev/null || true) \
-    | target/debug/defmt-log "$CARGO_TARGET_DIR/$T/release/bench" | grep -m1 '^KERNEL' || true)
+    | "$DECODER" "$CARGO_TARGET_DIR/$T/release/bench" | grep -m1 '^KERNEL' || true)
   n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
   of=$(sed -n 's/.*states=\([0-9]*\).*/\1/p' <<< "$line")
   echo "MUTANT $name: ${n:-no KERNEL line, so none} of ${of:-the} states differ"

@@ -6,10 +6,15 @@
 #                               "ok   NAME (34 s)" or "FAIL NAME (34 s): see LOG";
 #                               returns COMMAND's status.
 #   say TEXT                    one line on stderr.
+#   build_decoder [ARGS]        builds the defmt log decoder, $DECODER (its own cargo
+#                               profile, `tool`: unoptimised, it builds in half the time).
 
 LOG_DIR=${LOG_DIR:-target/logs}
 mkdir -p "$LOG_DIR"
 STAGES=()
+
+DECODER=target/tool/defmt-log
+build_decoder() { cargo build -p defmt-log --profile tool "$@"; }
 
 say() { printf '%s\n' "$*" >&2; }
 

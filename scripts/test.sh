@@ -85,7 +85,7 @@ budget_test() {
   cargo build --release -p mccs-firmware --target "$t" --bin bench --features budget-test || return 1
   if timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin bench \
       --features budget-test < /dev/null 2> /dev/null \
-      | target/debug/defmt-log "target/$t/release/bench" > target/qemu/budget-test.log; then
+      | "$DECODER" "target/$t/release/bench" > target/qemu/budget-test.log; then
     echo "the bench firmware passed an impossible budget"
     return 1
   fi
@@ -172,7 +172,7 @@ run_stage clippy-host cargo clippy --workspace --all-targets -- -D warnings
 # build leaves out; the demo stages need it, and built here, before the host tests start
 # in the background, it has both cores).
 host_build() {
-  cargo test --workspace --no-run && cargo build -p defmt-log
+  cargo test --workspace --no-run && build_decoder
 }
 
 run_stage host-build host_build && start_host_tests
