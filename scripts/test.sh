@@ -146,10 +146,15 @@ host_tests() {
 # The host tests need only the host build, and they run beside the firmware stages (a
 # QEMU run or a thumb link leaves a core idle; the tests keep both busy): started in the
 # background once the host build is done, their output in $HOST_BG.log and their exit
-# status in $HOST_BG.status. The host-tests stage waits for them.
+# status in $HOST_BG.status. The host-tests stage waits for them. They run at a lower
+# priority (nice), so that the stages in front, which are mostly one thread each near the
+# end (the QEMU runs, the LTO links, the board's build), go first and the tests fill the
+# other core until the end; at the same priority the tests ended early and the last
+# stages ran on one core.
 HOST_BG=$LOG_DIR/host-tests-background
 start_host_tests() {
   (
+    renice -n 10 "$BASHPID" > /dev/null
     host_tests > "$HOST_BG.log" 2>&1 < /dev/null
     echo $? > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
   ) &

@@ -1503,3 +1503,93 @@ fn a_twelve_octave_corner_into_a_solid_point_at_the_domains_end() {
         ));
     }
 }
+
+/// The two springs of the long run's 10⁵ (commit eb6e585) refused for where their knots
+/// are, held refused, each with a narrower domain that meets the bound (`mccs table`
+/// names one when it refuses):
+/// - 58315, a soft series spring (`k_p/k` 0.085) preloaded to 0.89 `F_C`: its preload's
+///   kink (strain 0.232) lies below the cone's solid point (0.829), so above the kink the
+///   law still bends (the cone in series with the soft spring: its stiffness rises by
+///   0.4 %, 97.8 to 98.1 N per unit strain), but the table's segments end at the kink, since the corner graded toward it
+///   from below, which the law's approach needs (up to 26,000 N per unit strain), is a
+///   table's last segments; a straight line carries the rest. Its worst force error is
+///   that line's, at the domain's end.
+/// - 62805, a stiff series spring (`k_p/k` 9.1e3) whose solid point lies 3e-4 strain
+///   short of the domain's end: its stiffness climbs some 300-fold over the last 0.05 of
+///   strain before it, more than 80 uniform segments and a 48-segment corner of twelve
+///   octaves follow.
+#[test]
+fn the_long_runs_two_refusals_for_knots_and_the_domains_that_meet_the_bound() {
+    let soft = spring_of(
+        [
+            0.2328705267322286,
+            0.24409780229485475,
+            0.3617307803032588,
+            2.09502466668249,
+            0.23329991733197336,
+            189613.39943617504,
+        ],
+        [
+            0.12165921595397515,
+            0.4736323934691794,
+            20.117066768182426,
+            7660760.8174421415,
+            475.1766681345585,
+        ],
+    );
+    let stiff = spring_of(
+        [
+            0.03508090274255632,
+            0.3041737126457285,
+            0.41932365748515543,
+            1.6392791916964022,
+            0.9495436225730001,
+            344935.6321324554,
+        ],
+        [
+            0.16426764000144503,
+            0.2501253795178,
+            13.63440247162617,
+            17444972.35995296,
+            0.24234344169925903,
+        ],
+    );
+    let bound = TableBound::PRODUCT;
+    for (i, p, narrower) in [
+        (58315, &soft, [(DOMAIN.0, 0.371), (0.172, DOMAIN.1)]),
+        (62805, &stiff, [(DOMAIN.0, 0.949), (DOMAIN.0, 0.949)]),
+    ] {
+        let reached = refused_at(p);
+        let confirmed = refusal_confirmed(p, &reached, &bound);
+        assert!(confirmed.is_ok(), "{confirmed:?}");
+        println!(
+            "KNOTREFUSAL case=spring{i} force={:.1e} stiffness={:.1e}",
+            reached.force, reached.stiffness
+        );
+        for (from, to) in narrower {
+            let t = ForceTable::<128>::with_bound(p, from, to, &bound);
+            assert!(t.is_ok(), "spring {i} over [{from}, {to}]: {t:?}");
+        }
+    }
+    // The soft spring: its corner ends on the preload's kink, the law bends above it,
+    // and its worst force error is at the domain's end.
+    let r = Reference::new(&soft).unwrap();
+    let e_p = r.delta(soft.linear.preload.unwrap());
+    assert!(e_p < r.strain_c());
+    let law = mccs::Law::new(&soft).unwrap();
+    let t = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    let (_, hi) = t.corner().expect("a graded corner");
+    assert!((hi.to_num::<f64>() - e_p).abs() < 1e-6, "{hi} {e_p}");
+    let bends = r.stiffness(r.strain_c() - 1e-3) / r.stiffness(e_p + 1e-3) - 1.0;
+    println!("KNOTLAW case=spring58315 bends={bends:.1e}");
+    assert!(bends > 2.0 * bound.stiffness, "{bends}");
+    let end = (t.force(mccs::Strain::from_num(DOMAIN.1)).to_num::<f64>() - r.force(DOMAIN.1)).abs()
+        / r.force(DOMAIN.1);
+    assert!(end > 0.9 * refused_at(&soft).force, "{end}");
+    // The stiff spring: its solid point just short of the end, the law's rise before it.
+    let r = Reference::new(&stiff).unwrap();
+    assert!(r.strain_c() > DOMAIN.1 - 4e-4 && r.strain_c() < DOMAIN.1);
+    let rise = r.stiffness(r.strain_c() - 1e-6) / r.stiffness(r.strain_c() - 0.05);
+    println!("KNOTLAW case=spring62805 rise={rise:.0}");
+    assert!(rise > 100.0, "{rise}");
+}
