@@ -1510,10 +1510,14 @@ fn a_twelve_octave_corner_into_a_solid_point_at_the_domains_end() {
 /// - 58315, a soft series spring (`k_p/k` 0.085) preloaded to 0.89 `F_C`: its preload's
 ///   kink (strain 0.232) lies below the cone's solid point (0.829), so above the kink the
 ///   law still bends (the cone in series with the soft spring: its stiffness rises by
-///   0.4 %, 97.8 to 98.1 N per unit strain), but the table's segments end at the kink, since the corner graded toward it
-///   from below, which the law's approach needs (up to 26,000 N per unit strain), is a
-///   table's last segments; a straight line carries the rest. Its worst force error is
-///   that line's, at the domain's end.
+///   0.4 %, 97.8 to 98.1 N per unit strain), and below it the cone rises steeply into it
+///   (to 26,000 N per unit strain). The corner graded toward the kink from below, with the
+///   grid above it (`CornerEnd::Lower`), is the layout for that, but it does not fit the
+///   corner's coefficient format: a corner's stiffness is `D · 2^z` within 2²⁹ in the
+///   force's Q20 unit, which holds a corner's steepest stiffness times its length to
+///   2¹¹ = 2,048 N, and this one's is more (its length from `Δ(F_T)` to the kink). The
+///   layouts that fit put the table's segments below the kink and a straight line above
+///   it; its worst force error is that line's, at the domain's end.
 /// - 62805, a stiff series spring (`k_p/k` 9.1e3) whose solid point lies 3e-4 strain
 ///   short of the domain's end: its stiffness climbs some 300-fold over the last 0.05 of
 ///   strain before it, more than 80 uniform segments and a 48-segment corner of twelve
@@ -1581,8 +1585,11 @@ fn the_long_runs_two_refusals_for_knots_and_the_domains_that_meet_the_bound() {
     let (_, hi) = t.corner().expect("a graded corner");
     assert!((hi.to_num::<f64>() - e_p).abs() < 1e-6, "{hi} {e_p}");
     let bends = r.stiffness(r.strain_c() - 1e-3) / r.stiffness(e_p + 1e-3) - 1.0;
-    println!("KNOTLAW case=spring58315 bends={bends:.1e}");
+    // The lower corner's stiffness times length (its steepest, just below the kink).
+    let steep = r.stiffness(e_p - 1e-7) * (e_p - r.strain_t());
+    println!("KNOTLAW case=spring58315 bends={bends:.1e} corner_stiffness_length={steep:.0}");
     assert!(bends > 2.0 * bound.stiffness, "{bends}");
+    assert!(steep > 2048.0, "{steep}");
     let end = (t.force(mccs::Strain::from_num(DOMAIN.1)).to_num::<f64>() - r.force(DOMAIN.1)).abs()
         / r.force(DOMAIN.1);
     assert!(end > 0.9 * refused_at(&soft).force, "{end}");
