@@ -373,7 +373,7 @@ impl<const S: usize> ForceTable<S> {
             None => None,
         };
         let corner_ends = corner_ends.as_ref().map(|e| &e[..corner_segments]);
-        let magnitude = corner_ends.map_or((0.0, 0.0), magnitude);
+        let magnitude = corner_ends.map_or((0.0, 0.0, 0.0), magnitude);
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
@@ -779,18 +779,19 @@ impl Corner {
     }
 }
 
-/// The corner's largest knot and `(|C1| + |C2| + |C3|) · 2^z` in Q20 N units, from its
-/// segments' ends (for the coefficients' shift: the stiffness in octave `z` takes
-/// `D << z`).
-fn magnitude(ends: &[[f64; 4]]) -> (f64, f64) {
-    let (mut value, mut poly) = (0.0f64, 0.0f64);
+/// The corner's largest knot, `|C1| + |C2| + |C3|` and `(|C1| + |C2| + |C3|) · 2^z`, in
+/// Q20 N units, from its segments' ends (for the coefficients' shift: the stiffness in
+/// octave `z` takes `D << z`).
+fn magnitude(ends: &[[f64; 4]]) -> (f64, f64, f64) {
+    let (mut value, mut poly, mut stiff) = (0.0f64, 0.0f64, 0.0f64);
     for (i, &[a0, a1, m0, m1]) in ends.iter().enumerate() {
         let c = hermite(a0, a1, m0, m1);
         value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
         let sum = libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]);
-        poly = libm::fmax(poly, libm::ldexp(sum, (i / CORNER_PER_OCTAVE) as i32));
+        poly = libm::fmax(poly, sum);
+        stiff = libm::fmax(stiff, libm::ldexp(sum, (i / CORNER_PER_OCTAVE) as i32));
     }
-    (value, poly)
+    (value, poly, stiff)
 }
 
 /// The corner's coefficients in the unit of `shift`, rounded as [`segments`] rounds
@@ -881,6 +882,13 @@ fn kink_on_knot(below: f64, (z, jj): (u32, u32), octaves: usize) -> Option<f64> 
 /// The lengths of a corner above the law's first kink ([`CornerEnd::Onset`]) that
 /// [`ForceTable::from_law_best`] tries first, as fractions of the law's curved part.
 const ONSET_FRACTIONS: [f64; 5] = [0.02, 0.05, 0.1, 0.2, 0.35];
+
+/// The bound on a graded corner's `(|C1| + |C2| + |C3|) · 2^z` in octave `z` (the
+/// coefficients' unit): `D << z` within `i32` (`|D| ≤ |C1| + |C2| + ¾ |C3|`), with room
+/// for the halving Horner steps' flooring. Up to 2026-11-27 it was 2²⁹, the sum's own
+/// bound, which held a corner's steepest stiffness times its length to about 2,048 N in
+/// Q20 (`the_long_runs_soft_series_spring_meets_the_bound_with_its_lower_corner`).
+const CORNER_STIFF_MAX: f64 = (1u64 << 31) as f64 - (1u64 << 24) as f64;
 
 /// How far a lower corner reaches below `Δ(P)`, as a factor of the way down to the
 /// law's first kink (or the domain's start): its nearest octave's `1/256` lies past
@@ -1185,10 +1193,12 @@ fn hermite(a0: f64, a1: f64, m0: f64, m1: f64) -> [f64; 3] {
 }
 
 /// The coefficients' unit, Q(20 + shift) N: the largest shift (≤ 12) that keeps every knot
-/// within 2³⁰ and every segment's |C1| + |C2| + |C3| within 2²⁹, so that no Horner step
-/// of the value or the stiffness can overflow.
-fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64)) -> Result<u32, TableError> {
+/// within 2³⁰, every segment's |C1| + |C2| + |C3| within 2²⁹, so that no Horner step of
+/// the value or the stiffness can overflow, and, in the graded corner's octave `z`,
+/// that sum times `2^z` within [`CORNER_STIFF_MAX`], so that `D << z` cannot.
+fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64, f64)) -> Result<u32, TableError> {
     let (mut big_value, mut big_poly) = (libm::fmax(1e-30, corner.0), libm::fmax(1e-30, corner.1));
+    let corner_stiff = corner.2;
     let mut prev = grid.knot(law, 0)?;
     big_value = libm::fmax(big_value, libm::fabs(prev.value));
     for i in 1..=grid.used {
@@ -1205,6 +1215,7 @@ fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64)) -> Result<u32, 
         let x = (1u64 << shift) as f64;
         big_value * x + knot_bias(shift) as f64 <= (1u64 << 30) as f64 - 64.0
             && 1.01 * big_poly * x <= (1u64 << 29) as f64 - 64.0
+            && 1.01 * corner_stiff * x <= CORNER_STIFF_MAX
     };
     if !fits(0) {
         return Err(TableError::OutOfRange);
@@ -1251,15 +1262,18 @@ fn segments<const S: usize>(law: &Law, grid: &Grid, shift: u32) -> Result<Segmen
 
 /// One segment's `[C0, C1, C2, C3]` from its rounded end values `a0, a1` and its end
 /// slopes `m0, m1` (the coefficients' unit): `C1`, `C2` rounded, `C3 = 8 (a1 − a0) − 4 C1
-/// − 2 C2` exact, so that the cubic ends on `a1`; refused unless `|a0| < 2³⁰` and
-/// `(|C1| + |C2| + |C3|) · 2^z ≤ 2²⁹` (`z` = 0 on the uniform grid, the octave in the
-/// graded corner, whose stiffness takes `D << z`).
+/// − 2 C2` exact, so that the cubic ends on `a1`; refused unless `|a0| < 2³⁰`,
+/// `|C1| + |C2| + |C3| ≤ 2²⁹` and that sum times `2^z` within [`CORNER_STIFF_MAX`] (`z` =
+/// 0 on the uniform grid, the octave in the graded corner, whose stiffness takes
+/// `D << z`, `|D| ≤ |C1| + |C2| + ¾ |C3|`).
 fn rounded_cubic(a0: f64, a1: f64, m0: f64, m1: f64, z: i32) -> Result<[i32; 4], TableError> {
     let [c1, c2, _] = hermite(a0, a1, m0, m1);
     let (c1, c2) = (libm::round(c1), libm::round(c2));
     let c3 = 8.0 * (a1 - a0) - 4.0 * c1 - 2.0 * c2;
+    let sum = libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3);
     if libm::fabs(a0) >= (1u64 << 30) as f64
-        || libm::ldexp(libm::fabs(c1) + libm::fabs(c2) + libm::fabs(c3), z) > (1u64 << 29) as f64
+        || sum > (1u64 << 29) as f64
+        || libm::ldexp(sum, z) > CORNER_STIFF_MAX
     {
         return Err(TableError::OutOfRange);
     }

@@ -196,7 +196,7 @@ pub struct RawTable<const S: usize> {
     pub corner_base: u32,
     /// The stiffness in the corner, in Q16: `⌊(D · 2^z) · corner_scale / 2³²⌋ ·
     /// corner_post` for `D = 2 dF/dτ` in the coefficients' unit, which the builder keeps
-    /// within ±2²⁹ times `2^−z` in octave `z` (`τ` runs down in strain, so the scale is
+    /// within ±2³¹ times `2^−z` in octave `z` (`τ` runs down in strain, so the scale is
     /// negative; positive where the corner lies above its anchor; `corner_post` a power
     /// of two).
     pub corner_scale: i32,
@@ -575,7 +575,7 @@ impl<const S: usize> ForceTable<S> {
         // (The header's fields after the cubic, as in the uniform part.)
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         let f = sum.wrapping_shr(r.shift);
-        // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2²⁹ (z ≤ 11 on a
+        // ⌊(D << z) · scale / 2³²⌋: the builder keeps D << z within ±2³¹ (z ≤ 11 on a
         // valid table; the shift wraps at 32 on any other, without a panic). Floored, not
         // rounded as the uniform part's: a graded corner's stiffness (a stiff series
         // spring's) is thousands of LSBs, and rounding costs the M0 nine instructions.
