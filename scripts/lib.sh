@@ -7,14 +7,20 @@
 #                               returns COMMAND's status.
 #   say TEXT                    one line on stderr.
 #   build_decoder [ARGS]        builds the defmt log decoder, $DECODER (its own cargo
-#                               profile, `tool`: unoptimised, it builds in half the time).
+#                               profile, `tool`: unoptimised, it builds in half the time),
+#                               linted as it builds (clippy's driver as the workspace's
+#                               rustc wrapper, warnings denied): the test command's
+#                               clippy-host stage leaves it out.
 
 LOG_DIR=${LOG_DIR:-target/logs}
 mkdir -p "$LOG_DIR"
 STAGES=()
 
 DECODER=target/tool/defmt-log
-build_decoder() { cargo build -p defmt-log --profile tool "$@"; }
+build_decoder() {
+  RUSTFLAGS=-Dwarnings RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver)" \
+    cargo build -p defmt-log --profile tool "$@"
+}
 
 say() { printf '%s\n' "$*" >&2; }
 
