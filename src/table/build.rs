@@ -373,7 +373,7 @@ impl<const S: usize> ForceTable<S> {
             None => None,
         };
         let corner_ends = corner_ends.as_ref().map(|e| &e[..corner_segments]);
-        let magnitude = corner_ends.map_or((0.0, 0.0, 0.0), magnitude);
+        let magnitude = corner_ends.map_or(Magnitude::default(), magnitude);
         let shift = coefficient_shift(law, &grid, magnitude)?;
         let mut segs = segments::<S>(law, &grid, shift)?;
         let (stiff_scale, stiff_post) = stiffness_scale(&grid, shift, segs.slope_bound)?;
@@ -585,8 +585,7 @@ impl Corner {
         if end == CornerEnd::Onset {
             return Self::above(law, to, len, octaves);
         }
-        // The nearest octave's inner end, as a coordinate: 2^(32 − octaves).
-        let inner_bits = 32 - octaves as i32;
+        let inner_d = corner_inner(octaves);
         let e_end = match end {
             CornerEnd::Solid => law.strain_c(),
             CornerEnd::DomainEnd => to,
@@ -612,10 +611,10 @@ impl Corner {
             libm::round(pre)
         };
         // The nearest octave's inner end at least a strain LSB from the anchor.
-        if !(pre >= 1.0 && pre <= libm::ldexp(1.0, inner_bits)) {
+        if !(pre >= 1.0 && pre <= inner_d) {
             return Err(TableError::TooNarrow);
         }
-        let inner = libm::ldexp(1.0, inner_bits) / pre;
+        let inner = inner_d / pre;
         let anchor =
             checked_from_f64(e_end + inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         // The last strain e with (A − e) · pre ≥ 2^(32 − octaves), plus one.
@@ -659,12 +658,12 @@ impl Corner {
     fn above(law: &Law, to: f64, len: f64, octaves: usize) -> Result<Self, TableError> {
         let unit = (1u64 << STRAIN_FRAC) as f64;
         let e_kink = law.strain_t();
-        let inner_bits = 32 - octaves as i32;
+        let inner_d = corner_inner(octaves);
         let p = libm::round(libm::ldexp(1.0, 32) / (len * unit));
-        if !(p >= 1.0 && p <= libm::ldexp(1.0, inner_bits)) {
+        if !(p >= 1.0 && p <= inner_d) {
             return Err(TableError::TooNarrow);
         }
-        let inner = libm::ldexp(1.0, inner_bits) / p;
+        let inner = inner_d / p;
         let anchor =
             checked_from_f64(e_kink - inner / unit, STRAIN_FRAC).ok_or(TableError::BadDomain)?;
         // The last strain with d < 2^(32 − octaves) (the line below's), and the last
@@ -779,19 +778,29 @@ impl Corner {
     }
 }
 
-/// The corner's largest knot, `|C1| + |C2| + |C3|` and `(|C1| + |C2| + |C3|) · 2^z`, in
-/// Q20 N units, from its segments' ends (for the coefficients' shift: the stiffness in
-/// octave `z` takes `D << z`).
-fn magnitude(ends: &[[f64; 4]]) -> (f64, f64, f64) {
-    let (mut value, mut poly, mut stiff) = (0.0f64, 0.0f64, 0.0f64);
+/// A graded corner's largest values in Q20 N units (for the coefficients' shift).
+#[derive(Clone, Copy, Default)]
+struct Magnitude {
+    /// The largest knot.
+    value: f64,
+    /// The largest `|C1| + |C2| + |C3|`.
+    poly: f64,
+    /// The largest `(|C1| + |C2| + |C3|) · 2^z` in octave `z`: the stiffness takes
+    /// `D << z`.
+    stiff: f64,
+}
+
+/// The corner's [`Magnitude`], from its segments' ends.
+fn magnitude(ends: &[[f64; 4]]) -> Magnitude {
+    let mut m = Magnitude::default();
     for (i, &[a0, a1, m0, m1]) in ends.iter().enumerate() {
         let c = hermite(a0, a1, m0, m1);
-        value = libm::fmax(value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
+        m.value = libm::fmax(m.value, libm::fmax(libm::fabs(a0), libm::fabs(a1)));
         let sum = libm::fabs(c[0]) + libm::fabs(c[1]) + libm::fabs(c[2]);
-        poly = libm::fmax(poly, sum);
-        stiff = libm::fmax(stiff, libm::ldexp(sum, (i / CORNER_PER_OCTAVE) as i32));
+        m.poly = libm::fmax(m.poly, sum);
+        m.stiff = libm::fmax(m.stiff, libm::ldexp(sum, (i / CORNER_PER_OCTAVE) as i32));
     }
-    (value, poly, stiff)
+    m
 }
 
 /// The corner's coefficients in the unit of `shift`, rounded as [`segments`] rounds
@@ -852,6 +861,12 @@ const CORNER_FRACTIONS: [f64; 6] = [0.05, 0.1, 0.02, 0.2, 0.35, 0.5];
 /// springs a scratch classification found refused for where their knots are, 2026-11-26).
 const MORE_CORNER_FRACTIONS: [f64; 4] = [0.03, 0.07, 0.14, 0.28];
 
+/// The coordinate `d` of a graded corner's nearest octave's inner end, `2^(32 − octaves)`:
+/// a corner's `d` lies in `[corner_inner, 2³²)`.
+fn corner_inner(octaves: usize) -> f64 {
+    libm::ldexp(1.0, 32 - octaves as i32)
+}
+
 /// Whether the solid point `Δ(F_C)` lies inside `[from, to]` or a little past its end
 /// (within half the curved part's reach into the domain): the rise toward it is then
 /// inside the domain, and a corner toward it ([`CornerEnd::Solid`]) is worth trying.
@@ -873,7 +888,7 @@ const KINK_ON_KNOT_LSB: f64 = 64.0;
 /// [`ForceTable::from_law_best`] tries each octave's outer end and midpoint.
 fn kink_on_knot(below: f64, (z, jj): (u32, u32), octaves: usize) -> Option<f64> {
     let unit = (1u64 << STRAIN_FRAC) as f64;
-    let inner = libm::ldexp(1.0, 32 - octaves as i32);
+    let inner = corner_inner(octaves);
     let d = libm::ldexp(1.0 + jj as f64 / CORNER_PER_OCTAVE as f64, 31 - z as i32);
     let pre = libm::round((d - inner) / (below * unit));
     (pre >= 1.0 && pre <= inner).then(|| libm::ldexp(1.0, 32) / (pre * unit))
@@ -1196,9 +1211,11 @@ fn hermite(a0: f64, a1: f64, m0: f64, m1: f64) -> [f64; 3] {
 /// within 2³⁰, every segment's |C1| + |C2| + |C3| within 2²⁹, so that no Horner step of
 /// the value or the stiffness can overflow, and, in the graded corner's octave `z`,
 /// that sum times `2^z` within [`CORNER_STIFF_MAX`], so that `D << z` cannot.
-fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64, f64)) -> Result<u32, TableError> {
-    let (mut big_value, mut big_poly) = (libm::fmax(1e-30, corner.0), libm::fmax(1e-30, corner.1));
-    let corner_stiff = corner.2;
+fn coefficient_shift(law: &Law, grid: &Grid, corner: Magnitude) -> Result<u32, TableError> {
+    let (mut big_value, mut big_poly) = (
+        libm::fmax(1e-30, corner.value),
+        libm::fmax(1e-30, corner.poly),
+    );
     let mut prev = grid.knot(law, 0)?;
     big_value = libm::fmax(big_value, libm::fabs(prev.value));
     for i in 1..=grid.used {
@@ -1215,7 +1232,7 @@ fn coefficient_shift(law: &Law, grid: &Grid, corner: (f64, f64, f64)) -> Result<
         let x = (1u64 << shift) as f64;
         big_value * x + knot_bias(shift) as f64 <= (1u64 << 30) as f64 - 64.0
             && 1.01 * big_poly * x <= (1u64 << 29) as f64 - 64.0
-            && 1.01 * corner_stiff * x <= CORNER_STIFF_MAX
+            && 1.01 * corner.stiff * x <= CORNER_STIFF_MAX
     };
     if !fits(0) {
         return Err(TableError::OutOfRange);
