@@ -363,7 +363,7 @@ fn patch_errors_name_the_argument() {
         ),
         (
             ["--grid", "5", "--spacing", "2.5", "--indent", "9"],
-            "--indent",
+            "--indent: must be 0 … 2.5 mm",
         ),
     ] {
         let args: Vec<&str> = base.iter().chain(extra.iter()).copied().collect();

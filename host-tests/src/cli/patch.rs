@@ -55,7 +55,8 @@ impl PatchRun {
     fn new(patch: PatchArgs, depth: f64, duration: f64) -> Result<Self, CliError> {
         patch.check()?;
         if !(depth.is_finite() && (0.0..=patch.spacing).contains(&depth)) {
-            return Err(arg_error("--indent", "must be 0 … spacing mm"));
+            let what = format!("must be 0 … {} mm (the --spacing)", patch.spacing);
+            return Err(arg_error("--indent", &what));
         }
         if !(duration.is_finite() && duration > 0.0 && duration <= 60.0) {
             return Err(arg_error("--duration", "must be > 0 and ≤ 60 s"));
