@@ -817,7 +817,7 @@ fn the_table_rounds_to_the_nearest_lsb() {
 /// The line below the table rounds to the nearest LSB too, although its evaluation
 /// floors the product (`force_lo + ⌊slope · (e − anchor_lo) / 2^P⌋`): the builder places
 /// its anchor where the line's exact force is half an LSB below a Q20 value
-/// (`rounding_anchor` in `src/table/build.rs`). Before, the anchor was the kink's origin
+/// (`rounding_anchor` in `src/table/builder/lines.rs`). Before, the anchor was the kink's origin
 /// or the first knot, and every force on the line was up to a whole LSB below it, half
 /// an LSB on average: on the small spring of the test above, 1.0 of its force bound's
 /// 1.9 LSBs. 100,000 strains below `strain_lo`, against the line itself (the law's own

@@ -91,7 +91,7 @@ use crate::q::{self, mul_t, mul_wide, mulhi, mulhi_round, mulhi_u, shr_held};
 use crate::units::{Force, Stiffness, Strain, FORCE_FRAC, STIFF_FRAC, STRAIN_FRAC};
 
 mod bound;
-mod build;
+mod builder;
 mod error;
 
 pub use bound::{format_floor, measure, TableBound, KINK_MARGIN, POINTS_PER_SEGMENT, UNMEASURED};
