@@ -1594,4 +1594,48 @@ fn the_long_runs_refusal_for_knots_and_the_domain_that_meets_the_bound() {
     assert!(rise > 100.0, "{rise}");
     let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, 0.949, &bound);
     assert!(t.is_ok(), "{t:?}");
+    // Where the least-far table misses, on every strain LSB of its corner and of the
+    // uniform grid's last 0.02 under it: the force only in the corner's last segment,
+    // which ends on the solid point (the law rises there like the square root of the
+    // distance to it); the stiffness only in the uniform grid.
+    let law = mccs::Law::new(&p).unwrap();
+    let best = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    let (lo, hi) = best.corner().expect("a graded corner");
+    let last = (0..best.corner_segments())
+        .map(|i| best.corner_segment_range(i))
+        .fold((f64::MIN, f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
+    let lsb = |x: f64| (x * (1u64 << 24) as f64) as i32;
+    let f_end = r.force(DOMAIN.1);
+    let (mut last_force, mut corner_force, mut grid_force) = (0f64, 0f64, 0f64);
+    let (mut corner_stiffness, mut grid_stiffness) = (0f64, 0f64);
+    for bits in lsb(lo.to_num::<f64>() - 0.02)..hi.to_bits() {
+        let s = Strain::from_bits(bits);
+        let e = s.to_num::<f64>();
+        let (f, k) = best.force_and_stiffness(s);
+        let fe = (f.to_num::<f64>() - r.force(e)).abs() / f_end;
+        let away = (e - r.strain_c()).abs() > mccs::table::KINK_MARGIN;
+        let ke = if away {
+            (k.to_num::<f64>() / r.stiffness(e) - 1.0).abs()
+        } else {
+            0.0
+        };
+        if bits < lo.to_bits() {
+            grid_force = grid_force.max(fe);
+            grid_stiffness = grid_stiffness.max(ke);
+        } else if e >= last.0 {
+            last_force = last_force.max(fe);
+        } else {
+            corner_force = corner_force.max(fe);
+            corner_stiffness = corner_stiffness.max(ke);
+        }
+    }
+    let last_lsbs = lsb(last.1) - lsb(last.0);
+    println!(
+        "KNOTREFUSAL case=spring62805_where last_segment_lsbs={last_lsbs} \
+         last_segment_force={last_force:.1e} corner_force={corner_force:.1e} \
+         corner_stiffness={corner_stiffness:.1e} grid_force={grid_force:.1e} \
+         grid_stiffness={grid_stiffness:.1e}"
+    );
+    assert!(last_force > bound.force && corner_force < bound.force);
+    assert!(grid_stiffness > bound.stiffness && corner_stiffness < bound.stiffness);
 }
