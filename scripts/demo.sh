@@ -12,5 +12,9 @@ run_stage build-decoder build_decoder
 run_stage build-firmware cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
 say "...  running the firmware in QEMU (Cortex-M4F, 4 s of simulated ticks: a palpation)"
 start=$SECONDS
-bash scripts/firmware.sh m4f
-say "ok   demo ($((SECONDS - start)) s)"
+# The decoded log is kept, for `mccs demo --core m4f --check` (the README's next step).
+mkdir -p target/qemu
+log=target/qemu/demo-m4f.log
+rm -f "$log"
+bash scripts/firmware.sh m4f | tee "$log"
+say "ok   demo ($((SECONDS - start)) s); its log: $log (mccs demo --core m4f --check $log compares it with the host)"
