@@ -6,6 +6,8 @@
 # (host-tests) before fixing it. Not part of the test command (see docs/reliability.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+LOG_DIR=target/fuzz
+source scripts/lib.sh  # run_stage: says what runs, ticks every 10 s, logs to target/fuzz/
 seconds=${1:-60}
 if ! rustup toolchain list | grep -q '^nightly'; then
   echo "fuzz.sh: installing the nightly toolchain (rustup toolchain install nightly)" >&2
@@ -17,16 +19,16 @@ if ! command -v cargo-fuzz >/dev/null 2>&1; then
 fi
 mkdir -p target/fuzz
 status=0
+fuzz_one() {
+  cd fuzz && cargo +nightly fuzz run "$1" "corpus/$1" -- \
+    -max_total_time="$seconds" -rss_limit_mb=4096 -print_final_stats=1
+}
 for target in $(sed -n 's/^name = "\(.*\)"$/\1/p' fuzz/Cargo.toml | grep -v mccs-fuzz); do
   echo "fuzz.sh: building and running $target for $seconds s" >&2
   log="target/fuzz/$target.log"
   mkdir -p "fuzz/corpus/$target"
-  set +e
-  (cd fuzz && cargo +nightly fuzz run "$target" "corpus/$target" -- \
-      -max_total_time="$seconds" -rss_limit_mb=4096 -print_final_stats=1) \
-      < /dev/null > "$log" 2>&1
-  rc=$?
-  set -e
+  rc=0
+  run_stage "$target" fuzz_one "$target" || rc=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   # libFuzzer's artifacts: crash-, leak-, oom-, timeout- (failures) and slow-unit- (an
   # input over its 10 s report threshold, under the sanitizer: not a failure, but kept).
