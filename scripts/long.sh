@@ -6,7 +6,7 @@
 #   2. the roaming probe over random caps and paths at CASES / 10 cases
 #      (host-tests/tests/cap.rs), the stability bound against the exact one on CASES / 2
 #      random configurations (host-tests/tests/stability.rs), and the force-table bound
-#      over 10⁵ random springs (host-tests/tests/table_bound.rs);
+#      over 10⁵ random springs (host-tests/tests/table_bound/);
 #   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
 # First, the whole host test suite in a release build (link-time optimisation, as
 # docs/cli.md builds the CLI), and that build's stack probes

@@ -480,16 +480,16 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         .replace("shear_modulus = 4.9151e5", "shear_modulus = 1.386e7");
     assert_ne!(stiff_series, TABLE2);
     // A near-cylindrical cone against a soft series spring preloaded to 0.9 F_C (a random
-    // spring of `table_bound.rs`): the graded corner takes the smooth part above the
+    // spring of `table_bound/`): the graded corner takes the smooth part above the
     // preload's kink, up to the domain's end (the solid point lies far past it).
     let near_solid = "[cone]\nwire_diameter = 0.0630138115362447\nsmall_diameter = 0.3519773312502775\nlarge_diameter = 0.4222780483510128\nactive_coils = 1.6042596549155683\ncompressible_height = 0.35952497526300037\nshear_modulus = 248660.54999980563\n\n[linear]\nwire_diameter = 0.19740203691142258\nmean_diameter = 0.1616103995851277\nactive_coils = 7.837305368448284\nshear_modulus = 10.711463844770453\npreload = 2.2667975385647203\n";
     // A preload on the cone's steep rise toward its own solid point (spring 261 of
-    // table_bound.rs): refused before the lower corner, now within the bound, and the
+    // table_bound/): refused before the lower corner, now within the bound, and the
     // header says that the corner lies under the grid.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let steep = std::fs::read_to_string(format!("{root}/params/steep-kink.toml")).unwrap();
     // A stiff series spring whose solid point lies 8e-5 strain short of the domain's end
-    // (spring 43,342 of table_bound.rs's long draw): its corner has twelve octaves.
+    // (spring 43,342 of table_bound/'s long draw): its corner has twelve octaves.
     let deep = "[cone]\nwire_diameter = 0.08841261262983599\nsmall_diameter = 0.8856937931006725\nlarge_diameter = 2.1354017962062777\nactive_coils = 1.7330631953425195\ncompressible_height = 0.9491764266538272\nshear_modulus = 75368.21771890546\n\n[linear]\nwire_diameter = 0.021732733900039335\nmean_diameter = 0.2840336966862483\nactive_coils = 3.353250298619566\nshear_modulus = 1566611236.3573682\n";
     for (name, params, layout) in [
         (
@@ -691,7 +691,7 @@ fn word_after<'a>(text: &'a str, marker: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no {marker:?} in {text}"))
 }
 
-/// A large spring (spring 3,375 of table_bound.rs's long draw: 808 N at `F(0.95)`) whose
+/// A large spring (spring 3,375 of table_bound/'s long draw: 808 N at `F(0.95)`) whose
 /// tension line leaves the force format, ±2048 N, inside the default domain (−2066 N at
 /// −0.5): the table saturates there, and the refusal names the narrower domain that
 /// meets the bound, whose command builds it.

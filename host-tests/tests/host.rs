@@ -44,7 +44,7 @@ mod stability;
 mod swap;
 #[path = "table_accuracy.rs"]
 mod table_accuracy;
-#[path = "table_bound.rs"]
+#[path = "table_bound/mod.rs"]
 mod table_bound;
 #[path = "table_edges.rs"]
 mod table_edges;

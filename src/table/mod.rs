@@ -84,7 +84,7 @@
 //! Each table carries its own measured error against the `f64` law over its domain
 //! ([`ForceTable::max_error`], [`TableBound`]); [`ForceTable::with_bound`] refuses a table
 //! that misses a bound ([`TableError::BoundNotMet`]). Measured against the independent
-//! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound.rs`:
+//! `f64` reference by `host-tests/tests/table_accuracy.rs` and `table_bound/`:
 //! `docs/accuracy.md`.
 
 use crate::q::{self, mul_t, mul_wide, mulhi, mulhi_round, mulhi_u, shr_held};
