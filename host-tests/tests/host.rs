@@ -10,7 +10,7 @@ mod architecture;
 mod arith;
 #[path = "cap.rs"]
 mod cap;
-#[path = "cli.rs"]
+#[path = "cli/mod.rs"]
 mod cli;
 #[path = "contact.rs"]
 mod contact;

@@ -1,0 +1,89 @@
+//! `mccs curve`: the reference's CSV, the fixed backend against it, and its ranges.
+
+use super::*;
+
+#[test]
+fn curve_prints_the_reference_csv() {
+    let out = mccs(&[
+        "curve",
+        "--params",
+        "params/table2.toml",
+        "--from",
+        "-0.2",
+        "--to",
+        "1.3",
+        "--step",
+        "0.1",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("strain,force_n,stiffness_n"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 16);
+    assert_eq!(rows[0][0], -0.2);
+    assert_eq!(rows[15][0], 1.3);
+    let r = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
+    // The reference's values to their last bits: within 2 ULP, because `f64::powi` is not
+    // correctly rounded and its result depends on how the compiler inlined it (a
+    // release build of this test and of the CLI differ by one ULP).
+    let close = |a: f64, b: f64| (a - b).abs() <= 2.0 * f64::EPSILON * b.abs();
+    for row in &rows {
+        assert!(close(row[1], r.force(row[0])), "{row:?}");
+        assert!(close(row[2], r.stiffness(row[0])), "{row:?}");
+    }
+    assert!(rows.windows(2).all(|w| w[1][1] > w[0][1]));
+}
+
+#[test]
+fn curve_fixed_backend_tracks_reference() {
+    let args = |b| {
+        mccs(&[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            "-0.5",
+            "--to",
+            "0.95",
+            "--step",
+            "0.01",
+            "--backend",
+            b,
+        ])
+    };
+    let (a, b) = (args("reference"), args("fixed"));
+    assert!(a.status.success() && b.status.success());
+    let (a, b) = (
+        String::from_utf8(a.stdout).unwrap(),
+        String::from_utf8(b.stdout).unwrap(),
+    );
+    assert_eq!(a.lines().count(), b.lines().count());
+    for (x, y) in a.lines().zip(b.lines()).skip(1) {
+        let x: Vec<f64> = x.split(',').map(|v| v.parse().unwrap()).collect();
+        let y: Vec<f64> = y.split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(x[0], y[0]);
+        assert!((x[1] - y[1]).abs() < 1e-4, "{x:?} vs {y:?}");
+    }
+}
+
+#[test]
+fn bad_ranges_name_the_argument() {
+    let base = ["curve", "--params", "params/table2.toml"];
+    for (extra, needle) in [
+        (["--from", "0", "--to", "1", "--step", "0"], "--step"),
+        (["--from", "0", "--to", "1", "--step", "-0.1"], "--step"),
+        (["--from", "1", "--to", "0", "--step", "0.1"], "--to"),
+        (["--from", "nan", "--to", "1", "--step", "0.1"], "--from"),
+        (["--from", "0", "--to", "inf", "--step", "0.1"], "--to"),
+        (["--from", "0", "--to", "1", "--step", "1e-12"], "--step"),
+        (["--from", "0", "--to", "x", "--step", "0.1"], "--to"),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra.iter()).copied().collect();
+        assert_usage_error(&mccs(&args), &[needle]);
+    }
+    assert_usage_error(&mccs(&["curve", "--from", "0"]), &["--params"]);
+    assert_usage_error(&mccs(&["frobnicate"]), &["frobnicate"]);
+}

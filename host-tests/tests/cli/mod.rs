@@ -1,0 +1,352 @@
+//! The `mccs` binary as a user runs it: output format, and one-line errors with exit 2.
+//! Here the parameter files, help and usage, the demo check and the progress of long
+//! runs; each subcommand's own in its file.
+
+mod curve;
+mod fit;
+mod patch;
+mod replay;
+mod table;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mccs(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mccs"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run mccs")
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn temp_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mccs-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::File::create(&path)
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    path
+}
+
+/// Asserts exit 2, empty stdout, and one stderr line containing every `needle` — for a
+/// mistake the argument parser finds, followed by one `usage:` hint line.
+fn assert_usage_error(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(out.stdout.is_empty(), "stdout not empty");
+    let lines: Vec<&str> = err.lines().collect();
+    let one_line = lines.len() == 1 || (lines.len() == 2 && lines[1].starts_with("usage: mccs"));
+    assert!(one_line, "not one line (and a usage hint): {err:?}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{err:?} lacks {n:?}");
+    }
+}
+
+/// Asserts exit 2, empty stdout, and exactly one stderr line containing every `needle` —
+/// for a mistake found past the argument parser (no usage hint).
+fn assert_one_line_error(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(out.stdout.is_empty(), "stdout not empty");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} lacks {n:?}");
+    }
+}
+
+const TABLE2: &str = include_str!("../../../params/table2.toml");
+
+#[test]
+fn bad_files_name_file_and_key() {
+    let missing = temp_file("missing.toml", &TABLE2.replace("active_coils = 5.0\n", ""));
+    let out = mccs(&[
+        "curve",
+        "--params",
+        missing.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["missing.toml", "cone.active_coils", "missing"]);
+
+    let neg = temp_file(
+        "neg.toml",
+        &TABLE2.replace("mean_diameter = 0.2", "mean_diameter = -0.2"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        neg.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["neg.toml", "linear.mean_diameter", "> 0"]);
+
+    let nan = temp_file(
+        "nan.toml",
+        &TABLE2.replace("shear_modulus = 1.8472e5", "shear_modulus = nan"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        nan.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["nan.toml", "cone.shear_modulus", "finite"]);
+
+    let order = temp_file(
+        "order.toml",
+        &TABLE2.replace("large_diameter = 0.8", "large_diameter = 0.3"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        order.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["order.toml", "cone.large_diameter"]);
+
+    let text = temp_file(
+        "text.toml",
+        &TABLE2.replace("active_coils = 10.0", "active_coils = \"ten\""),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        text.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["text.toml", "linear.active_coils", "number"]);
+
+    let typo = temp_file(
+        "typo.toml",
+        &TABLE2.replace("wire_diameter = 0.1", "wire_diametr = 0.1"),
+    );
+    let out = mccs(&[
+        "curve",
+        "--params",
+        typo.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["typo.toml", "cone.wire_diametr", "unknown"]);
+
+    let bad = temp_file("bad.toml", "[cone\nwire_diameter = 1");
+    let out = mccs(&[
+        "curve",
+        "--params",
+        bad.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["bad.toml", "line 1", "TOML"]);
+
+    let out = mccs(&[
+        "curve",
+        "--params",
+        "no/such.toml",
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["no/such.toml", "cannot read"]);
+
+    let pre = temp_file("pre.toml", &format!("{TABLE2}preload = 11.0\n"));
+    let out = mccs(&[
+        "curve",
+        "--params",
+        pre.to_str().unwrap(),
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--step",
+        "0.1",
+    ]);
+    assert_usage_error(&out, &["pre.toml", "linear.preload"]);
+}
+
+/// The front door: a bare `mccs` prints its full help; a usage error names the argument
+/// and gives a usage hint; `demo --check` takes only a demo log of its core whose SUMMARY
+/// equals the host's run, with the exit statuses its help states.
+#[test]
+fn help_usage_and_the_demo_check() {
+    let out = mccs(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for sub in ["curve", "table", "fit", "demo", "patch", "replay"] {
+        assert!(help.contains(sub), "{help}");
+    }
+    let out = mccs(&["curve", "--params", "x", "--frm", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.lines().next().unwrap().contains("--frm"), "{err}");
+    assert!(
+        err.contains("tip: a similar argument exists: '--from'"),
+        "{err}"
+    );
+    assert!(
+        err.lines().nth(1).unwrap().starts_with("usage: mccs curve"),
+        "{err}"
+    );
+
+    let host = String::from_utf8(mccs(&["demo", "--core", "m3"]).stdout).unwrap();
+    let summary = host.trim();
+    let start = "INFO  mccs haptic demo: core=m3 tick=1000 Hz, …";
+    let old_summary = summary.split(" window_shifts=").next().unwrap().to_owned();
+    let cases: [(&str, String, Option<i32>); 8] = [
+        (
+            "good.log",
+            format!("{start}\nINFO  tick=100 …\n{summary}\n"),
+            Some(0),
+        ),
+        ("readme.log", format!("# README\n{summary}\n"), Some(2)),
+        (
+            "other-core.log",
+            format!("INFO  mccs haptic demo: core=m0 …\n{summary}\n"),
+            Some(2),
+        ),
+        (
+            "unfinished.log",
+            format!("{start}\nINFO  tick=100 …\n"),
+            Some(2),
+        ),
+        (
+            "overrun.log",
+            format!("{start}\n{}\n", summary.replace("overruns=0", "overruns=3")),
+            Some(1),
+        ),
+        (
+            "digits.log",
+            format!("{start}\n{}\n", summary.replace("ticks=4000", "ticks=3999")),
+            Some(1),
+        ),
+        (
+            "old-firmware.log",
+            format!("{start}\n{old_summary}\n"),
+            Some(2),
+        ),
+        (
+            "shifts.log",
+            format!(
+                "{start}\n{}\n",
+                summary.replace("window_shifts=", "window_shifts=9")
+            ),
+            Some(1),
+        ),
+    ];
+    for (name, text, status) in cases {
+        let f = temp_file(name, &text);
+        let out = mccs(&["demo", "--core", "m3", "--check", f.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), status, "{name}: {err}");
+        if status != Some(0) {
+            assert_eq!(err.lines().count(), 1, "{name}: {err}");
+            assert!(err.contains(name), "{name}: {err}");
+        }
+    }
+}
+
+/// The palpation replayed on a 64 × 64 tissue with friction 0.6 / 0.4.
+const PALPATION: [&str; 9] = [
+    "replay",
+    "--params",
+    "params/table2.toml",
+    "--probe",
+    "params/palpation.csv",
+    "--tissue",
+    "64,64",
+    "--friction",
+    "0.6,0.4",
+];
+
+/// A run that takes long says how far it is on stderr, every period (2 s; here 1 ms, by
+/// `MCCS_PROGRESS_MS`), and its stdout is the same; a short run says nothing.
+#[test]
+fn long_runs_report_progress_on_stderr() {
+    let runs: [&[&str]; 2] = [
+        &[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/stroke.csv",
+        ],
+        &[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--duration",
+            "0.5",
+        ],
+    ];
+    for (args, command, total) in [(runs[0], "replay", "3.0"), (runs[1], "patch", "0.5")] {
+        let quiet = mccs(args);
+        assert!(quiet.status.success());
+        assert!(
+            quiet.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&quiet.stderr)
+        );
+        let told = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(args)
+            .current_dir(root())
+            .env("MCCS_PROGRESS_MS", "1")
+            .output()
+            .expect("run mccs");
+        assert!(told.status.success());
+        assert_eq!(told.stdout, quiet.stdout, "{command}: the same output");
+        let err = String::from_utf8_lossy(&told.stderr);
+        let lines: Vec<&str> = err.lines().collect();
+        let prefix = format!("mccs {command}: ");
+        let of = format!(" of {total} s simulated, ");
+        assert!(
+            !lines.is_empty()
+                && lines
+                    .iter()
+                    .all(|l| l.starts_with(&prefix) && l.contains(&of) && l.ends_with(" s so far")),
+            "{command}: {err}"
+        );
+    }
+}

@@ -1,0 +1,167 @@
+//! `mccs patch`: the indentation run, its arguments, and its integrators.
+
+use super::*;
+
+fn patch_rows(args: &[&str]) -> Vec<(f64, f64)> {
+    let mut all = vec!["patch", "--params", "params/table2.toml"];
+    all.extend_from_slice(args);
+    let out = mccs(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("time_s,reaction_n"));
+    lines
+        .map(|l| {
+            let (t, r) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), r.parse().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn patch_defaults_end_settled() {
+    let base = ["--grid", "5", "--spacing", "2.5", "--indent", "0.8"];
+    let run = |backend: &str, extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend_from_slice(&["--backend", backend]);
+        a.extend_from_slice(extra);
+        patch_rows(&a)
+    };
+    let short = run("reference", &[]);
+    assert_eq!(short.len(), 1000);
+    assert_eq!(short[0].0, 0.001);
+    assert_eq!(short[999].0, 1.0);
+    // The ramp: the reaction grows over the first half.
+    assert!(short[100].1 < short[400].1);
+    let long = run("reference", &["--duration", "4"]);
+    let settled = long.last().unwrap().1;
+    let last = short.last().unwrap().1;
+    assert!(
+        (last - settled).abs() <= 1e-4 * settled,
+        "{last} vs {settled}"
+    );
+    let fixed = run("fixed", &[]);
+    let f = fixed.last().unwrap().1;
+    assert!((f - settled).abs() <= 5e-3 * settled, "{f} vs {settled}");
+}
+
+#[test]
+fn patch_errors_name_the_argument() {
+    let base = [
+        "patch",
+        "--params",
+        "params/table2.toml",
+        "--backend",
+        "fixed",
+    ];
+    for (extra, needle) in [
+        (
+            ["--grid", "2", "--spacing", "2.5", "--indent", "0.8"],
+            "--grid",
+        ),
+        (
+            ["--grid", "13", "--spacing", "2.5", "--indent", "0.8"],
+            "--grid",
+        ),
+        (
+            ["--grid", "5", "--spacing", "0", "--indent", "0.8"],
+            "--spacing",
+        ),
+        (
+            ["--grid", "5", "--spacing", "nan", "--indent", "0.8"],
+            "--spacing",
+        ),
+        (
+            ["--grid", "5", "--spacing", "2.5", "--indent", "-1"],
+            "--indent",
+        ),
+        (
+            ["--grid", "5", "--spacing", "2.5", "--indent", "9"],
+            "--indent: must be 0 … 2.5 mm",
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra.iter()).copied().collect();
+        assert_usage_error(&mccs(&args), &[needle]);
+    }
+    let ok = ["--grid", "5", "--spacing", "2.5", "--indent", "0.8"];
+    for (extra, needle) in [
+        (["--rate", "0"], "--rate"),
+        (["--rate", "1.5"], "--rate"),
+        (["--duration", "0"], "--duration"),
+        (["--duration", "100"], "--duration"),
+    ] {
+        let args: Vec<&str> = base
+            .iter()
+            .chain(ok.iter())
+            .chain(extra.iter())
+            .copied()
+            .collect();
+        assert_usage_error(&mccs(&args), &[needle]);
+    }
+    // The patch has defaults (N = 5, 2.5 mm, the reference backend); the depth has none.
+    assert_usage_error(
+        &mccs(&["patch", "--params", "params/table2.toml", "--grid", "5"]),
+        &["--indent"],
+    );
+    // --arith is for the fixed backend only.
+    assert_usage_error(
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--arith",
+            "narrow",
+        ]),
+        &["--arith"],
+    );
+}
+
+/// `--integrator symplectic-damped` runs the option in either backend: the settled force
+/// of an indentation is the paper's integrator's (the same equilibrium), and a name
+/// that is not an integrator is a usage error naming the argument.
+#[test]
+fn patch_runs_either_integrator_to_the_same_settled_force() {
+    let settled = |backend: &str, integrator: &str| -> f64 {
+        let out = mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1.2",
+            "--backend",
+            backend,
+            "--integrator",
+            integrator,
+        ]);
+        assert!(out.status.success(), "{backend} {integrator}: {out:?}");
+        let text = String::from_utf8(out.stdout).unwrap();
+        let last = text.lines().last().unwrap();
+        last.split(',').nth(1).unwrap().parse().unwrap()
+    };
+    for backend in ["reference", "fixed"] {
+        let paper = settled(backend, "improved-euler");
+        let option = settled(backend, "symplectic-damped");
+        assert!(
+            (paper - option).abs() <= 1e-5 * paper,
+            "{backend}: {paper} vs {option}"
+        );
+    }
+    assert_usage_error(
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "1",
+            "--integrator",
+            "heun",
+        ]),
+        &["--integrator"],
+    );
+}

@@ -1,0 +1,179 @@
+//! `mccs replay`: the roaming probe on a tissue with friction, its arguments, and the
+//! core against the reference.
+
+use super::*;
+
+#[test]
+fn replay_roams_a_tissue_with_friction() {
+    let out = mccs(&PALPATION);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "stderr: {err}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some(
+            "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts"
+        )
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 7401);
+    // Sliding +x at 10 mm/s (t = 1 … 3.5 s): slipping, the friction against the motion
+    // at μ_k = 0.4 of the normal force (the rest normal is z on a flat tissue).
+    for r in rows.iter().filter(|r| (1.0..3.5).contains(&r[0])) {
+        assert_eq!(
+            (r[7], r[8]),
+            (1.0, 1.0),
+            "t = {}: not a slipping contact",
+            r[0]
+        );
+        let ratio = -r[1] / r[3];
+        assert!(
+            (ratio - 0.4).abs() < 0.4 * 0.02,
+            "t = {}: ratio {ratio}",
+            r[0]
+        );
+    }
+    // 30 mm out and back across a 2.5 mm grid: the window moved at every node.
+    let last = rows.last().unwrap();
+    assert!(last[9] >= 20.0, "{} window shifts", last[9]);
+    assert_eq!((last[1], last[2], last[3], last[7]), (0.0, 0.0, 0.0, 0.0));
+}
+
+#[test]
+fn replay_roaming_errors_name_the_argument() {
+    let base = [
+        "replay",
+        "--params",
+        "params/table2.toml",
+        "--probe",
+        "params/palpation.csv",
+    ];
+    for (extra, needles) in [
+        (
+            &[
+                "--backend",
+                "fixed",
+                "--tissue",
+                "64,64",
+                "--cap-radius",
+                "2500",
+            ][..],
+            &["--cap-radius", "2000 mm"][..],
+        ),
+        (
+            // A cap whose corner cell's diagonal is longer than the M0's arithmetic takes.
+            &[
+                "--backend",
+                "fixed",
+                "--arith",
+                "narrow",
+                "--tissue",
+                "21,21",
+                "--spacing",
+                "10",
+                "--cap-radius",
+                "189",
+            ][..],
+            &["--cap-radius", "the arithmetic's longest"][..],
+        ),
+        (&["--tissue", "2,64"], &["--tissue", "3..=64"]),
+        (&["--tissue", "64"], &["--tissue", "W,H"]),
+        (&["--tissue", "64,x"], &["--tissue", "W,H"]),
+        (
+            &["--tissue", "64,64", "--friction", "0.3"],
+            &["--friction", "MU_S,MU_K"],
+        ),
+        (
+            &["--tissue", "64,64", "--friction", "3,1"],
+            &["--friction", "[0, 2]"],
+        ),
+        (
+            &["--friction", "0.3,0.2"],
+            &["--friction", "only with --tissue"],
+        ),
+        (
+            &["--probe-radius", "1"],
+            &["--probe-radius", "only with --tissue"],
+        ),
+        (
+            &["--tissue", "64,64", "--probe-radius", "2"],
+            &["--probe-radius"],
+        ),
+        (
+            &["--tissue", "64,64", "--probe-radius", "NaN"],
+            &["--probe-radius"],
+        ),
+        (
+            &["--tissue", "64,64", "--cap-radius", "10"],
+            &["--cap-radius"],
+        ),
+        (&["--tissue", "8,8", "--grid", "9"], &["--grid"]),
+        (
+            &["--tissue", "64,64", "--spacing", "4"],
+            &["--spacing", "100 mm"],
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        assert_usage_error(&mccs(&args), needles);
+    }
+}
+
+#[test]
+fn replay_roams_in_the_core_as_in_the_reference() {
+    let run = |extra: &[&str]| -> Vec<Vec<f64>> {
+        let mut args = PALPATION.to_vec();
+        args.extend_from_slice(extra);
+        let out = mccs(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "stderr: {err}");
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    // Flat, and over a cap (R = 200 mm: the path's 1 mm below the top is 0.44 … 1 mm
+    // deep); and flat with the symplectic integrator option in both backends.
+    for shape in [
+        &[][..],
+        &["--cap-radius", "200"][..],
+        &["--integrator", "symplectic-damped"][..],
+    ] {
+        let reference = run(shape);
+        for extra in [
+            &["--backend", "fixed"][..],
+            &["--backend", "fixed", "--arith", "narrow"],
+        ] {
+            let extra = [extra, shape].concat();
+            let fixed = run(&extra);
+            assert_eq!(fixed.len(), reference.len());
+            for (f, r) in fixed.iter().zip(&reference) {
+                let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
+                let diff =
+                    ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
+                assert!(
+                    diff <= 0.02 + 0.02 * mag,
+                    "{extra:?} t = {}: {f:?} against {r:?}",
+                    r[0]
+                );
+                let proxy =
+                    ((f[4] - r[4]).powi(2) + (f[5] - r[5]).powi(2) + (f[6] - r[6]).powi(2)).sqrt();
+                assert!(
+                    proxy <= 0.01,
+                    "{extra:?} t = {}: the proxy is {proxy} mm off",
+                    r[0]
+                );
+                assert_eq!(
+                    (f[7], f[8], f[9]),
+                    (r[7], r[8], r[9]),
+                    "{extra:?} t = {}: contact, slip, shifts",
+                    r[0]
+                );
+            }
+        }
+    }
+}
