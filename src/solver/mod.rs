@@ -8,8 +8,9 @@
 //! virtual [`crate::Coupling`]; the device renders the coupling force.
 //!
 //! - `config.rs`: [`SolverConfig`] and its ranges; `error.rs`: [`SolverError`];
-//! - `stability.rs`: the substeps per tick the integrator needs (the one-step matrix, a
-//!   closed-form and an estimated bound);
+//! - `stability/`: the substeps per tick the integrator needs (the one-step matrix, a
+//!   closed-form and an estimated bound; the estimate's linearised step in block fixed
+//!   point in `linearised.rs`);
 //! - `param_set.rs`: [`ParamSet`], prepared away from the tick and switched in between two;
 //! - `step.rs`: the tick itself.
 //!
