@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 LOG_DIR=target/fuzz
 source scripts/lib.sh  # run_stage: says what runs, ticks every 10 s, logs to target/fuzz/
 seconds=${1:-60}
+[[ $seconds =~ ^[1-9][0-9]*$ ]] || { say "usage: scripts/fuzz.sh [SECONDS] (a positive integer; not '$seconds')"; exit 2; }
 if ! rustup toolchain list | grep -q '^nightly'; then
   echo "fuzz.sh: installing the nightly toolchain (rustup toolchain install nightly)" >&2
   rustup toolchain install nightly --profile minimal >&2

@@ -21,6 +21,9 @@ LOG_DIR=target/logs/long
 source scripts/lib.sh
 cases=${1:-50000}
 fuzz_seconds=${2:-300}
+for n in "$cases" "$fuzz_seconds"; do
+  [[ $n =~ ^[1-9][0-9]*$ ]] || { say "usage: scripts/long.sh [CASES] [FUZZ_SECONDS] (positive integers; not '$n')"; exit 2; }
+done
 start=$SECONDS
 # (fd 3: the terminal's stderr, for the table bound's own progress lines inside a stage.)
 exec 3>&2
