@@ -8,6 +8,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/lib.sh  # core_target
 mode=${1:-check}
+case "$mode" in
+  check | --update | --check-log) ;;
+  *) echo "usage: scripts/bench.sh [--update | --check-log CORE LOG] (not '$mode')" >&2; exit 2 ;;
+esac
 # Whether a bench log ran to its end: the firmware's last act is its budget check.
 complete() { grep -q "^BUDGET core=$1 " "$2"; }
 # `scripts/bench.sh --check-log CORE LOG`: only that (the test command's check of it).

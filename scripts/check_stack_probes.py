@@ -49,9 +49,13 @@ def suspects(path):
 
 def main():
     if len(sys.argv) != 2:
-        print(__doc__.strip().splitlines()[-1].strip(), file=sys.stderr)
+        print("usage: " + __doc__.strip().splitlines()[-1].strip(), file=sys.stderr)
         return 2
-    hits, probed = suspects(sys.argv[1])
+    try:
+        hits, probed = suspects(sys.argv[1])
+    except OSError as e:
+        print(f"check_stack_probes: {sys.argv[1]}: {e.strerror}", file=sys.stderr)
+        return 2
     for name, writes in hits:
         print(f"STACKPROBE r11 written before the probe loop: {name} ({'; '.join(writes)})")
     # (No probe loop at all would make the check vacuous: that fails too.)

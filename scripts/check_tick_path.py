@@ -40,7 +40,13 @@ FLOAT_INSN = re.compile(r"^\s*v[a-z0-9]+(\.[a-z]+)*\.f(32|64)\b")
 
 
 def main() -> int:
+    if not 2 <= len(sys.argv) <= 4:
+        print("usage: check_tick_path.py ELF [ENTRY [INIT]]", file=sys.stderr)
+        return 2
     elf = sys.argv[1]
+    if not Path(elf).is_file():
+        print(f"check_tick_path: {elf}: no such file (build the release firmware first)", file=sys.stderr)
+        return 2
     entry = sys.argv[2] if len(sys.argv) > 2 else "SysTick"
     text = subprocess.run([objdump(), "-d", "-C", "--no-show-raw-insn", elf], capture_output=True, text=True, check=True).stdout
     funcs: dict[str, list[str]] = {}

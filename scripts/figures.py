@@ -113,6 +113,9 @@ def docs():
 
 def main() -> int:
     mode = sys.argv[1] if len(sys.argv) > 1 else "check"
+    if mode not in ("check", "update", "list") or len(sys.argv) > 2:
+        print("usage: scripts/figures.py [check|update|list]", file=sys.stderr)
+        return 2
     figs = figures()
     if mode == "list":
         for k in sorted(figs):

@@ -36,21 +36,42 @@ MACHINES = {
 }
 
 
+USAGE = "usage: scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines] [--mix PATTERN]"
+
+
+def usage(why):
+    print(f"{USAGE} ({why})", file=sys.stderr)
+    sys.exit(2)
+
+
+def option_value(name):
+    """The value after option `name`, or None when it is absent."""
+    if name not in sys.argv:
+        return None
+    i = sys.argv.index(name)
+    if i + 1 >= len(sys.argv) or sys.argv[i + 1].startswith("--"):
+        usage(f"{name} needs a value")
+    return sys.argv[i + 1]
+
+
 def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    known = {"--top", "--lines", "--mix"}
+    for a in sys.argv[1:]:
+        if a.startswith("--") and a not in known:
+            usage(f"unknown option {a}")
+    top_arg, mix = option_value("--top"), option_value("--mix")
     top = 40
-    if "--top" in sys.argv:
-        top = int(sys.argv[sys.argv.index("--top") + 1])
-        args = [a for a in args if a != str(top)]
+    if top_arg is not None:
+        if not top_arg.isdigit() or int(top_arg) == 0:
+            usage(f"--top must be a positive integer, not '{top_arg}'")
+        top = int(top_arg)
     by_line = "--lines" in sys.argv
-    mix = None
-    if "--mix" in sys.argv:
-        mix = sys.argv[sys.argv.index("--mix") + 1]
-        args = [a for a in args if a != mix]
+    values = {sys.argv.index(o) + 1 for o in ("--top", "--mix") if o in sys.argv}
+    args = [a for i, a in enumerate(sys.argv) if i > 0 and i not in values and not a.startswith("--")]
     if not args or args[0] not in TARGETS:
-        print("usage: scripts/profile.py m4f|m3|m0 [bin] [--top N] [--lines] [--mix PATTERN]",
-              file=sys.stderr)
-        sys.exit(2)
+        usage("the core first")
+    if len(args) > 2:
+        usage(f"one bin at most, not {args[1:]}")
     core, binary = args[0], (args[1] if len(args) > 1 else "haptic")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     target = TARGETS[core]

@@ -15,7 +15,14 @@ def tool(name: str) -> str:
 
 
 def main() -> int:
-    elf, target, binary, flash_max, ram_max = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5])
+    args = sys.argv[1:]
+    if len(args) != 5 or not args[3].isdigit() or not args[4].isdigit():
+        print("usage: size.py ELF TARGET BIN FLASH_MAX RAM_MAX (the budgets in bytes)", file=sys.stderr)
+        return 2
+    elf, target, binary, flash_max, ram_max = args[0], args[1], args[2], int(args[3]), int(args[4])
+    if not Path(elf).is_file():
+        print(f"size: {elf}: no such file (build the release firmware first)", file=sys.stderr)
+        return 2
     out = subprocess.run([tool("llvm-size"), "-A", elf], capture_output=True, text=True, check=True).stdout
     sec = {}
     for line in out.splitlines():

@@ -34,6 +34,8 @@ mod reference_law;
 mod replay;
 #[path = "roam.rs"]
 mod roam;
+#[path = "scripts.rs"]
+mod scripts;
 #[path = "solver_properties.rs"]
 mod solver_properties;
 #[path = "spring_sweep.rs"]
