@@ -21,12 +21,20 @@ use corner::{corner_inner, CornerEnd};
 use grid::Align;
 
 impl<const S: usize> ForceTable<S> {
-    /// Builds the table for `params` over the default domain [−0.5, 0.95].
+    /// Builds the table for `params` over the default domain [−0.5, 0.95]: one
+    /// placement of the uniform grid ([`ForceTable::from_law`]), not measured and held to
+    /// no bound. That serves Table 2 and springs like it; a spring whose law bends hard
+    /// (a stiff series spring near its solid point, a preload near `F_C`) can be far
+    /// outside the product's bound (`docs/accuracy.md`, "Accuracy against the f64
+    /// reference"). For a table held to the bound, use `mccs table` and `include!` its
+    /// output, or [`ForceTable::with_bound`]; [`ForceTable::measured`] and
+    /// [`ForceTable::max_error`] tell what a table reaches.
     pub fn new(params: &Params) -> Result<Self, TableError> {
         Self::with_domain(params, DEFAULT_DOMAIN.0, DEFAULT_DOMAIN.1)
     }
 
-    /// Builds the table for `params` over the strain domain `[from, to]`.
+    /// Builds the table for `params` over the strain domain `[from, to]`, as
+    /// [`ForceTable::new`] does (one placement, not measured, no bound).
     ///
     /// Runs the `f64` law (software floating point on most cores): call it at start-up or
     /// on the host (`mccs table`), never per tick.
