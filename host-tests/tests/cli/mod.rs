@@ -63,147 +63,63 @@ fn assert_one_line_error(out: &Output, needles: &[&str]) {
 
 const TABLE2: &str = include_str!("../../../params/table2.toml");
 
+/// `mccs curve` over a parameter file: the subcommand that reads one and nothing else.
+fn curve_of(params: &str) -> Output {
+    mccs(&[
+        "curve", "--params", params, "--from", "0", "--to", "1", "--step", "0.1",
+    ])
+}
+
 #[test]
 fn bad_files_name_file_and_key() {
-    let missing = temp_file("missing.toml", &TABLE2.replace("active_coils = 5.0\n", ""));
-    let out = mccs(&[
-        "curve",
-        "--params",
-        missing.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["missing.toml", "cone.active_coils", "missing"]);
-
-    let neg = temp_file(
-        "neg.toml",
-        &TABLE2.replace("mean_diameter = 0.2", "mean_diameter = -0.2"),
-    );
-    let out = mccs(&[
-        "curve",
-        "--params",
-        neg.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["neg.toml", "linear.mean_diameter", "> 0"]);
-
-    let nan = temp_file(
-        "nan.toml",
-        &TABLE2.replace("shear_modulus = 1.8472e5", "shear_modulus = nan"),
-    );
-    let out = mccs(&[
-        "curve",
-        "--params",
-        nan.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["nan.toml", "cone.shear_modulus", "finite"]);
-
-    let order = temp_file(
-        "order.toml",
-        &TABLE2.replace("large_diameter = 0.8", "large_diameter = 0.3"),
-    );
-    let out = mccs(&[
-        "curve",
-        "--params",
-        order.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["order.toml", "cone.large_diameter"]);
-
-    let text = temp_file(
-        "text.toml",
-        &TABLE2.replace("active_coils = 10.0", "active_coils = \"ten\""),
-    );
-    let out = mccs(&[
-        "curve",
-        "--params",
-        text.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["text.toml", "linear.active_coils", "number"]);
-
-    let typo = temp_file(
-        "typo.toml",
-        &TABLE2.replace("wire_diameter = 0.1", "wire_diametr = 0.1"),
-    );
-    let out = mccs(&[
-        "curve",
-        "--params",
-        typo.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["typo.toml", "cone.wire_diametr", "unknown"]);
-
-    let bad = temp_file("bad.toml", "[cone\nwire_diameter = 1");
-    let out = mccs(&[
-        "curve",
-        "--params",
-        bad.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["bad.toml", "line 1", "TOML"]);
-
-    let out = mccs(&[
-        "curve",
-        "--params",
-        "no/such.toml",
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["no/such.toml", "cannot read"]);
-
-    let pre = temp_file("pre.toml", &format!("{TABLE2}preload = 11.0\n"));
-    let out = mccs(&[
-        "curve",
-        "--params",
-        pre.to_str().unwrap(),
-        "--from",
-        "0",
-        "--to",
-        "1",
-        "--step",
-        "0.1",
-    ]);
-    assert_usage_error(&out, &["pre.toml", "linear.preload"]);
+    let cases: [(&str, String, &[&str]); 8] = [
+        (
+            "missing.toml",
+            TABLE2.replace("active_coils = 5.0\n", ""),
+            &["cone.active_coils", "missing"],
+        ),
+        (
+            "neg.toml",
+            TABLE2.replace("mean_diameter = 0.2", "mean_diameter = -0.2"),
+            &["linear.mean_diameter", "> 0"],
+        ),
+        (
+            "nan.toml",
+            TABLE2.replace("shear_modulus = 1.8472e5", "shear_modulus = nan"),
+            &["cone.shear_modulus", "finite"],
+        ),
+        (
+            "order.toml",
+            TABLE2.replace("large_diameter = 0.8", "large_diameter = 0.3"),
+            &["cone.large_diameter"],
+        ),
+        (
+            "text.toml",
+            TABLE2.replace("active_coils = 10.0", "active_coils = \"ten\""),
+            &["linear.active_coils", "number"],
+        ),
+        (
+            "typo.toml",
+            TABLE2.replace("wire_diameter = 0.1", "wire_diametr = 0.1"),
+            &["cone.wire_diametr", "unknown"],
+        ),
+        (
+            "bad.toml",
+            "[cone\nwire_diameter = 1".to_string(),
+            &["line 1", "TOML"],
+        ),
+        (
+            "pre.toml",
+            format!("{TABLE2}preload = 11.0\n"),
+            &["linear.preload"],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let path = temp_file(name, &text);
+        let needles: Vec<&str> = [name].iter().chain(needles).copied().collect();
+        assert_usage_error(&curve_of(path.to_str().unwrap()), &needles);
+    }
+    assert_usage_error(&curve_of("no/such.toml"), &["no/such.toml", "cannot read"]);
 }
 
 /// The front door: a bare `mccs` prints its full help; a usage error names the argument
