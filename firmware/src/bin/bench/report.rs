@@ -169,6 +169,35 @@ pub fn largest_patch(figs: &Figures, steps: &Steps) {
         worst,
         half_tick
     );
+    if steps.integrator == Integrator::ImprovedEuler {
+        next_patch(figs, steps, n.max(2) + 1, half_tick);
+    }
+}
+
+/// The next standard patch, `n` × `n`, one larger than the largest that fits (where this
+/// core measures its substep): what it would take, as a `BENCH` line, `case=next_patch_1khz
+/// n= substeps= instructions= worst_instructions= half_tick_instructions=
+/// substep_to_fit=`, the last the largest measured substep with which its bound would fit
+/// half a tick (its substeps unchanged; 0 where the spread alone fills it).
+fn next_patch(figs: &Figures, steps: &Steps, n: u32, half_tick: u32) {
+    let Some((substeps, tick, worst)) = tick_of(figs, steps, n, 1_000) else {
+        return;
+    };
+    let Some(spread) = figs.get(SPRING_PATH_SPREAD) else {
+        return;
+    };
+    let springs = standard_capacity(n as usize).1 as u32;
+    let to_fit = (half_tick / substeps.max(1)).saturating_sub(springs.saturating_mul(spread));
+    defmt::println!(
+        "BENCH core={=str} case=next_patch_1khz n={=u32} substeps={=u32} instructions={=u32} worst_instructions={=u32} half_tick_instructions={=u32} substep_to_fit={=u32}",
+        CORE.name(),
+        n,
+        substeps,
+        tick,
+        worst,
+        half_tick,
+        to_fit
+    );
 }
 
 /// The substep (s) the default configuration's stability bound takes on the standard
