@@ -67,7 +67,7 @@ table_bound() {
     -- --nocapture table_bound::every_table 2>&1 \
     | tee >(grep --line-buffered "^table_bound:" >&3 || true)
 }
-say "long.sh: the force-table bound over 10^5 random springs (about 36 minutes on one core; docs/reliability.md)"
+say "long.sh: the force-table bound over 10^5 random springs (about 22 minutes on two cores; docs/reliability.md)"
 run_stage table-bound table_bound
 grep -E "^TABLEBOUND " "$LOG_DIR/table-bound.log"
 

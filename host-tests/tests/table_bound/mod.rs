@@ -275,6 +275,21 @@ struct Tally {
     other: usize,
 }
 
+impl Tally {
+    /// Adds `o`'s counts to these.
+    fn add(&mut self, o: &Tally) {
+        self.springs += o.springs;
+        self.met += o.met;
+        self.refused += o.refused;
+        self.over_force += o.over_force;
+        self.over_stiffness += o.over_stiffness;
+        self.format_limited += o.format_limited;
+        self.met_format_limited += o.met_format_limited;
+        self.range_limited += o.range_limited;
+        self.other += o.other;
+    }
+}
+
 /// Whether the law leaves the force format's range, ±2048 N (`mccs::Force`), inside the
 /// domain: a large spring's tension line (`F(−0.5)` beyond −2048 N where `F(0.95)` is
 /// some 500 N or more). The table saturates there; `mccs table` names the narrower
@@ -464,91 +479,160 @@ fn a_refusal_once_confirmed_only_on_a_denser_sweep_now_meets_the_bound() {
     }
 }
 
+/// One spring of [`every_table_meets_the_bound_or_is_refused_with_what_it_reached`]:
+/// built and held to the reference, or its refusal confirmed; counted in `d`, and the
+/// largest errors of a table built within the bound in `worst_met`.
+fn check_spring(p: &Params, d: &mut Tally, worst_met: &mut TableBound) {
+    let bound = TableBound::PRODUCT;
+    d.springs += 1;
+    match ForceTable::<128>::with_bound(p, DOMAIN.0, DOMAIN.1, &bound) {
+        Ok(t) => {
+            // Whatever placement it took (a graded corner toward the solid point, or
+            // above a preload's kink toward the domain's end), it keeps the
+            // invariants the evaluation relies on.
+            assert_eq!(t.validate(), Ok(()), "{p:?}");
+            let m = independent(p, &t);
+            // The two measurements sample different strains: they agree to 2 % of the
+            // bound and two LSBs of the output formats (one Q20 force LSB is 1e-5 of
+            // F(0.95) at 0.1 N).
+            let r = Reference::new(p).unwrap();
+            let allowed = TableBound {
+                force: 1.02 * bound.force + 2.0 * FORCE_LSB / r.force(DOMAIN.1),
+                stiffness: 1.02 * bound.stiffness + 2.0 * STIFFNESS_LSB / smallest_stiffness(&r),
+            };
+            assert!(
+                m.within(&allowed),
+                "{p:?}: built, but the reference finds {m:?}"
+            );
+            assert!(t.max_error().unwrap().within(&bound));
+            // Nothing beats the force format's floor, half an LSB (to a tenth: the
+            // sweep's largest rounding error is just short of it).
+            let law = mccs::Law::new(p).unwrap();
+            let floor = mccs::table::format_floor(&law, DOMAIN.0, DOMAIN.1);
+            assert!(
+                m.force >= 0.9 * floor.force,
+                "{p:?}: {m:?} below the force format's floor {floor:?}"
+            );
+            d.met_format_limited += usize::from(format_limited(p, &bound));
+            worst_met.force = worst_met.force.max(m.force);
+            worst_met.stiffness = worst_met.stiffness.max(m.stiffness);
+            d.met += 1;
+        }
+        Err(TableError::BoundNotMet {
+            force_ppb,
+            stiffness_ppb,
+        }) => {
+            let reported = TableBound::from_ppb(force_ppb, stiffness_ppb);
+            assert!(
+                !reported.within(&bound),
+                "{p:?}: refused within the bound: {reported:?}"
+            );
+            // The refusal is real (`refusal_confirmed`).
+            if let Err(m) = refusal_confirmed(p, &reported, &bound) {
+                panic!("{p:?}: refused at {reported:?}, the reference finds {m:?}");
+            }
+            d.refused += 1;
+            d.over_force += usize::from(reported.force > bound.force);
+            d.over_stiffness += usize::from(reported.stiffness > bound.stiffness);
+            let resolution = format_limited(p, &bound);
+            d.format_limited += usize::from(resolution);
+            d.range_limited += usize::from(!resolution && range_limited(p));
+        }
+        Err(TableError::NoNonlinearPhase | TableError::OutOfRange | TableError::TooNarrow) => {
+            d.other += 1;
+        }
+        Err(e) => panic!("{p:?}: {e}"),
+    }
+}
+
+/// The decade of `k_p/k` a spring's tally goes in (1e-3 … 1e4, seven).
+fn decade_of(ratio: f64) -> usize {
+    ((ratio.log10() + 3.0).floor() as usize).min(6)
+}
+
 #[test]
 fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
-    let bound = TableBound::PRODUCT;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
+    let (n, first) = (springs(), first_spring());
+    if first > 0 {
+        eprintln!("table_bound: springs {first} to {n} (those before drawn, not checked)");
+    }
+    // Drawn in order (the same springs whatever the threads), then checked on every core
+    // (the test command's tail, and the long run's 10⁵ springs, take half the time on two),
+    // each worker taking every `workers`-th spring; the tallies are sums and maxima, the
+    // same in any order.
+    let drawn: Vec<(Params, f64)> = (0..n).map(|_| spring(&mut rng)).collect();
+    let todo = drawn.get(first..).unwrap_or(&[]);
+    let workers = std::thread::available_parallelism().map_or(1, |w| w.get().min(8));
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    // Set by a worker that fails, so that the others stop instead of running on (for
+    // minutes in the long run).
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    // (It also names the spring that failed, by its place in the draw, from which
+    // `TABLE_BOUND_FROM` resumes.)
+    struct StopOthers<'a>(&'a std::sync::atomic::AtomicBool, usize);
+    impl Drop for StopOthers<'_> {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+                eprintln!(
+                    "table_bound: spring {} failed (TABLE_BOUND_FROM={0} resumes from it)",
+                    self.1
+                );
+            }
+        }
+    }
+    let tallies: Vec<([Tally; 7], TableBound)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..workers)
+            .map(|w| {
+                let (done, failed) = (&done, &failed);
+                s.spawn(move || {
+                    let mut stop = StopOthers(failed, 0);
+                    let mut decades = [Tally::default(); 7];
+                    let mut worst = TableBound {
+                        force: 0.0,
+                        stiffness: 0.0,
+                    };
+                    for (i, (p, ratio)) in todo.iter().enumerate().skip(w).step_by(workers) {
+                        if failed.load(std::sync::atomic::Ordering::Relaxed) {
+                            break;
+                        }
+                        stop.1 = first + i;
+                        check_spring(p, &mut decades[decade_of(*ratio)], &mut worst);
+                        done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    }
+                    (decades, worst)
+                })
+            })
+            .collect();
+        // Progress every 10 s (the long run's 10⁵ springs take about 20 minutes on two
+        // cores).
+        let mut said = std::time::Instant::now();
+        while !handles.iter().all(|h| h.is_finished()) {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            if said.elapsed().as_secs() >= 10 {
+                let checked = done.load(std::sync::atomic::Ordering::Relaxed);
+                eprintln!("table_bound: {} of {n} springs", first + checked);
+                said = std::time::Instant::now();
+            }
+        }
+        // A worker's failure fails the test with its own message.
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
     let mut decades = [Tally::default(); 7];
     let mut worst_met = TableBound {
         force: 0.0,
         stiffness: 0.0,
     };
-    let (n, first) = (springs(), first_spring());
-    if first > 0 {
-        eprintln!("table_bound: springs {first} to {n} (those before drawn, not checked)");
-    }
-    let mut said = std::time::Instant::now();
-    for i in 0..n {
-        // Progress every 10 s (the long run's 10⁵ springs take about 40 minutes).
-        if said.elapsed().as_secs() >= 10 {
-            eprintln!("table_bound: {i} of {n} springs");
-            said = std::time::Instant::now();
+    for (t, worst) in &tallies {
+        for (d, w) in decades.iter_mut().zip(t) {
+            d.add(w);
         }
-        let (p, ratio) = spring(&mut rng);
-        if i < first {
-            continue;
-        }
-        let d = &mut decades[((ratio.log10() + 3.0).floor() as usize).min(6)];
-        d.springs += 1;
-        match ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &bound) {
-            Ok(t) => {
-                // Whatever placement it took (a graded corner toward the solid point, or
-                // above a preload's kink toward the domain's end), it keeps the
-                // invariants the evaluation relies on.
-                assert_eq!(t.validate(), Ok(()), "{p:?}");
-                let m = independent(&p, &t);
-                // The two measurements sample different strains: they agree to 2 % of the
-                // bound and two LSBs of the output formats (one Q20 force LSB is 1e-5 of
-                // F(0.95) at 0.1 N).
-                let r = Reference::new(&p).unwrap();
-                let allowed = TableBound {
-                    force: 1.02 * bound.force + 2.0 * FORCE_LSB / r.force(DOMAIN.1),
-                    stiffness: 1.02 * bound.stiffness
-                        + 2.0 * STIFFNESS_LSB / smallest_stiffness(&r),
-                };
-                assert!(
-                    m.within(&allowed),
-                    "{p:?}: built, but the reference finds {m:?}"
-                );
-                assert!(t.max_error().unwrap().within(&bound));
-                // Nothing beats the force format's floor, half an LSB (to a tenth: the
-                // sweep's largest rounding error is just short of it).
-                let law = mccs::Law::new(&p).unwrap();
-                let floor = mccs::table::format_floor(&law, DOMAIN.0, DOMAIN.1);
-                assert!(
-                    m.force >= 0.9 * floor.force,
-                    "{p:?}: {m:?} below the force format's floor {floor:?}"
-                );
-                d.met_format_limited += usize::from(format_limited(&p, &bound));
-                worst_met.force = worst_met.force.max(m.force);
-                worst_met.stiffness = worst_met.stiffness.max(m.stiffness);
-                d.met += 1;
-            }
-            Err(TableError::BoundNotMet {
-                force_ppb,
-                stiffness_ppb,
-            }) => {
-                let reported = TableBound::from_ppb(force_ppb, stiffness_ppb);
-                assert!(
-                    !reported.within(&bound),
-                    "{p:?}: refused within the bound: {reported:?}"
-                );
-                // The refusal is real (`refusal_confirmed`).
-                if let Err(m) = refusal_confirmed(&p, &reported, &bound) {
-                    panic!("{p:?}: refused at {reported:?}, the reference finds {m:?}");
-                }
-                d.refused += 1;
-                d.over_force += usize::from(reported.force > bound.force);
-                d.over_stiffness += usize::from(reported.stiffness > bound.stiffness);
-                let resolution = format_limited(&p, &bound);
-                d.format_limited += usize::from(resolution);
-                d.range_limited += usize::from(!resolution && range_limited(&p));
-            }
-            Err(TableError::NoNonlinearPhase | TableError::OutOfRange | TableError::TooNarrow) => {
-                d.other += 1;
-            }
-            Err(e) => panic!("{p:?}: {e}"),
-        }
+        worst_met.force = worst_met.force.max(worst.force);
+        worst_met.stiffness = worst_met.stiffness.max(worst.stiffness);
     }
     let mut all = Tally::default();
     for (i, d) in decades.iter().enumerate() {
@@ -566,15 +650,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
             d.met_format_limited,
             d.other
         );
-        all.format_limited += d.format_limited;
-        all.met_format_limited += d.met_format_limited;
-        all.range_limited += d.range_limited;
-        all.over_force += d.over_force;
-        all.over_stiffness += d.over_stiffness;
-        all.springs += d.springs;
-        all.met += d.met;
-        all.refused += d.refused;
-        all.other += d.other;
+        all.add(d);
     }
     // Refused for where the knots are: neither the formats' resolution nor their range.
     let placement = all.refused - all.format_limited - all.range_limited;
