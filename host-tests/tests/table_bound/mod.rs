@@ -605,7 +605,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
                 })
             })
             .collect();
-        // Progress every 10 s (the long run's 10⁵ springs take about 20 minutes on two
+        // Progress every 10 s (the long run's 10⁵ springs take about 22 minutes on two
         // cores).
         let mut said = std::time::Instant::now();
         while !handles.iter().all(|h| h.is_finished()) {
