@@ -2,11 +2,11 @@
 //! (a 20 mm stroke with a stiff coupling), and a press–stroke–lift along `y`, on both
 //! backends and in both arithmetics: after lift-off every node comes back to rest.
 
+use crate::cli::{mccs, mccs_ok};
 use mccs::{Coupling, Params, SolverConfig};
 use mccs_host::replay::{Engine, Replay, Row};
 use mccs_host::trajectory::{self, Trajectory};
 use std::path::PathBuf;
-use std::process::Command;
 
 /// Press 1.2 mm, stroke `stroke` mm along `axis` at 20 mm/s, lift off, and wait 4 s.
 fn press_stroke_lift(axis: usize, stroke: f64) -> Trajectory {
@@ -94,14 +94,6 @@ fn the_replayed_forces_stay_within_the_device_maximum() {
     }
 }
 
-fn mccs(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mccs"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
-        .output()
-        .unwrap()
-}
-
 fn temp(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mccs-replay-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -128,12 +120,7 @@ fn the_cli_prints_one_row_per_tick() {
             traj.to_str().unwrap(),
         ];
         args.extend(backend);
-        let out = mccs(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = mccs_ok(&args);
         let text = String::from_utf8(out.stdout).unwrap();
         let mut lines = text.lines();
         assert_eq!(

@@ -7,7 +7,7 @@ fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
     let dir = std::env::temp_dir().join(format!("mccs-fit-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (toml, svg) = (dir.join("fitted.toml"), dir.join("fit.svg"));
-    let out = mccs(&[
+    let out = mccs_ok(&[
         "fit",
         "--data",
         "params/demo-data.csv",
@@ -18,11 +18,6 @@ fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
         "--plot",
         svg.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let text = String::from_utf8(out.stdout).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 3);
@@ -35,12 +30,7 @@ fn fit_prints_one_line_per_model_and_writes_usable_parameters() {
     }
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
     // The fitted file feeds `mccs table` directly.
-    let out = mccs(&["table", "--params", toml.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    mccs_ok(&["table", "--params", toml.to_str().unwrap()]);
     let one = mccs(&["fit", "--data", "params/demo-data.csv", "--model", "mcs"]);
     assert_eq!(String::from_utf8(one.stdout).unwrap().lines().count(), 1);
 }
@@ -123,12 +113,7 @@ fn fit_rejects_what_the_models_cannot_take_and_checks_outputs_first() {
         big.push_str(&format!("{:.9},{f:.9}\n", law.delta(f)));
     }
     let f = temp_file("big.csv", &big);
-    let out = mccs(&["fit", "--data", f.to_str().unwrap(), "--model", "mccs"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = mccs_ok(&["fit", "--data", f.to_str().unwrap(), "--model", "mccs"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("3000 rows: fitting on 1000"), "{err}");
     let stdout = String::from_utf8_lossy(&out.stdout);

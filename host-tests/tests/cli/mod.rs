@@ -12,12 +12,25 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn mccs(args: &[&str]) -> Output {
+/// Runs the CLI from the repository root (the replay tests' too).
+pub(crate) fn mccs(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mccs"))
         .args(args)
         .current_dir(root())
         .output()
         .expect("run mccs")
+}
+
+/// [`mccs`], which must succeed: a failure shows the arguments and the CLI's stderr.
+pub(crate) fn mccs_ok(args: &[&str]) -> Output {
+    let out = mccs(args);
+    assert!(
+        out.status.success(),
+        "mccs {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 fn root() -> PathBuf {

@@ -5,12 +5,7 @@ use super::*;
 fn patch_rows(args: &[&str]) -> Vec<(f64, f64)> {
     let mut all = vec!["patch", "--params", "params/table2.toml"];
     all.extend_from_slice(args);
-    let out = mccs(&all);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = mccs_ok(&all);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("time_s,reaction_n"));

@@ -118,12 +118,7 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         ),
     ] {
         let f = temp_file(name, params);
-        let out = mccs(&["table", "--params", f.to_str().unwrap(), "--knots", "129"]);
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = mccs_ok(&["table", "--params", f.to_str().unwrap(), "--knots", "129"]);
         let src = String::from_utf8(out.stdout).unwrap();
         let lines: Vec<&str> = src.lines().collect();
         assert!(
