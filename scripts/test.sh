@@ -44,9 +44,11 @@ clippy_thumb() {
 }
 
 # Without warnings, which fails the stage: rustc's on the M3 are checked here, as the
-# lints above leave its target out.
+# lints above leave its target out. First the log decoder, which the stages after need
+# to read the firmware's output (a bin without tests, which the host build leaves out).
 firmware_builds() {
   local out=target/logs/firmware-builds-cargo.txt status=0
+  build_decoder || return 1
   cargo build --release -p mccs-firmware "${THUMB_ARGS[@]}" --bins > "$out" 2>&1 || status=1
   cat "$out"
   [ "$status" = 0 ] || return 1
@@ -199,17 +201,13 @@ wait_host_tests() {
 }
 
 run_stage fmt cargo fmt --all -- --check
-# (The log decoder is linted where it is built, in host-build: `build_decoder`. Checked
-# here too, its dependencies, defmt-decoder's tree, took a third of this stage.)
+# The host build first, so that the host tests start in the background as early as they
+# can and fill what the stages after leave of the two cores (clippy's and the links'
+# serial stretches): 10 to 20 s sooner in all than with the host lints first.
+run_stage host-build cargo test --workspace --no-run && start_host_tests
+# (The log decoder is linted where it is built, in firmware-builds: `build_decoder`.
+# Checked here too, its dependencies, defmt-decoder's tree, took a third of this stage.)
 run_stage clippy-host cargo clippy --workspace --exclude defmt-log --all-targets -- -D warnings
-# The host build: the tests, then the log decoder (a bin without tests, which the test
-# build leaves out; the demo stages need it, and built here, before the host tests start
-# in the background, it has both cores).
-host_build() {
-  cargo test --workspace --no-run && build_decoder
-}
-
-run_stage host-build host_build && start_host_tests
 run_stage clippy-thumb clippy_thumb
 run_stage firmware-builds firmware_builds
 run_stage demo-m4f-in-a-terminal demo_in_a_terminal
