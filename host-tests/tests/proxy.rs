@@ -7,7 +7,7 @@ use mccs_host::patch::{TwinConfig, V};
 use mccs_host::reference::Reference;
 use mccs_host::roam::{Friction, RoamConfig, RoamTwin, Shape, Tissue};
 
-use crate::common::patch5::{device_max, fixed, proxy_config, N, SPACING};
+use crate::common::patch5::{build, device_max, fixed, proxy_config, N, SPACING};
 
 fn twin(substeps: u32, mu: (f64, f64), radius: f64) -> RoamTwin {
     let cfg = RoamConfig {
@@ -35,6 +35,29 @@ fn path(t: usize) -> V {
     let slide = ((s - 0.5).max(0.0) * 10.0).min(2.0);
     let side = ((s - 0.7).max(0.0) * 10.0).min(1.0);
     [0.3 + slide, 0.2 + side, z]
+}
+
+/// The solver at rest that the tests keep and clone (`common::patch5::fixed`) is a
+/// fresh build: the same state, and the same forces along a press and a slide with
+/// friction, in both arithmetics, after it has been cloned and run before.
+#[test]
+fn the_kept_solver_at_rest_is_a_fresh_build() {
+    fn run<A: Arith>(mut s: crate::common::patch5::Fixed<A>) -> Vec<[mccs::Force; 3]> {
+        let mut proxy = s.proxy(&proxy_config((0.6, 0.4), 0.5)).unwrap();
+        (0..800)
+            .map(|t| s.step_proxy(path(t).map(Length::from_num), &mut proxy))
+            .collect()
+    }
+    fn same<A: Arith>() {
+        let first = run(fixed::<A>());
+        let kept = fixed::<A>();
+        let fresh = build::<A>();
+        assert_eq!(format!("{kept:?}"), format!("{fresh:?}"));
+        assert_eq!(run(kept), run(fresh));
+        assert_eq!(first, run(build::<A>()));
+    }
+    same::<Wide>();
+    same::<Narrow>();
 }
 
 /// How far the core's force `got` is from the twin's `want`, and `|want|` (N).
