@@ -207,10 +207,7 @@ fn independent_dense<const S: usize>(p: &Params, t: &ForceTable<S>, dense: usize
     // And round the cone's own transition Δ(F_T), a corner of the error.
     let e_t = r.delta(r.f_t);
     let transition = (0..=400).map(move |j| e_t + margin * 0.08 * (j as f64 / 200.0 - 1.0));
-    let mut worst = TableBound {
-        force: 0.0,
-        stiffness: 0.0,
-    };
+    let mut worst = NO_ERROR;
     for e in uniform
         .chain(segments)
         .chain(lines)
@@ -287,6 +284,20 @@ impl Tally {
         self.met_format_limited += o.met_format_limited;
         self.range_limited += o.range_limited;
         self.other += o.other;
+    }
+}
+
+/// No error: where a largest-error fold ([`larger`]) starts.
+const NO_ERROR: TableBound = TableBound {
+    force: 0.0,
+    stiffness: 0.0,
+};
+
+/// The larger of `a`'s and `b`'s force errors, and of their stiffness errors.
+fn larger(a: TableBound, b: &TableBound) -> TableBound {
+    TableBound {
+        force: a.force.max(b.force),
+        stiffness: a.stiffness.max(b.stiffness),
     }
 }
 
@@ -514,8 +525,7 @@ fn check_spring(p: &Params, d: &mut Tally, worst_met: &mut TableBound) {
                 "{p:?}: {m:?} below the force format's floor {floor:?}"
             );
             d.met_format_limited += usize::from(format_limited(p, &bound));
-            worst_met.force = worst_met.force.max(m.force);
-            worst_met.stiffness = worst_met.stiffness.max(m.stiffness);
+            *worst_met = larger(*worst_met, &m);
             d.met += 1;
         }
         Err(TableError::BoundNotMet {
@@ -589,10 +599,7 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
                 s.spawn(move || {
                     let mut stop = StopOthers(failed, 0);
                     let mut decades = [Tally::default(); 7];
-                    let mut worst = TableBound {
-                        force: 0.0,
-                        stiffness: 0.0,
-                    };
+                    let mut worst = NO_ERROR;
                     for (i, (p, ratio)) in todo.iter().enumerate().skip(w).step_by(workers) {
                         if failed.load(std::sync::atomic::Ordering::Relaxed) {
                             break;
@@ -623,16 +630,12 @@ fn every_table_meets_the_bound_or_is_refused_with_what_it_reached() {
             .collect()
     });
     let mut decades = [Tally::default(); 7];
-    let mut worst_met = TableBound {
-        force: 0.0,
-        stiffness: 0.0,
-    };
+    let mut worst_met = NO_ERROR;
     for (t, worst) in &tallies {
         for (d, w) in decades.iter_mut().zip(t) {
             d.add(w);
         }
-        worst_met.force = worst_met.force.max(worst.force);
-        worst_met.stiffness = worst_met.stiffness.max(worst.stiffness);
+        worst_met = larger(worst_met, worst);
     }
     let mut all = Tally::default();
     for (i, d) in decades.iter().enumerate() {
