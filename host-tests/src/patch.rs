@@ -157,7 +157,8 @@ pub fn max_stiffness(law: &Reference) -> f64 {
 /// computed independently: every spring at most `k_max / l0` stiff in every direction
 /// against its damping `C` in every direction, `θ = k_max / (l0_min C)` or the coupling's
 /// `k_c / (c + b_c)`; `γ` the damping's largest Gershgorin row sum over the mass; `h` half
-/// of `min(2/θ, 2/γ)`. `None` without damping.
+/// of `min(2/θ, 2/γ)`. `None` without damping; `u32::MAX` where no step is stable in
+/// `f64` (a spring so short, or a node so light, that `h` is zero).
 pub fn substeps(mesh: &Mesh, k_max: f64, cfg: &TwinConfig) -> Option<u32> {
     let n = mesh.rest.len();
     let (cs, cn) = (cfg.spring_damping, cfg.node_damping);
@@ -191,7 +192,9 @@ pub fn substeps(mesh: &Mesh, k_max: f64, cfg: &TwinConfig) -> Option<u32> {
         return None;
     };
     let h = 0.5 * (2.0 / theta).min(2.0 / gamma);
-    (h.is_finite() && h > 0.0).then(|| (1.0 / (cfg.tick_hz * h)).ceil().max(1.0) as u32)
+    // (The cast saturates: an `h` of zero or below f64's range is u32::MAX substeps.)
+    let h = if h.is_nan() { 0.0 } else { h };
+    Some((1.0 / (cfg.tick_hz * h)).ceil().max(1.0) as u32)
 }
 
 /// The f64 patch.

@@ -6,7 +6,7 @@
 //! every 2 s.
 
 use super::progress::Ticker;
-use super::{arg_error, io_error, CliError};
+use super::{arg_error, fmt_given, io_error, CliError};
 use crate::fit::{self, ModelKind, Progress};
 use crate::paramfile;
 use std::io::Write;
@@ -95,15 +95,20 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             );
         }
     };
+    // Every model is fitted before anything is printed: a model that cannot be fitted
+    // leaves stdout empty, as every other error does, and its line says which did fit.
     let mut fits = Vec::new();
+    let mut failed = Vec::new();
     for kind in kinds {
-        let f = fit::fit_rows(kind, &points, &mut progress).ok_or_else(|| {
-            CliError::new(format!(
-                "{}: the {} model could not be fitted",
-                a.data.display(),
-                kind.name()
-            ))
-        })?;
+        match fit::fit_rows(kind, &points, &mut progress) {
+            Some(f) => fits.push((kind, f)),
+            None => failed.push(kind),
+        }
+    }
+    if !failed.is_empty() {
+        return Err(not_fitted(&a.data, &points, &failed, &fits));
+    }
+    for (kind, f) in &fits {
         let m = f.metrics;
         writeln!(
             out,
@@ -114,9 +119,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             m.mse
         )
         .map_err(io_error)?;
-        out.flush().map_err(io_error)?;
-        fits.push(f);
     }
+    out.flush().map_err(io_error)?;
+    let fits: Vec<fit::Fit> = fits.into_iter().map(|(_, f)| f).collect();
     let mccs_params = fits.iter().find_map(|f| match f.model {
         fit::Fitted::Mccs(p) => Some(p),
         _ => None,
@@ -136,4 +141,40 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", path.display())))?;
     }
     Ok(())
+}
+
+/// The one line for models that could not be fitted: which, why (no starting point
+/// ended on parameters the model accepts: for MCCS, within the fixed point's ranges,
+/// docs/model.md), the data's forces, and the models that did fit.
+fn not_fitted(
+    data: &Path,
+    points: &[fit::Point],
+    failed: &[ModelKind],
+    fitted: &[(ModelKind, fit::Fit)],
+) -> CliError {
+    // "the mccs model", "the ms and mcs models".
+    let models = |kinds: &[ModelKind]| {
+        let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+        let s = if names.len() > 1 { "s" } else { "" };
+        format!("the {} model{s}", names.join(" and "))
+    };
+    let (lo, hi) = (points[0].1, points[points.len() - 1].1);
+    let why = if failed.contains(&ModelKind::Mccs) {
+        "parameters within the model's ranges (for mccs, the fixed point's: docs/model.md)"
+    } else {
+        "parameters that give a strain at every force"
+    };
+    let mut line = format!(
+        "{}: {} could not be fitted: no starting point ended on {why}, for forces {} … {} N",
+        data.display(),
+        models(failed),
+        fmt_given(lo),
+        fmt_given(hi),
+    );
+    if !fitted.is_empty() {
+        let ok: Vec<ModelKind> = fitted.iter().map(|(k, _)| *k).collect();
+        let each: Vec<String> = ok.iter().map(|k| format!("--model {}", k.name())).collect();
+        line.push_str(&format!("; {} fitted ({})", models(&ok), each.join(", ")));
+    }
+    CliError::new(line)
 }

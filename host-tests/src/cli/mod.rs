@@ -162,6 +162,16 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     }
 }
 
+/// A number a user gave, for a message: as written for everyday magnitudes (`2.5`), in
+/// scientific notation outside 1e-4 … 1e9 (`1e-300`, not three hundred zeros).
+pub(crate) fn fmt_given(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e9).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// A grid strain with the float noise of `from + i·step` removed (12 decimals at most).
 pub(crate) fn fmt_strain(e: f64) -> String {
     let s = format!("{e:.12}");

@@ -1,10 +1,10 @@
 //! `mccs patch`: the indentation test on the standard patch, in the `f64` twin or the
 //! fixed-point core.
 
-use super::patch_args::{config_error, PatchArgs};
+use super::patch_args::{config_error, topology_error, PatchArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
-use super::{arg_error, file_error, fmt_strain, io_error, CliError};
+use super::{arg_error, file_error, fmt_given, fmt_strain, io_error, CliError};
 use crate::paramfile;
 use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig};
 use crate::reference::Reference;
@@ -55,7 +55,10 @@ impl PatchRun {
     fn new(patch: PatchArgs, depth: f64, duration: f64) -> Result<Self, CliError> {
         patch.check()?;
         if !(depth.is_finite() && (0.0..=patch.spacing).contains(&depth)) {
-            let what = format!("must be 0 … {} mm (the --spacing)", patch.spacing);
+            let what = format!(
+                "must be 0 … {} mm (the --spacing)",
+                fmt_given(patch.spacing)
+            );
             return Err(arg_error("--indent", &what));
         }
         if !(duration.is_finite() && duration > 0.0 && duration <= 60.0) {
@@ -101,7 +104,7 @@ impl PatchRun {
             self.patch.grid,
             self.patch.spacing,
         )
-        .map_err(|e| arg_error("--grid", &e.to_string()))?;
+        .map_err(topology_error)?;
         let mut s =
             Solver::with_arith(topo, table, cfg, arith).map_err(|e| config_error(e, cfg))?;
         let mut progress = self.progress();

@@ -116,6 +116,23 @@ impl TuningArgs {
     }
 }
 
+/// The standard patch's topology refused by the fixed-point core, as the argument at
+/// fault: its spring lengths and positions come from `--spacing` (springs of 1 mm at
+/// least), its node and spring counts from `--grid`.
+pub(super) fn topology_error(e: mccs::TopologyError) -> CliError {
+    use mccs::TopologyError as E;
+    match e {
+        E::TooShort => arg_error(
+            "--spacing",
+            "must be ≥ 1 mm with --backend fixed (its springs are 1 mm long at least)",
+        ),
+        E::OutOfRange | E::BadGrid => arg_error("--spacing", &e.to_string()),
+        E::NodeCapacity | E::EdgeCapacity | E::BadEnd | E::TooManySprings => {
+            arg_error("--grid", &e.to_string())
+        }
+    }
+}
+
 /// A solver error as the argument at fault, where one is.
 pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError {
     use mccs::{ConfigKey as K, SolverError as E};
@@ -130,7 +147,8 @@ pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError
             return arg_error(
                 "--rate",
                 &format!(
-                    "this spring needs {needed} substeps per tick at {} Hz (at most {}): lower the rate, or raise --node-mass or the damping",
+                    "this spring needs {} substeps per tick at {} Hz (at most {}): lower the rate, or raise --node-mass, the damping or --spacing",
+                    if needed == u32::MAX { format!("{needed} or more") } else { needed.to_string() },
                     cfg.tick_hz, cfg.max_substeps
                 ),
             )

@@ -1,7 +1,7 @@
 //! `mccs replay`: a recorded probe trajectory against the standard patch, one CSV row
 //! per tick; with `--tissue`, against the `f64` roaming probe (docs/roaming.md).
 
-use super::patch_args::{config_error, PatchArgs, TuningArgs};
+use super::patch_args::{config_error, topology_error, PatchArgs, TuningArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
 use super::{arg_error, file_error, io_error, CliError};
@@ -137,6 +137,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         ReplayError::Solver(s) => config_error(s, &cfg),
         ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
         ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
+        ReplayError::Topology(e) => topology_error(e),
         other => file_error(&a.params, other),
     };
     match roaming {

@@ -125,3 +125,50 @@ fn fit_rejects_what_the_models_cannot_take_and_checks_outputs_first() {
         .unwrap();
     assert!(mean < 1e-6, "noise-free data fit exactly: {stdout}");
 }
+
+/// Data no MCCS parameters within the fixed point's ranges can fit (forces of 1e-300 N,
+/// or up to 1e9 N): exit 2 and one line that names the file and the model, gives the
+/// data's forces and the models that did fit, with nothing on stdout (once the models
+/// fitted before it were printed, and the line said only "could not be fitted").
+#[test]
+fn a_model_that_cannot_be_fitted_is_one_line_naming_the_others() {
+    let rows = |forces: [f64; 5]| {
+        let mut s = String::from("strain,force_n\n");
+        for (i, f) in forces.iter().enumerate() {
+            s.push_str(&format!("0.{},{f:e}\n", i + 1));
+        }
+        s
+    };
+    for (name, forces, range) in [
+        (
+            "tiny-forces.csv",
+            [1e-300, 2e-300, 3e-300, 4e-300, 5e-300],
+            "forces 1e-300 … 5e-300 N",
+        ),
+        (
+            "huge-forces.csv",
+            [1.0, 2.0, 1e5, 1.00001e5, 1e9],
+            "forces 1 … 1e9 N",
+        ),
+    ] {
+        let f = temp_file(name, &rows(forces));
+        let path = f.to_str().unwrap();
+        assert_one_line_error(
+            &mccs(&["fit", "--data", path]),
+            &[
+                name,
+                "the mccs model could not be fitted",
+                "within the model's ranges",
+                range,
+                "the ms and mcs models fitted (--model ms, --model mcs)",
+            ],
+        );
+        // The one model alone: the same line without the others.
+        let out = mccs(&["fit", "--data", path, "--model", "mccs"]);
+        assert_one_line_error(&out, &[name, "the mccs model could not be fitted"]);
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("fitted ("));
+        // The models that fit print their line.
+        let ms = mccs_ok(&["fit", "--data", path, "--model", "ms"]);
+        assert!(String::from_utf8_lossy(&ms.stdout).starts_with("FIT model=ms "));
+    }
+}

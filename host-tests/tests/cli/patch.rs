@@ -160,3 +160,56 @@ fn patch_runs_either_integrator_to_the_same_settled_force() {
         &["--integrator"],
     );
 }
+
+/// The patch's spacing at its edges names `--spacing` (or the rate it would need) in
+/// both backends and both commands, never another argument or the parameter file, and a
+/// tiny spacing is written as given: a spacing below the fixed core's 1 mm springs
+/// (once `--grid: topology: …` from `patch` and `PARAMS: topology: …` from `replay`),
+/// and one so small that the twin's stable step is zero (once `--spring-damping: the
+/// integrator needs damping`, with the damping at its default).
+#[test]
+fn tiny_spacings_name_the_spacing() {
+    let patch = |extra: &[&str]| {
+        let mut a = vec!["patch", "--params", "params/table2.toml"];
+        a.extend_from_slice(extra);
+        mccs(&a)
+    };
+    let replay = |extra: &[&str]| {
+        let mut a = vec![
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/stroke.csv",
+        ];
+        a.extend_from_slice(extra);
+        mccs(&a)
+    };
+    let fixed_short = ["--spacing", "0.5", "--backend", "fixed"];
+    let needle = "--spacing: must be ≥ 1 mm with --backend fixed";
+    assert_one_line_error(
+        &patch(&[&fixed_short[..], &["--indent", "0.2"]].concat()),
+        &[needle],
+    );
+    assert_one_line_error(&replay(&fixed_short), &[needle]);
+    let zero_step = ["--spacing", "1e-300", "--backend", "reference"];
+    for out in [
+        patch(&[&zero_step[..], &["--indent", "0"]].concat()),
+        replay(&zero_step),
+    ] {
+        assert_one_line_error(
+            &out,
+            &[
+                "--rate: this spring needs 4294967295 or more substeps",
+                "--spacing",
+            ],
+        );
+    }
+    assert_one_line_error(
+        &patch(&[&zero_step[..], &["--indent", "0.5"]].concat()),
+        &["--indent: must be 0 … 1e-300 mm (the --spacing)"],
+    );
+    // Small but stable: the twin runs it at its substeps, or says how many it needs.
+    let out = patch(&["--spacing", "0.5", "--indent", "0.1", "--duration", "0.01"]);
+    assert!(out.status.success(), "{out:?}");
+}
