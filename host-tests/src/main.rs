@@ -2,7 +2,7 @@
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
-use mccs_host::cli::{run, Cli};
+use mccs_host::cli::{join_negative_values, run, Cli};
 use std::process::ExitCode;
 
 /// A usage error as one line naming what is wrong, and a short usage hint.
@@ -30,7 +30,7 @@ fn usage_error(e: &clap::Error) -> String {
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match Cli::try_parse_from(join_negative_values(std::env::args_os())) {
         Ok(cli) => cli,
         Err(e) => match e.kind() {
             ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {

@@ -6,7 +6,7 @@
 //! every 2 s.
 
 use super::progress::Ticker;
-use super::{arg_error, fmt_given, io_error, CliError};
+use super::{arg_error, check_writable, fmt_given, io_error, CliError};
 use crate::fit::{self, ModelKind, Progress};
 use crate::paramfile;
 use std::io::Write;
@@ -27,31 +27,6 @@ pub(super) struct Args {
     /// Draw the data and the fitted curves here (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
-}
-
-/// Fails unless `path` can be written: its folder exists and takes a new file, and it is
-/// not a folder or a read-only file itself.
-fn check_writable(arg: &str, path: &Path) -> Result<(), CliError> {
-    let bad = |what: &str| arg_error(arg, &format!("{}: {what}", path.display()));
-    if path.is_dir() {
-        return Err(bad("is a folder"));
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(bad("its folder does not exist"));
-    }
-    if let Ok(meta) = std::fs::metadata(path) {
-        if meta.permissions().readonly() {
-            return Err(bad("is read-only"));
-        }
-    }
-    let probe = dir.join(format!(".mccs-write-check-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(|e| bad(&format!("its folder cannot be written: {e}")))?;
-    let _ = std::fs::remove_file(probe);
-    Ok(())
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {

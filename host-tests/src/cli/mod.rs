@@ -4,8 +4,9 @@
 
 use crate::paramfile;
 use clap::{Parser, Subcommand, ValueEnum};
+use std::ffi::OsString;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 mod curve;
 mod demo;
@@ -160,6 +161,56 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Patch(a) => patch::run(a, out),
         Command::Replay(a) => replay::run(a, out),
     }
+}
+
+/// The command line with each negative number that follows a long option joined to it
+/// (`--from -1e-3` → `--from=-1e-3`). clap takes `-1e3` or `-0.5` as a value, but not a
+/// negative number with a signed exponent (`-1e-3`, `-5E-2`), which it would split into
+/// short flags (`unexpected argument '-1'`). Other arguments pass unchanged.
+pub fn join_negative_values(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut out: Vec<OsString> = Vec::new();
+    for arg in args {
+        let number = arg
+            .to_str()
+            .is_some_and(|a| a.starts_with('-') && a.parse::<f64>().is_ok());
+        let after_long = out
+            .last()
+            .and_then(|p| p.to_str())
+            .is_some_and(|p| p.len() > 2 && p.starts_with("--") && !p.contains('='));
+        match out.last_mut() {
+            Some(prev) if number && after_long => {
+                prev.push("=");
+                prev.push(&arg);
+            }
+            _ => out.push(arg),
+        }
+    }
+    out
+}
+
+/// Fails unless `path` can be written: its folder exists and takes a new file, and it is
+/// not a folder or a read-only file itself.
+pub(crate) fn check_writable(arg: &str, path: &Path) -> Result<(), CliError> {
+    let bad = |what: &str| arg_error(arg, &format!("{}: {what}", path.display()));
+    if path.is_dir() {
+        return Err(bad("is a folder"));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(bad("its folder does not exist"));
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.permissions().readonly() {
+            return Err(bad("is read-only"));
+        }
+    }
+    let probe = dir.join(format!(".mccs-write-check-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| bad(&format!("its folder cannot be written: {e}")))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
 }
 
 /// A number a user gave, for a message: as written for everyday magnitudes (`2.5`), in

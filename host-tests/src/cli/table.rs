@@ -1,7 +1,7 @@
 //! `mccs table`: the fixed-point force table as Rust source for `include!`, and the
 //! builder every fixed-point subcommand shares.
 
-use super::{arg_error, file_error, io_error, CliError};
+use super::{arg_error, check_writable, file_error, io_error, CliError};
 use crate::paramfile;
 use mccs::{ForceTable, Params, TableBound, TableError};
 use std::io::Write;
@@ -31,6 +31,10 @@ pub(super) struct Args {
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
+    // The output is checked before the table is built and measured.
+    if let Some(path) = &a.out {
+        check_writable("--out", path)?;
+    }
     let p = paramfile::read(&a.params)?;
     let (knots, from, to) = (a.knots, a.from, a.to);
     let header = format!(

@@ -87,3 +87,68 @@ fn bad_ranges_name_the_argument() {
     assert_usage_error(&mccs(&["curve", "--from", "0"]), &["--params"]);
     assert_usage_error(&mccs(&["frobnicate"]), &["frobnicate"]);
 }
+
+/// A negative number in scientific notation with a signed exponent is a value, as in any
+/// other spelling (clap alone split `-1e-3` into short flags: `unexpected argument '-1'`),
+/// and the same strains come out as from its decimal spelling; a stray one after a value
+/// is still an error.
+#[test]
+fn negative_numbers_with_signed_exponents_are_values() {
+    let run = |from: &str, step: &str| {
+        let out = mccs_ok(&[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            from,
+            "--to",
+            "0.01",
+            "--step",
+            step,
+        ]);
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let decimal = run("-0.01", "0.005");
+    assert!(decimal.lines().nth(1).unwrap().starts_with("-0.01,"));
+    for from in ["-1e-2", "-1E-2", "-10e-3", "-0.1e-1"] {
+        assert_eq!(run(from, "5e-3"), decimal, "--from {from}");
+    }
+    // The `=` spelling, which clap always took, is unchanged.
+    let out = mccs_ok(&[
+        "curve",
+        "--params",
+        "params/table2.toml",
+        "--from=-1e-2",
+        "--to",
+        "0.01",
+        "--step",
+        "0.005",
+    ]);
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), decimal);
+    assert_usage_error(
+        &mccs(&[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            "-1e-2",
+            "-2e-2",
+            "--to",
+            "0.01",
+            "--step",
+            "0.005",
+        ]),
+        &["unexpected argument"],
+    );
+    // In the other subcommands' numbers too: a negative indentation, named.
+    assert_one_line_error(
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "-1e-9",
+        ]),
+        &["--indent: must be 0 … 2.5 mm"],
+    );
+}
