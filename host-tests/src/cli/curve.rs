@@ -47,6 +47,17 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
         }
         Backend::Fixed => {
+            // The printed strain must be the one evaluated: none is held at the format's
+            // edge.
+            let (min, max) = (Strain::MIN.to_num::<f64>(), Strain::MAX.to_num::<f64>());
+            for (name, v) in [("--from", a.from), ("--to", a.to)] {
+                if !(min..=max).contains(&v) {
+                    return Err(arg_error(
+                        name,
+                        "must be within the fixed point's strains, -128 … 127.99999994 (Q24), with --backend fixed",
+                    ));
+                }
+            }
             let rows = with_table!(a.knots, &p, &a.params, Domain::Default, |t| {
                 fixed_curve(&t, &strains)
             });
@@ -57,19 +68,21 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     write_curve(out, &rows)
 }
 
-/// Warns on stderr when strains lie above the fixed table's domain where the law is
-/// still curved: there the table's line is the law's tangent at the domain's edge, an
-/// under-estimate (below the domain, and above the solid point, the lines are exact).
+/// Warns on stderr when strains lie above the fixed table's domain and the domain ends
+/// before the solid point: there the table's line is the law's tangent at the domain's
+/// edge, an under-estimate, before the solid point and past it alike (past it the law is
+/// the line of slope `k_p`, which the tangent is not). Below the domain, and above it
+/// when the domain reaches the solid point, the lines are the law's own.
 fn warn_outside_domain(p: &mccs::Params, strains: &[f64]) {
     let (lo, hi) = mccs::table::DEFAULT_DOMAIN;
     let Ok(law) = mccs::Law::new(p) else { return };
-    let above = strains
-        .iter()
-        .filter(|&&e| e > hi && e < law.strain_c())
-        .count();
+    if hi >= law.strain_c() {
+        return;
+    }
+    let above = strains.iter().filter(|&&e| e > hi).count();
     if above > 0 {
         eprintln!(
-            "mccs: warning: {above} strains lie above the fixed table's domain [{lo}, {hi}] and below the solid point {:.6}: there the table gives the tangent at {hi}, not the law",
+            "mccs: warning: {above} strains lie above the fixed table's domain [{lo}, {hi}], which ends before the solid point {:.6}: there the table gives the tangent at {hi}, below the law",
             law.strain_c()
         );
     }

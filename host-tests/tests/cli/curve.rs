@@ -152,3 +152,66 @@ fn negative_numbers_with_signed_exponents_are_values() {
         &["--indent: must be 0 … 2.5 mm"],
     );
 }
+
+/// The fixed backend off its table's domain: every strain above the domain (Table 2's
+/// ends at 0.95, before its solid point 1.19) is counted in one warning, past the solid
+/// point too, where the table's tangent is below the law's line of slope `k_p` (the
+/// warning once stopped at the solid point and said nothing of the 4 % there); below the
+/// domain, the law's own line, no warning. A strain outside the fixed point's range
+/// (±128, Q24) is refused, naming the argument (it was held at ±128 and printed as
+/// given, with the force of −128).
+#[test]
+fn fixed_curve_off_its_domain_warns_and_refuses_what_it_cannot_hold() {
+    let curve = |from: &str, to: &str, step: &str| {
+        mccs(&[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            from,
+            "--to",
+            to,
+            "--step",
+            step,
+            "--backend",
+            "fixed",
+        ])
+    };
+    let rows = |out: &Output| -> Vec<Vec<f64>> {
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let above = curve("1.3", "1.5", "0.1");
+    assert!(above.status.success());
+    let err = String::from_utf8_lossy(&above.stderr);
+    assert!(
+        err.contains("warning: 3 strains lie above the fixed table's domain [-0.5, 0.95], which ends before the solid point 1.19"),
+        "{err}"
+    );
+    let law = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
+    for r in rows(&above) {
+        // What the warning is about: the tangent, under the law by more than 1 %.
+        assert!(r[1] < 0.99 * law.force(r[0]), "{r:?}");
+    }
+    let below = curve("-3", "-1", "0.5");
+    assert!(below.status.success() && below.stderr.is_empty());
+    for r in rows(&below) {
+        assert!(
+            (r[1] - law.force(r[0])).abs() < 1e-5 * law.force(r[0]).abs(),
+            "{r:?}"
+        );
+    }
+    for (from, to, arg) in [
+        ("-200", "0", "--from"),
+        ("0", "128", "--to"),
+        ("-128.5", "0", "--from"),
+    ] {
+        assert_one_line_error(&curve(from, to, "1"), &[arg, "-128 … 127.99999994 (Q24)"]);
+    }
+    let edge = curve("-128", "-127", "1");
+    assert!(edge.status.success());
+    assert_eq!(rows(&edge).len(), 2);
+}
