@@ -152,6 +152,12 @@ pub fn max_stiffness(law: &Reference) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The most substeps per tick the twin runs (the CLI's reference backend): more than the
+/// core's 64, since its rule ([`substeps`]) is the conservative one, which asks for more
+/// than the core's exact bound (spring damping 30 N·s/m at the defaults: over 64, which
+/// the core runs; `tests/cli/replay.rs`), and the `f64` twin has no tick to fit.
+pub const TWIN_MAX_SUBSTEPS: u32 = 1024;
+
 /// Substeps per tick for `mesh` with the law's largest tangent stiffness `k_max` (N per
 /// unit strain), from the conservative bound of the core's docs (`solver::stability`),
 /// computed independently: every spring at most `k_max / l0` stiff in every direction

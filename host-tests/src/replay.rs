@@ -4,7 +4,7 @@
 //! node. Or, with a tissue, against the `f64` roaming probe (`roam::RoamTwin`): per tick
 //! the device force, the proxy, the contact's state and the window's shifts.
 
-use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, V};
+use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, TWIN_MAX_SUBSTEPS, V};
 use crate::reference::Reference;
 use crate::roam::{Friction, RoamConfig, RoamError, RoamTwin, Tissue};
 use crate::trajectory::Trajectory;
@@ -174,7 +174,7 @@ impl Replay {
         let mut tc = TwinConfig::from_solver(&self.config, 0);
         let k_max = max_stiffness(law);
         let n = substeps(&mesh, k_max, &tc).ok_or(ReplayError::Solver(SolverError::NoDamping))?;
-        if n > self.config.max_substeps {
+        if n > TWIN_MAX_SUBSTEPS {
             return Err(ReplayError::Solver(SolverError::TooManySubsteps {
                 needed: n,
             }));

@@ -1,12 +1,12 @@
 //! `mccs patch`: the indentation test on the standard patch, in the `f64` twin or the
 //! fixed-point core.
 
-use super::patch_args::{config_error, topology_error, PatchArgs};
+use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
 use super::{arg_error, file_error, fmt_given, fmt_strain, io_error, CliError};
 use crate::paramfile;
-use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig};
+use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, TWIN_MAX_SUBSTEPS};
 use crate::reference::Reference;
 use crate::replay::{Engine, FIXED_EDGES, FIXED_NODES};
 use mccs::{Arith, Length, Params, Solver, SolverConfig, Topology};
@@ -131,10 +131,10 @@ impl PatchRun {
         let k_max = max_stiffness(&law);
         let n = substeps(&mesh, k_max, &tc)
             .ok_or_else(|| config_error(mccs::SolverError::NoDamping, cfg))?;
-        if n > cfg.max_substeps {
+        if n > TWIN_MAX_SUBSTEPS {
             return Err(config_error(
                 mccs::SolverError::TooManySubsteps { needed: n },
-                cfg,
+                &twin_limits(cfg),
             ));
         }
         tc.substeps = n;

@@ -133,6 +133,14 @@ pub(super) fn topology_error(e: mccs::TopologyError) -> CliError {
     }
 }
 
+/// `cfg` with the twin's cap on substeps: what the reference backend's errors quote.
+pub(super) fn twin_limits(cfg: &SolverConfig) -> SolverConfig {
+    SolverConfig {
+        max_substeps: crate::patch::TWIN_MAX_SUBSTEPS,
+        ..*cfg
+    }
+}
+
 /// A solver error as the argument at fault, where one is.
 pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError {
     use mccs::{ConfigKey as K, SolverError as E};

@@ -1,12 +1,12 @@
 //! `mccs replay`: a recorded probe trajectory against the standard patch, one CSV row
 //! per tick; with `--tissue`, against the `f64` roaming probe (docs/roaming.md).
 
-use super::patch_args::{config_error, topology_error, PatchArgs, TuningArgs};
+use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs, TuningArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
 use super::{arg_error, file_error, io_error, CliError};
 use crate::paramfile;
-use crate::replay::{Replay, ReplayError, RoamRow, Roaming};
+use crate::replay::{Engine, Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
 use crate::trajectory;
 use mccs::{ProxyError, SolverConfig};
@@ -133,8 +133,13 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     // Progress lines on stderr for a replay that takes long (a long trajectory on a large
     // reference patch: 600 s on the 8 × 8 twin takes 14 s).
     let mut progress = Simulated::new("replay", traj.span().1);
+    // The reference backend's substeps are the twin's, under its own cap.
+    let limits = match replay.engine {
+        Engine::Reference => twin_limits(&cfg),
+        _ => cfg,
+    };
     let fail = |e| match e {
-        ReplayError::Solver(s) => config_error(s, &cfg),
+        ReplayError::Solver(s) => config_error(s, &limits),
         ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
         ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
         ReplayError::Topology(e) => topology_error(e),

@@ -177,3 +177,74 @@ fn replay_roams_in_the_core_as_in_the_reference() {
         }
     }
 }
+
+/// The reference backend runs what the fixed one runs: at the largest spring damping
+/// (30 N·s/m) the twin's conservative rule asks for more substeps than the core's cap
+/// of 64, which it once shared (refused, `--rate: … needs N substeps`), and fewer than
+/// its own (1024). Both replays of the stroke agree to 1 % of the peak force; a configuration
+/// beyond the twin's cap quotes it.
+#[test]
+fn the_reference_backend_runs_the_heaviest_damping() {
+    let run = |backend: &str| {
+        let out = mccs_ok(&[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/stroke.csv",
+            "--spring-damping",
+            "30",
+            "--backend",
+            backend,
+        ]);
+        let text = String::from_utf8(out.stdout).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect::<Vec<Vec<f64>>>()
+    };
+    // The case is over the core's cap for the twin's rule, and under the twin's own.
+    let law = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
+    let cfg = mccs::SolverConfig {
+        spring_damping: 30.0,
+        ..mccs::SolverConfig::default()
+    };
+    let twin = mccs_host::patch::substeps(
+        &mccs_host::patch::Mesh::standard(5, 2.5),
+        mccs_host::patch::max_stiffness(&law),
+        &mccs_host::patch::TwinConfig::from_solver(&cfg, 0),
+    )
+    .unwrap();
+    assert!(
+        (65..=mccs_host::patch::TWIN_MAX_SUBSTEPS).contains(&twin),
+        "{twin}"
+    );
+    let (reference, fixed) = (run("reference"), run("fixed"));
+    assert_eq!(reference.len(), fixed.len());
+    let peak = reference
+        .iter()
+        .flat_map(|r| r[1..4].iter())
+        .fold(0.0f64, |m, f| m.max(f.abs()));
+    assert!(peak > 1.0, "{peak}");
+    for (r, f) in reference.iter().zip(&fixed) {
+        for k in 1..4 {
+            assert!(
+                (r[k] - f[k]).abs() <= 0.01 * peak,
+                "t = {}: {r:?} vs {f:?}",
+                r[0]
+            );
+        }
+    }
+    assert_one_line_error(
+        &mccs(&[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/stroke.csv",
+            "--node-mass",
+            "1e-6",
+        ]),
+        &["--rate: this spring needs", "(at most 1024)"],
+    );
+}
