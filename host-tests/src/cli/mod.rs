@@ -163,16 +163,17 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     }
 }
 
-/// The command line with each negative number that follows a long option joined to it
-/// (`--from -1e-3` → `--from=-1e-3`). clap takes `-1e3` or `-0.5` as a value, but not a
-/// negative number with a signed exponent (`-1e-3`, `-5E-2`), which it would split into
-/// short flags (`unexpected argument '-1'`). Other arguments pass unchanged.
+/// The command line with each negative number (or pair of numbers, the first negative)
+/// that follows a long option joined to it (`--from -1e-3` → `--from=-1e-3`). clap takes
+/// `-1e3` or `-0.5` as a value, but not a negative number with a signed exponent
+/// (`-1e-3`, `-5E-2`) or a pair (`--friction -0.1,0`), which it would split into short
+/// flags (`unexpected argument '-1'`). Other arguments pass unchanged.
 pub fn join_negative_values(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
     let mut out: Vec<OsString> = Vec::new();
     for arg in args {
-        let number = arg
-            .to_str()
-            .is_some_and(|a| a.starts_with('-') && a.parse::<f64>().is_ok());
+        let number = arg.to_str().is_some_and(|a| {
+            a.starts_with('-') && a.split(',').all(|x| x.trim().parse::<f64>().is_ok())
+        });
         let after_long = out
             .last()
             .and_then(|p| p.to_str())

@@ -140,6 +140,22 @@ fn negative_numbers_with_signed_exponents_are_values() {
         ]),
         &["unexpected argument"],
     );
+    // A pair whose first number is negative, named by its own check (was clap's
+    // `unexpected argument '-1'`).
+    assert_one_line_error(
+        &mccs(&[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/palpation.csv",
+            "--tissue",
+            "64,64",
+            "--friction",
+            "-1e-3,0",
+        ]),
+        &["--friction: friction: mu_s and mu_k must be within [0, 2]"],
+    );
     // In the other subcommands' numbers too: a negative indentation, named.
     assert_one_line_error(
         &mccs(&[
