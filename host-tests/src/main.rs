@@ -54,7 +54,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             drop(out);
-            eprintln!("mccs: {e}");
+            // (No line when the reader closed stdout.)
+            if !e.message.is_empty() {
+                eprintln!("mccs: {e}");
+            }
             ExitCode::from(e.status)
         }
     }

@@ -3,7 +3,7 @@
 
 use super::table::{table, with_table, Domain};
 
-use super::{arg_error, file_error, fmt_strain, io_error, Backend, CliError};
+use super::{arg_error, csv_error, file_error, fmt_strain, io_error, Backend, CliError};
 use crate::paramfile;
 use crate::reference::Reference;
 use mccs::{ForceTable, Strain};
@@ -126,12 +126,11 @@ fn fixed_curve<const S: usize>(t: &ForceTable<S>, strains: &[f64]) -> Vec<(f64, 
 
 fn write_curve(out: &mut dyn Write, rows: &[(f64, f64, f64)]) -> Result<(), CliError> {
     let mut w = csv::Writer::from_writer(out);
-    let err = |e: csv::Error| CliError::new(format!("stdout: {e}"));
     w.write_record(["strain", "force_n", "stiffness_n"])
-        .map_err(err)?;
+        .map_err(csv_error)?;
     for (e, f, k) in rows {
         w.write_record([fmt_strain(*e), f.to_string(), k.to_string()])
-            .map_err(err)?;
+            .map_err(csv_error)?;
     }
     w.flush().map_err(io_error)
 }

@@ -27,7 +27,8 @@ pub use table::render_table;
 pub struct CliError {
     /// The line.
     pub message: String,
-    /// 2: bad input (a file, a row, an argument); 1: a check ran and failed.
+    /// 2: bad input (a file, a row, an argument); 1: a check ran and failed; 141: the
+    /// reader of stdout closed it ([`CliError::output_closed`]).
     pub status: u8,
 }
 
@@ -37,6 +38,15 @@ impl CliError {
         Self {
             message: message.into(),
             status: 2,
+        }
+    }
+
+    /// The reader closed stdout (`mccs curve … | head`): no line, and exit status 141,
+    /// what a tool killed by `SIGPIPE` gives (never 0: `demo --check` does not pass).
+    pub fn output_closed() -> Self {
+        Self {
+            message: String::new(),
+            status: OUTPUT_CLOSED,
         }
     }
 
@@ -71,9 +81,25 @@ pub(crate) fn file_error(file: &Path, e: impl std::fmt::Display) -> CliError {
     CliError::new(format!("{}: {e}", file.display()))
 }
 
-/// A failure writing the output.
+/// The exit status when the reader closed stdout: 128 + `SIGPIPE`.
+pub const OUTPUT_CLOSED: u8 = 141;
+
+/// A failure writing the output: [`CliError::output_closed`] when the reader closed it,
+/// else `stdout: …`.
 pub(crate) fn io_error(e: std::io::Error) -> CliError {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        return CliError::output_closed();
+    }
     CliError::new(format!("stdout: {e}"))
+}
+
+/// A failure of the CSV writer on stdout, as [`io_error`].
+pub(crate) fn csv_error(e: csv::Error) -> CliError {
+    let line = format!("stdout: {e}");
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => io_error(io),
+        _ => CliError::new(line),
+    }
 }
 
 /// Multi-component conical spring soft tissue: curves, tables, fits, patch runs and

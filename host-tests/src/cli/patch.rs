@@ -4,7 +4,7 @@
 use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
-use super::{arg_error, file_error, fmt_given, fmt_strain, io_error, CliError};
+use super::{arg_error, csv_error, file_error, fmt_given, fmt_strain, io_error, CliError};
 use crate::paramfile;
 use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, TWIN_MAX_SUBSTEPS};
 use crate::reference::Reference;
@@ -33,11 +33,11 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let p = paramfile::read(&a.params)?;
     let rows = run.reactions(&p, &a.params)?;
     let mut w = csv::Writer::from_writer(out);
-    let err = |e: csv::Error| CliError::new(format!("stdout: {e}"));
-    w.write_record(["time_s", "reaction_n"]).map_err(err)?;
+    w.write_record(["time_s", "reaction_n"])
+        .map_err(csv_error)?;
     for (t, r) in rows {
         w.write_record([fmt_strain(t), r.to_string()])
-            .map_err(err)?;
+            .map_err(csv_error)?;
     }
     w.flush().map_err(io_error)
 }

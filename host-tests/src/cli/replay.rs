@@ -4,7 +4,7 @@
 use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs, TuningArgs};
 use super::progress::Simulated;
 use super::table::solver_table;
-use super::{arg_error, file_error, io_error, CliError};
+use super::{arg_error, file_error, io_error, CliError, OUTPUT_CLOSED};
 use crate::paramfile;
 use crate::replay::{Engine, Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
@@ -213,6 +213,10 @@ fn csv(
             };
             started = true;
             if let Err(e) = header.and_then(|()| writeln!(w, "{line}")) {
+                // The reader closed stdout: nothing more to write or to run for.
+                if e.kind() == std::io::ErrorKind::BrokenPipe {
+                    std::process::exit(OUTPUT_CLOSED.into());
+                }
                 failed = Some(e);
             }
         }

@@ -279,3 +279,58 @@ fn long_runs_report_progress_on_stderr() {
         );
     }
 }
+
+/// A reader that closes stdout early (`mccs … | head -1`): the run stops with no line on
+/// stderr and exit status 141, what a tool killed by `SIGPIPE` gives, never 0 (it used to
+/// print `mccs: stdout: Broken pipe (os error 32)` and exit 2, as for bad input, and a
+/// replay ran to its end first). Both writers: the CSV of `curve`, and `replay`'s rows
+/// as they are simulated.
+#[test]
+fn a_closed_stdout_ends_the_run_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let runs: [&[&str]; 2] = [
+        &[
+            "curve",
+            "--params",
+            "params/table2.toml",
+            "--from",
+            "0",
+            "--to",
+            "0.9",
+            "--step",
+            "0.00001",
+        ],
+        &[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/palpation.csv",
+            "--tissue",
+            "64,64",
+        ],
+    ];
+    for args in runs {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_mccs"))
+            .args(args)
+            .current_dir(root())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        assert!(first.contains(','), "{first}");
+        // (The reader is dropped here: the pipe is closed with most rows unwritten.)
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(141), "{}: {out:?}", args[0]);
+        assert!(
+            out.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
