@@ -390,7 +390,9 @@ impl RoamTwin {
         self.twin.x = x;
         self.twin.v = v;
         self.corner = corner;
-        self.shifts += 1;
+        // One shift per axis moved, as the core counts them (`docs/roaming.md`: a
+        // diagonal move is two shifts).
+        self.shifts += u32::from(corner.0 != old.0) + u32::from(corner.1 != old.1);
     }
 
     fn substep(&mut self, p: V, pv: V) {

@@ -82,8 +82,11 @@ fn bary_xy(p: [V; 3], x: f64, y: f64) -> Option<[f64; 3]> {
 /// The surface point above or below `(x, y)` (mm) on the deformed surface whose nodes are
 /// at `pos`: the triangle whose `xy` projection holds it, searched among the 3 × 3 cells
 /// around the rest grid's guess (nodes move less than a spacing sideways). Beyond the
-/// tissue's edge, the nearest point of the edge's triangle.
+/// tissue's edge, the point above the nearest point of its rectangle (`(x, y)` clamped
+/// to the rest extent, as the core clamps the grid point: the edge's nodes are fixed).
 pub fn locate(tissue: &Tissue, pos: impl Fn((usize, usize)) -> V, x: f64, y: f64) -> Anchor {
+    let (hx, hy) = tissue.half_extent();
+    let (x, y) = (x.clamp(-hx, hx), y.clamp(-hy, hy));
     let (u, v) = tissue.grid(x, y);
     let clamp = |g: f64, n: usize| (g.floor().max(0.0) as usize).min(n - 2);
     let (ci, cj) = (clamp(u, tissue.w), clamp(v, tissue.h));
@@ -114,8 +117,7 @@ pub fn locate(tissue: &Tissue, pos: impl Fn((usize, usize)) -> V, x: f64, y: f64
             bary: [1.0, 0.0, 0.0],
         },
     ));
-    // Outside every triangle (beyond the tissue's edge): the weights clipped to the
-    // triangle, the nearest corner or edge point.
+    // On the edge, or a rounding outside the triangle: the weights clipped to it.
     let clipped = a.bary.map(|b| b.max(0.0));
     let sum: f64 = clipped.iter().sum();
     a.bary = clipped.map(|b| b / sum);
