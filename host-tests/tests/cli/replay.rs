@@ -3,6 +3,25 @@
 
 use super::*;
 
+/// A replay's CSV rows as numbers (the header left out).
+fn numbers(out: Output) -> Vec<Vec<f64>> {
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
+/// `(|F_r|, |F_f − F_r|)`: the reference row's force and how far the other's is from it.
+fn force_gap(f: &[f64], r: &[f64]) -> (f64, f64) {
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    (
+        norm([r[1], r[2], r[3]]),
+        norm([f[1] - r[1], f[2] - r[2], f[3] - r[3]]),
+    )
+}
+
 #[test]
 fn replay_roams_a_tissue_with_friction() {
     let out = mccs(&PALPATION);
@@ -126,15 +145,7 @@ fn replay_roams_in_the_core_as_in_the_reference() {
     let run = |extra: &[&str]| -> Vec<Vec<f64>> {
         let mut args = PALPATION.to_vec();
         args.extend_from_slice(extra);
-        let out = mccs(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "stderr: {err}");
-        String::from_utf8(out.stdout)
-            .unwrap()
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect()
+        numbers(mccs_ok(&args))
     };
     // Flat, and over a cap (R = 200 mm: the path's 1 mm below the top is 0.44 … 1 mm
     // deep); and flat with the symplectic integrator option in both backends.
@@ -152,9 +163,7 @@ fn replay_roams_in_the_core_as_in_the_reference() {
             let fixed = run(&extra);
             assert_eq!(fixed.len(), reference.len());
             for (f, r) in fixed.iter().zip(&reference) {
-                let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
-                let diff =
-                    ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
+                let (mag, diff) = force_gap(f, r);
                 assert!(
                     diff <= 0.02 + 0.02 * mag,
                     "{extra:?} t = {}: {f:?} against {r:?}",
@@ -197,11 +206,7 @@ fn the_reference_backend_runs_the_heaviest_damping() {
             "--backend",
             backend,
         ]);
-        let text = String::from_utf8(out.stdout).unwrap();
-        text.lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-            .collect::<Vec<Vec<f64>>>()
+        numbers(out)
     };
     // The case is over the core's cap for the twin's rule, and under the twin's own.
     let law = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
@@ -276,13 +281,7 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
             "64,64",
         ];
         args.extend_from_slice(extra);
-        let out = mccs_ok(&args);
-        String::from_utf8(out.stdout)
-            .unwrap()
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect()
+        numbers(mccs_ok(&args))
     };
     for shape in [&[][..], &["--cap-radius", "300"][..]] {
         for friction in ["0,0", "0.6,0.4"] {
@@ -291,9 +290,7 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
             let fixed = run(&[&args[..], &["--backend", "fixed"][..]].concat());
             assert_eq!(fixed.len(), reference.len());
             for (f, r) in fixed.iter().zip(&reference) {
-                let mag = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
-                let diff =
-                    ((f[1] - r[1]).powi(2) + (f[2] - r[2]).powi(2) + (f[3] - r[3]).powi(2)).sqrt();
+                let (mag, diff) = force_gap(f, r);
                 assert!(
                     diff <= 0.02 + 0.01 * mag,
                     "{args:?} t = {}: {f:?} vs {r:?}",
