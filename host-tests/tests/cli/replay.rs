@@ -310,3 +310,54 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
         }
     }
 }
+
+/// The fastest slide the core's window follows: one spacing per tick (2.5 m/s at 2.5 mm
+/// and 1 kHz). A frictionless slide 1 mm deep, 80 mm along x, at 2.4 m/s: the core and
+/// the reference both push along the normal only. At 3 m/s the reference's proxy still
+/// follows the probe (past the window, on the tissue at rest), while the core's stays in
+/// its window, which moves one node per tick: it lags, and the coupling drags the probe
+/// back (a tangential force larger than the normal one). `docs/roaming.md` quotes both.
+#[test]
+fn the_core_follows_slides_up_to_one_spacing_per_tick() {
+    let tangent_over_normal = |speed: f64, backend: &str| -> f64 {
+        let end = 0.2 + 80.0 / speed;
+        let traj = temp_file(
+            &format!("slide-{speed}.csv"),
+            &format!(
+                "time_s,x_mm,y_mm,z_mm\n0,-40.3,0.2,1\n0.2,-40.3,0.2,-1\n{end:.6},39.7,0.2,-1\n{:.6},39.7,0.2,1\n",
+                end + 0.2
+            ),
+        );
+        let rows = numbers(mccs_ok(&[
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            traj.to_str().unwrap(),
+            "--tissue",
+            "64,64",
+            "--backend",
+            backend,
+        ]));
+        rows.iter()
+            .filter(|r| (0.22..end - 0.002).contains(&r[0]))
+            .map(|r| (r[1] * r[1] + r[2] * r[2]).sqrt() / r[3])
+            .fold(0.0, f64::max)
+    };
+    for (case, speed) in [("within", 2400.0), ("beyond", 3000.0)] {
+        let (reference, fixed) = (
+            tangent_over_normal(speed, "reference"),
+            tangent_over_normal(speed, "fixed"),
+        );
+        println!(
+            "ROAMSPEED case={case} speed_m_s={} reference_tangent_over_normal={reference:.1e} fixed_tangent_over_normal={fixed:.1e}",
+            speed / 1000.0
+        );
+        assert!(reference <= 1e-3, "{case}: {reference}");
+        if case == "within" {
+            assert!(fixed <= 1e-3, "{case}: {fixed}");
+        } else {
+            assert!(fixed >= 1.0, "{case}: {fixed}");
+        }
+    }
+}
