@@ -13,6 +13,21 @@ fn numbers(out: Output) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The rows of Table 2's 64 × 64 tissue roamed along `traj`, with `extra` arguments.
+fn roam_table2(traj: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
+    let mut args = vec![
+        "replay",
+        "--params",
+        "params/table2.toml",
+        "--probe",
+        traj.to_str().unwrap(),
+        "--tissue",
+        "64,64",
+    ];
+    args.extend_from_slice(extra);
+    numbers(mccs_ok(&args))
+}
+
 /// `(|F_r|, |F_f − F_r|)`: the reference row's force and how far the other's is from it.
 fn force_gap(f: &[f64], r: &[f64]) -> (f64, f64) {
     let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -270,19 +285,7 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
         "time_s,x_mm,y_mm,z_mm\n0,0.3,0.2,1\n0.5,0.3,0.2,-1\n1.5,93.7,0.2,-1\n\
          2,93.7,91.3,-3\n2.5,-92.1,-93.3,-1\n3,0.3,0.2,1\n",
     );
-    let run = |extra: &[&str]| -> Vec<Vec<f64>> {
-        let mut args = vec![
-            "replay",
-            "--params",
-            "params/table2.toml",
-            "--probe",
-            traj.to_str().unwrap(),
-            "--tissue",
-            "64,64",
-        ];
-        args.extend_from_slice(extra);
-        numbers(mccs_ok(&args))
-    };
+    let run = |extra: &[&str]| roam_table2(&traj, extra);
     for shape in [&[][..], &["--cap-radius", "300"][..]] {
         for friction in ["0,0", "0.6,0.4"] {
             let args = [shape, &["--friction", friction][..]].concat();
@@ -328,17 +331,7 @@ fn the_core_follows_slides_up_to_one_spacing_per_tick() {
                 end + 0.2
             ),
         );
-        let rows = numbers(mccs_ok(&[
-            "replay",
-            "--params",
-            "params/table2.toml",
-            "--probe",
-            traj.to_str().unwrap(),
-            "--tissue",
-            "64,64",
-            "--backend",
-            backend,
-        ]));
+        let rows = roam_table2(&traj, &["--backend", backend]);
         rows.iter()
             .filter(|r| (0.22..end - 0.002).contains(&r[0]))
             .map(|r| (r[1] * r[1] + r[2] * r[2]).sqrt() / r[3])
