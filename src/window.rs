@@ -130,6 +130,22 @@ impl<const EDGES: usize, const CAP: bool> Window<EDGES, CAP> {
         [at(c.0, self.w), at(c.1, self.h)]
     }
 
+    /// Patch-frame point `p` (Q24 mm) with its `xy` held to the tissue's rectangle, whose
+    /// sides lie `(W − 1) s / 2` from the tissue's centre.
+    pub(crate) fn held_to_tissue(&self, p: [i32; 3]) -> [i32; 3] {
+        let o = self.origin();
+        let half = |w: i32| crate::q::sat(crate::q::mul_wide(w - 1, self.spacing) >> 1);
+        let hold = |x: i32, o: i32, h: i32| {
+            x.max(h.saturating_neg().saturating_sub(o))
+                .min(h.saturating_sub(o))
+        };
+        [
+            hold(p[0], o[0], half(self.w)),
+            hold(p[1], o[1], half(self.h)),
+            p[2],
+        ]
+    }
+
     /// The shift for a point `g` (window grid coordinates, Q16): −1, 0 or +1 per axis,
     /// kept inside the tissue.
     pub(crate) fn step_for(&self, g: [i32; 2]) -> [i32; 2] {

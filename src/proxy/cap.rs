@@ -87,8 +87,9 @@ impl Proxy {
     }
 
     /// The grid position of the deformed surface's point on the cap's radial line
-    /// through `p` (patch frame, Q24 mm), and that line's direction (Q29).
-    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> ([i32; 2], V3) {
+    /// through `p` (patch frame, Q24 mm), whether it was held to the patch (the line
+    /// meets the surface beyond it), and that line's direction (Q29).
+    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> ([i32; 2], bool, V3) {
         let n = f.cap.radial([
             p[0].saturating_add(f.origin[0]),
             p[1].saturating_add(f.origin[1]),
@@ -99,12 +100,14 @@ impl Proxy {
         let r = f.cap.radius_q20();
         let on_cap = |k: usize| sat(mul_wide(r, n[k]) >> 25).saturating_sub(f.origin[k]);
         let start = self.rest_grid(on_cap(0), on_cap(1));
-        (self.locate_along(s, p, n, start, LOCATE_STEPS), n)
+        let (g, beyond) = self.locate_along(s, p, n, start, LOCATE_STEPS);
+        (g, beyond, n)
     }
 
     /// The grid position of the deformed surface's point on the line through `p` along
     /// `n` (Q29), from grid position `start` near it: `steps` corrections, each by the
-    /// offset between that line and the surface point there.
+    /// offset between that line and the surface point there; held to the patch, and
+    /// whether it was.
     fn locate_along(
         &self,
         s: &impl Surface,
@@ -112,7 +115,7 @@ impl Proxy {
         n: V3,
         start: [i32; 2],
         steps: usize,
-    ) -> [i32; 2] {
+    ) -> ([i32; 2], bool) {
         let mut g = start;
         for _ in 0..steps {
             let sp = self.point(s, g);
@@ -123,13 +126,12 @@ impl Proxy {
                 g[1].saturating_add(self.spacings(target[1].saturating_sub(sp[1]))),
             ];
         }
-        let top = (self.n - 1) << G_FRAC;
-        g.map(|x| x.max(0).min(top))
+        self.held_to_patch(g)
     }
 
     /// [`Proxy::update`] on a cap.
     pub(crate) fn update_cap(&mut self, s: &impl Surface, f: &CapFrame, probe: V3) {
-        let (goal_g, line) = self.locate_cap(s, f, probe);
+        let (goal_g, beyond, line) = self.locate_cap(s, f, probe);
         let (goal, n) = self.centre_cap(s, f, goal_g);
         if dot(sub(goal, probe), n) <= 0 {
             self.release();
@@ -147,6 +149,10 @@ impl Proxy {
             self.slipping = true;
             return;
         }
+        // The offset is measured from the goal's line: from the goal across its normal,
+        // or, when the line meets the surface beyond the patch (the goal held to its
+        // edge), from the probe across the line itself (as `Proxy::update`).
+        let (from, n) = if beyond { (probe, line) } else { (goal, n) };
         // The rest normal under `at`, once known (`None` after a move).
         let mut n_at = None;
         for pass in 0..3 {
@@ -154,7 +160,7 @@ impl Proxy {
             n_at = Some(under);
             let depth = dot(sub(proxy, probe), n).max(0);
             // The offset across n, and the cones, in Q20 (squares within i64).
-            let off = sub(proxy, goal);
+            let off = sub(proxy, from);
             let t = sub(off, along(dot(off, n), n));
             let t20 = t.map(|x| x >> 4);
             let t2 = t20.iter().map(|&x| mul_wide(x, x)).sum();
@@ -164,10 +170,12 @@ impl Proxy {
             }
             let lambda = scale_to(radius, t2);
             let next: V3 =
-                core::array::from_fn(|k| goal[k].saturating_add(q::mul_weight(t[k], lambda)));
+                core::array::from_fn(|k| from[k].saturating_add(q::mul_weight(t[k], lambda)));
             // The surface point under the slid proxy, along the goal's line, from where
             // the proxy was.
-            at = self.locate_along(s, sub(next, along(self.radius, n)), line, at, SLIP_STEPS);
+            at = self
+                .locate_along(s, sub(next, along(self.radius, n)), line, at, SLIP_STEPS)
+                .0;
             n_at = None;
         }
         self.at = Some(at);

@@ -269,8 +269,8 @@ impl Proxy {
 
     /// The deformed surface's point above or below patch-frame `(x, y)`: from the rest
     /// grid, two corrections by the surface's offset there (nodes move sideways far less
-    /// than a spacing).
-    fn locate(&self, s: &impl Surface, x: i32, y: i32) -> [i32; 2] {
+    /// than a spacing); held to the patch, and whether it was (the point lies beyond it).
+    fn locate(&self, s: &impl Surface, x: i32, y: i32) -> ([i32; 2], bool) {
         let mut g = self.rest_grid(x, y);
         for _ in 0..2 {
             let p = self.point(s, g);
@@ -279,8 +279,23 @@ impl Proxy {
                 g[1].saturating_add(self.spacings(y.saturating_sub(p[1]))),
             ];
         }
+        self.held_to_patch(g)
+    }
+
+    /// Patch-frame point `p` (Q24 mm) with its `xy` held to the patch's rectangle (its
+    /// nodes `0 … n − 1` spacings from the first, the centre node `n/2` at the origin):
+    /// the goal of [`Proxy::update`] when the patch is the whole surface.
+    pub(crate) fn held_to_patch_xy(&self, p: V3) -> V3 {
+        let at = |k: i32| q::sat(q::mul_wide(k, self.spacing));
+        let (lo, hi) = (at(-(self.n / 2)), at(self.n - 1 - self.n / 2));
+        [p[0].max(lo).min(hi), p[1].max(lo).min(hi), p[2]]
+    }
+
+    /// Grid position `g` held to the patch, and whether it was outside.
+    fn held_to_patch(&self, g: [i32; 2]) -> ([i32; 2], bool) {
         let top = (self.n - 1) << G_FRAC;
-        g.map(|x| x.max(0).min(top))
+        let held = g.map(|x| x.max(0).min(top));
+        (held, held != g)
     }
 
     /// The proxy's centre for grid `g`: the surface point plus `r` up.
@@ -294,9 +309,11 @@ impl Proxy {
         self.at.map(|g| self.centre(s, g))
     }
 
-    /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame).
+    /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame),
+    /// its `xy` held by the caller to the surface (the patch, or the window's tissue):
+    /// when it lies beyond the patch, the surface goes on there at rest.
     pub(crate) fn update(&mut self, s: &impl Surface, probe: V3) {
-        let goal_g = self.locate(s, probe[0], probe[1]);
+        let (goal_g, beyond) = self.locate(s, probe[0], probe[1]);
         let goal = self.centre(s, goal_g);
         if goal[2] <= probe[2] {
             self.release();
@@ -313,13 +330,19 @@ impl Proxy {
             self.slipping = true;
             return;
         }
+        // The offset is measured from the goal's line, the vertical through the probe:
+        // from the goal, or, when the probe lies beyond the patch (the goal held to its
+        // edge), from the probe itself, so that a probe far from a sticking proxy still
+        // makes it slip (held, the offset stopped at the patch's edge and the proxy
+        // stuck with the force at the device's maximum).
+        let from = if beyond { probe } else { goal };
         for pass in 0..3 {
             let proxy = self.centre(s, at);
             let depth = proxy[2].saturating_sub(probe[2]).max(0);
             // The offset across z, and the cones, in Q20 (squares within i64).
             let t = [
-                proxy[0].saturating_sub(goal[0]) >> 4,
-                proxy[1].saturating_sub(goal[1]) >> 4,
+                proxy[0].saturating_sub(from[0]) >> 4,
+                proxy[1].saturating_sub(from[1]) >> 4,
             ];
             let t2 = mul_wide(t[0], t[0]) + mul_wide(t[1], t[1]);
             let (radius, radius2) = self.cone(pass, t2, depth);
@@ -329,12 +352,12 @@ impl Proxy {
             // On the cone: goal + t · radius/|t|, the ratio by a reciprocal square root.
             let lambda = scale_to(radius, t2);
             let next = [0, 1].map(|k| {
-                let off = proxy[k].saturating_sub(goal[k]);
-                goal[k].saturating_add(q::mul_weight(off, lambda))
+                let off = proxy[k].saturating_sub(from[k]);
+                from[k].saturating_add(q::mul_weight(off, lambda))
             });
             // Past the cone only when slipping (sticking, the state test above keeps
             // `t2` within the static cone): the next pass re-measures the depth there.
-            at = self.locate(s, next[0], next[1]);
+            at = self.locate(s, next[0], next[1]).0;
         }
         self.at = Some(at);
     }

@@ -159,7 +159,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let p = probe.map(Length::to_bits);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
-        proxy.update(&self.view(proxy), p);
+        // Past the patch's edge, the goal is the point above the nearest point of it.
+        proxy.update(&self.view(proxy), proxy.held_to_patch_xy(p));
         self.proxy_substeps(p, probe_vel, proxy);
         self.device_force()
     }

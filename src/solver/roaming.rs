@@ -314,9 +314,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let mut p = in_window(window);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         let frame = cap_frame(window);
+        // The contact's goal: the probe with its `xy` held to the tissue's rectangle (past
+        // the tissue's edge, the point above the nearest point of the tissue).
+        let goal = window.held_to_tissue(p);
         match &frame {
-            None => proxy.update(&self.view(proxy), p),
-            Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, p),
+            None => proxy.update(&self.view(proxy), goal),
+            Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, goal),
         }
         let g = proxy.grid_position().unwrap_or_else(|| proxy.grid_of(p));
         let d = window.step_for(g);

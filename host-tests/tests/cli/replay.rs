@@ -354,3 +354,71 @@ fn the_core_follows_slides_up_to_one_spacing_per_tick() {
         }
     }
 }
+
+/// A deep press with high friction (μ_s = 2, μ_k = 1.5, the probe 4 mm in), slid 30 mm:
+/// the friction cone is wider than the core's window. The core slips when the reference
+/// does, at every tick, and its tangential force stays within μ_s times the normal one,
+/// flat and over a cap. Before, the core measured the proxy's offset from the goal held
+/// to its window's edge: the offset never passed the cone, the proxy stuck for good, the
+/// window (which follows the proxy) never moved, and the tangential force grew to the
+/// device's maximum, 9 times the normal one.
+#[test]
+fn a_friction_cone_wider_than_the_window_still_slips() {
+    let traj = temp_file(
+        "deep-friction.csv",
+        "time_s,x_mm,y_mm,z_mm\n0,0.3,0.2,1\n0.5,0.3,0.2,-4\n3.5,30.3,0.2,-4\n4,30.3,0.2,1\n",
+    );
+    for shape in [&[][..], &["--cap-radius", "300"][..]] {
+        let args = [shape, &["--friction", "2,1.5"][..]].concat();
+        let reference = roam_table2(&traj, &args);
+        let fixed = roam_table2(&traj, &[&args[..], &["--backend", "fixed"][..]].concat());
+        let ratio = |r: &Vec<f64>| {
+            if r[3] > 0.1 {
+                (r[1] * r[1] + r[2] * r[2]).sqrt() / r[3]
+            } else {
+                0.0
+            }
+        };
+        let most = fixed.iter().map(ratio).fold(0.0, f64::max);
+        assert!(most <= 2.0 * 1.01, "{args:?}: tangential {most} × normal");
+        assert!(fixed.iter().any(|r| r[8] == 1.0), "{args:?}: never slipped");
+        for (f, r) in fixed.iter().zip(&reference) {
+            assert_eq!((f[7], f[8]), (r[7], r[8]), "{args:?} t = {}", r[0]);
+        }
+        assert!(
+            fixed.last().unwrap()[9] >= 9.0,
+            "{args:?}: the window stayed"
+        );
+    }
+}
+
+/// A limit of the core's surface search, measured: it finds the point under a goal by
+/// two corrections from the rest grid, which converge more slowly where the surface is
+/// pressed far in (its nodes moved sideways by a large part of a spacing). Sliding with
+/// friction (0.6 / 0.4) 30 mm at 10 mm/s, the probe 2 mm and 4 mm in: the largest gap
+/// between the core's and the reference's sideways force (across the slide) against the
+/// normal force. `docs/roaming.md` quotes the lines; the bounds hold them.
+#[test]
+fn the_core_surface_search_at_deep_presses() {
+    for (case, depth, bound) in [("d2", 2.0, 0.02), ("d4", 4.0, 0.5)] {
+        let traj = temp_file(
+            &format!("deep-{case}.csv"),
+            &format!(
+                "time_s,x_mm,y_mm,z_mm\n0,0.3,0.2,1\n0.5,0.3,0.2,-{depth}\n3.5,30.3,0.2,-{depth}\n4,30.3,0.2,1\n"
+            ),
+        );
+        let args = ["--friction", "0.6,0.4"];
+        let reference = roam_table2(&traj, &args);
+        let fixed = roam_table2(&traj, &[&args[..], &["--backend", "fixed"][..]].concat());
+        let gap = fixed
+            .iter()
+            .zip(&reference)
+            .map(|(f, r)| (f[2] - r[2]).abs())
+            .fold(0.0, f64::max);
+        let normal = reference.iter().map(|r| r[3]).fold(0.0, f64::max);
+        println!(
+            "ROAMDEEP case={case} probe_depth_mm={depth} sideways_gap_n={gap:.2e} normal_n={normal:.2}"
+        );
+        assert!(gap <= bound, "{case}: {gap} N");
+    }
+}
