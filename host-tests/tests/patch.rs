@@ -461,6 +461,23 @@ fn bad_configurations_are_typed_errors() {
         mk(SolverConfig { node_mass: 1e-6, ..base }),
         Err(SolverError::TooManySubsteps { needed }) if needed > 64
     ));
+    // Too many substeps per tick: a tick rate too low for the stable step (1 Hz). The
+    // advice is to raise it (it once said to lower it, which asks for more).
+    let slow = mk(SolverConfig {
+        tick_hz: 1.0,
+        ..base
+    })
+    .unwrap_err();
+    assert!(
+        matches!(slow, SolverError::TooManySubsteps { .. }),
+        "{slow:?}"
+    );
+    let text = slow.to_string();
+    assert!(
+        text.contains("raise") && text.contains("the tick rate"),
+        "{text}"
+    );
+    assert!(!text.contains("lower"), "{text}");
     for (cfg, key) in [
         (
             SolverConfig {

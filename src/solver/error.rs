@@ -60,7 +60,7 @@ impl SolverError {
                 "spring_damping/node_damping: the improved Euler integrator needs damping"
             }
             Self::TooManySubsteps { .. } => {
-                "raise max_substeps, the node mass or the damping, or lower the tick rate"
+                "raise max_substeps, the node mass or the tick rate (the substeps are per tick), or change the damping"
             }
             Self::NoContact => "topology: no contact node",
             Self::ForeignParamSet => {

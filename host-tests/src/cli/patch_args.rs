@@ -155,7 +155,7 @@ pub(super) fn config_error(e: mccs::SolverError, cfg: &SolverConfig) -> CliError
             return arg_error(
                 "--rate",
                 &format!(
-                    "this spring needs {} substeps per tick at {} Hz (at most {}): lower the rate, or raise --node-mass, the damping or --spacing",
+                    "this spring needs {} substeps per tick at {} Hz (at most {}): raise the rate (the substeps are per tick), --node-mass or --spacing, or change the damping",
                     if needed == u32::MAX { format!("{needed} or more") } else { needed.to_string() },
                     cfg.tick_hz, cfg.max_substeps
                 ),

@@ -209,6 +209,15 @@ fn tiny_spacings_name_the_spacing() {
         &patch(&[&zero_step[..], &["--indent", "0.5"]].concat()),
         &["--indent: must be 0 … 1e-300 mm (the --spacing)"],
     );
+    // A rate too low for the stable step: raise it (the advice once said to lower it).
+    let slow = patch(&["--indent", "0.5", "--rate", "5", "--backend", "fixed"]);
+    assert_one_line_error(
+        &slow,
+        &[
+            "--rate: this spring needs",
+            "at 5 Hz (at most 64): raise the rate",
+        ],
+    );
     // Small but stable: the twin runs it at its substeps, or says how many it needs.
     let out = patch(&["--spacing", "0.5", "--indent", "0.1", "--duration", "0.01"]);
     assert!(out.status.success(), "{out:?}");
