@@ -271,7 +271,14 @@ impl Proxy {
     /// grid, two corrections by the surface's offset there (nodes move sideways far less
     /// than a spacing); held to the patch, and whether it was (the point lies beyond it).
     fn locate(&self, s: &impl Surface, x: i32, y: i32) -> ([i32; 2], bool) {
-        let mut g = self.rest_grid(x, y);
+        self.locate_from(s, x, y, self.rest_grid(x, y))
+    }
+
+    /// [`Proxy::locate`] from grid position `start` near the point (a slid proxy: from
+    /// where it was, whose offset from the point is the slide, not the surface's
+    /// sideways deformation there: the corrections converge from much closer).
+    fn locate_from(&self, s: &impl Surface, x: i32, y: i32, start: [i32; 2]) -> ([i32; 2], bool) {
+        let mut g = start;
         for _ in 0..2 {
             let p = self.point(s, g);
             g = [
@@ -357,7 +364,7 @@ impl Proxy {
             });
             // Past the cone only when slipping (sticking, the state test above keeps
             // `t2` within the static cone): the next pass re-measures the depth there.
-            at = self.locate(s, next[0], next[1]).0;
+            at = self.locate_from(s, next[0], next[1], at).0;
         }
         self.at = Some(at);
     }
