@@ -67,6 +67,16 @@ pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) ends: [u32; EDGES],
 }
 
+/// Patch-frame point `p` (Q24 mm) with its `xy` held to `rect` (`[x_lo, x_hi, y_lo,
+/// y_hi]`).
+pub(crate) fn held_to(rect: [i32; 4], p: [i32; 3]) -> [i32; 3] {
+    [
+        p[0].max(rect[0]).min(rect[1]),
+        p[1].max(rect[2]).min(rect[3]),
+        p[2],
+    ]
+}
+
 /// The spring a map entry names, and whether it runs the other way. `NONE`'s index,
 /// 2¹⁵ − 1, is past every spring (a window has fewer: `Solver::window_as` asserts it),
 /// so that a lookup finds nothing and its flag is never read.
@@ -130,19 +140,17 @@ impl<const EDGES: usize, const CAP: bool> Window<EDGES, CAP> {
         [at(c.0, self.w), at(c.1, self.h)]
     }
 
-    /// Patch-frame point `p` (Q24 mm) with its `xy` held to the tissue's rectangle, whose
-    /// sides lie `(W − 1) s / 2` from the tissue's centre.
-    pub(crate) fn held_to_tissue(&self, p: [i32; 3]) -> [i32; 3] {
+    /// The tissue's rectangle in the patch frame, Q24 mm: `[x_lo, x_hi, y_lo, y_hi]`, its
+    /// sides `(W − 1) s / 2` from the tissue's centre.
+    pub(crate) fn tissue_rect(&self) -> [i32; 4] {
         let o = self.origin();
         let half = |w: i32| crate::q::sat(crate::q::mul_wide(w - 1, self.spacing) >> 1);
-        let hold = |x: i32, o: i32, h: i32| {
-            x.max(h.saturating_neg().saturating_sub(o))
-                .min(h.saturating_sub(o))
-        };
+        let (hx, hy) = (half(self.w), half(self.h));
         [
-            hold(p[0], o[0], half(self.w)),
-            hold(p[1], o[1], half(self.h)),
-            p[2],
+            hx.saturating_neg().saturating_sub(o[0]),
+            hx.saturating_sub(o[0]),
+            hy.saturating_neg().saturating_sub(o[1]),
+            hy.saturating_sub(o[1]),
         ]
     }
 

@@ -88,8 +88,9 @@ impl Proxy {
 
     /// The grid position of the deformed surface's point on the cap's radial line
     /// through `p` (patch frame, Q24 mm), whether it was held to the patch (the line
-    /// meets the surface beyond it), and that line's direction (Q29).
-    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> ([i32; 2], bool, V3) {
+    /// meets the surface beyond it), that line's direction (Q29), and where it meets the
+    /// rest cap (patch frame `xy`).
+    fn locate_cap(&self, s: &impl Surface, f: &CapFrame, p: V3) -> ([i32; 2], bool, V3, [i32; 2]) {
         let n = f.cap.radial([
             p[0].saturating_add(f.origin[0]),
             p[1].saturating_add(f.origin[1]),
@@ -100,8 +101,8 @@ impl Proxy {
         let r = f.cap.radius_q20();
         let on_cap = |k: usize| sat(mul_wide(r, n[k]) >> 25).saturating_sub(f.origin[k]);
         let start = self.rest_grid(on_cap(0), on_cap(1));
-        let (g, beyond) = self.locate_along(s, p, n, start, LOCATE_STEPS);
-        (g, beyond, n)
+        let (g, held) = self.locate_along(s, p, n, start, LOCATE_STEPS);
+        (g, held, n, [on_cap(0), on_cap(1)])
     }
 
     /// The grid position of the deformed surface's point on the line through `p` along
@@ -129,9 +130,20 @@ impl Proxy {
         self.held_to_patch(g)
     }
 
-    /// [`Proxy::update`] on a cap.
-    pub(crate) fn update_cap(&mut self, s: &impl Surface, f: &CapFrame, probe: V3) {
-        let (goal_g, beyond, line) = self.locate_cap(s, f, probe);
+    /// [`Proxy::update`] on a cap; `tissue`: the tissue's rectangle in the patch frame
+    /// (`[x_lo, x_hi, y_lo, y_hi]`, Q24 mm).
+    pub(crate) fn update_cap(
+        &mut self,
+        s: &impl Surface,
+        f: &CapFrame,
+        probe: V3,
+        tissue: [i32; 4],
+    ) {
+        let (goal_g, held, line, meets) = self.locate_cap(s, f, probe);
+        // The line meets the tissue beyond the window: the window has yet to follow.
+        let over_tissue = (tissue[0]..=tissue[1]).contains(&meets[0])
+            && (tissue[2]..=tissue[3]).contains(&meets[1]);
+        let beyond = held && over_tissue;
         let (goal, n) = self.centre_cap(s, f, goal_g);
         if dot(sub(goal, probe), n) <= 0 {
             self.release();
@@ -150,8 +162,9 @@ impl Proxy {
             return;
         }
         // The offset is measured from the goal's line: from the goal across its normal,
-        // or, when the line meets the surface beyond the patch (the goal held to its
-        // edge), from the probe across the line itself (as `Proxy::update`).
+        // or, when the line meets the tissue beyond the patch (the goal held to its
+        // edge), from the probe across the line itself (as `Proxy::update`). Past the
+        // tissue's edge, from the goal held to it, as the reference.
         let (from, n) = if beyond { (probe, line) } else { (goal, n) };
         // The rest normal under `at`, once known (`None` after a move).
         let mut n_at = None;

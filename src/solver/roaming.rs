@@ -10,7 +10,7 @@ use crate::q::{self, mul_wide, sat, V3};
 use crate::state::Node;
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
-use crate::window::{continued, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
+use crate::window::{continued, held_to, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
 
 /// Where a spring's end is on the patch's grid: `(a, b, layer)` (layer 1: the base).
 type Key = [i32; 3];
@@ -314,12 +314,14 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let mut p = in_window(window);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         let frame = cap_frame(window);
-        // The contact's goal: the probe with its `xy` held to the tissue's rectangle (past
-        // the tissue's edge, the point above the nearest point of the tissue).
-        let goal = window.held_to_tissue(p);
+        // The contact's goal on a flat tissue: the probe with its `xy` held to the
+        // tissue's rectangle (past the tissue's edge, the point above the nearest point of
+        // the tissue). On a cap, the radial line through the probe itself (past the edge
+        // the cap falls away below the edge's rim, and the contact ends there).
+        let tissue = window.tissue_rect();
         match &frame {
-            None => proxy.update(&self.view(proxy), goal),
-            Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, goal),
+            None => proxy.update(&self.view(proxy), held_to(tissue, p)),
+            Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, p, tissue),
         }
         let g = proxy.grid_position().unwrap_or_else(|| proxy.grid_of(p));
         let d = window.step_for(g);
