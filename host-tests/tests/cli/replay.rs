@@ -361,7 +361,7 @@ fn the_core_follows_slides_up_to_one_spacing_per_tick() {
 /// flat and over a cap. Before, the core measured the proxy's offset from the goal held
 /// to its window's edge: the offset never passed the cone, the proxy stuck for good, the
 /// window (which follows the proxy) never moved, and the tangential force grew to the
-/// device's maximum, 9 times the normal one.
+/// device's maximum, up to 17 times the normal one.
 #[test]
 fn a_friction_cone_wider_than_the_window_still_slips() {
     let traj = temp_file(
