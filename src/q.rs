@@ -416,6 +416,18 @@ pub fn hold<const B: u32>(x: i32) -> i32 {
     }
 }
 
+/// Patch-frame point `p` (Q24 mm) with its `xy` held to `rect` (`[x_lo, x_hi, y_lo,
+/// y_hi]`, Q24 mm): the goal
+/// of the proxy's update past the surface's edge is the point above the nearest point
+/// of it.
+pub(crate) fn held_to(rect: [i32; 4], p: V3) -> V3 {
+    [
+        p[0].max(rect[0]).min(rect[1]),
+        p[1].max(rect[2]).min(rect[3]),
+        p[2],
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     /// `mul_weight` against the exact product, over weights 0 … 2¹⁶ and values up to ±2³¹.

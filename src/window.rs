@@ -59,22 +59,15 @@ pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) cap: Option<crate::cap::Cap>,
     /// `1/s`, Q30 per mm.
     pub(crate) inv_s: i32,
+    /// The tissue's half extents `(W − 1) s / 2`, `(H − 1) s / 2`, Q24 mm (as
+    /// [`Window::origin`] rounds them).
+    pub(crate) half: [i32; 2],
     /// On a cap: the rest heights of the window's `n × n` surface nodes (Q24 mm, node
     /// `(a, b)` at `a n + b`), in the first `n²` slots (the standard patch has
     /// `5n² − 14n + 6 ≥ n²` springs).
     pub(crate) heights: [i32; EDGES],
     /// On a cap: where each spring's two ends are on the window's grid ([`pack_ends`]).
     pub(crate) ends: [u32; EDGES],
-}
-
-/// Patch-frame point `p` (Q24 mm) with its `xy` held to `rect` (`[x_lo, x_hi, y_lo,
-/// y_hi]`).
-pub(crate) fn held_to(rect: [i32; 4], p: [i32; 3]) -> [i32; 3] {
-    [
-        p[0].max(rect[0]).min(rect[1]),
-        p[1].max(rect[2]).min(rect[3]),
-        p[2],
-    ]
 }
 
 /// The spring a map entry names, and whether it runs the other way. `NONE`'s index,
@@ -140,17 +133,15 @@ impl<const EDGES: usize, const CAP: bool> Window<EDGES, CAP> {
         [at(c.0, self.w), at(c.1, self.h)]
     }
 
-    /// The tissue's rectangle in the patch frame, Q24 mm: `[x_lo, x_hi, y_lo, y_hi]`, its
-    /// sides `(W − 1) s / 2` from the tissue's centre.
-    pub(crate) fn tissue_rect(&self) -> [i32; 4] {
-        let o = self.origin();
-        let half = |w: i32| crate::q::sat(crate::q::mul_wide(w - 1, self.spacing) >> 1);
-        let (hx, hy) = (half(self.w), half(self.h));
+    /// The tissue's rectangle in the patch frame whose origin is `o` ([`Window::origin`]),
+    /// Q24 mm (`[x_lo, x_hi, y_lo, y_hi]`).
+    pub(crate) fn tissue_rect(&self, o: [i32; 2]) -> [i32; 4] {
+        let h = self.half;
         [
-            hx.saturating_neg().saturating_sub(o[0]),
-            hx.saturating_sub(o[0]),
-            hy.saturating_neg().saturating_sub(o[1]),
-            hy.saturating_sub(o[1]),
+            h[0].saturating_neg().saturating_sub(o[0]),
+            h[0].saturating_sub(o[0]),
+            h[1].saturating_neg().saturating_sub(o[1]),
+            h[1].saturating_sub(o[1]),
         ]
     }
 

@@ -102,6 +102,9 @@ pub struct Proxy {
     n: i32,
     /// Spacing, Q24 mm.
     spacing: i32,
+    /// The patch's rectangle in the patch frame (Q24 mm, [`grid_rect`]): its nodes
+    /// `0 … n − 1`, the centre node `n/2` at the origin.
+    patch_rect: [i32; 4],
     /// `1/s`, Q30 per mm.
     inv_s: i32,
     /// `μ_s`, `μ_k` and the hysteresis cone `tan(0.6 atan μ_k)`, Q16.
@@ -154,9 +157,11 @@ impl Proxy {
         } else {
             tan_small(0.6 * libm::atan(c.mu_k))
         };
+        let (n, spacing) = (c.grid as i32, from_f64(c.spacing, LEN_FRAC));
         Ok(Proxy {
-            n: c.grid as i32,
-            spacing: from_f64(c.spacing, LEN_FRAC),
+            n,
+            spacing,
+            patch_rect: grid_rect([n / 2; 2], [n - 1; 2], spacing),
             inv_s: from_f64(1.0 / c.spacing, 30),
             mu_s: from_f64(c.mu_s, G_FRAC),
             mu_k: from_f64(c.mu_k, G_FRAC),
@@ -289,13 +294,9 @@ impl Proxy {
         self.held_to_patch(g)
     }
 
-    /// Patch-frame point `p` (Q24 mm) with its `xy` held to the patch's rectangle (its
-    /// nodes `0 … n − 1` spacings from the first, the centre node `n/2` at the origin):
-    /// the goal of [`Proxy::update`] when the patch is the whole surface.
-    pub(crate) fn held_to_patch_xy(&self, p: V3) -> V3 {
-        let at = |k: i32| q::sat(q::mul_wide(k, self.spacing));
-        let (lo, hi) = (at(-(self.n / 2)), at(self.n - 1 - self.n / 2));
-        [p[0].max(lo).min(hi), p[1].max(lo).min(hi), p[2]]
+    /// The patch's rectangle in the patch frame (Q24 mm, [`grid_rect`]).
+    pub(crate) fn patch_rect(&self) -> [i32; 4] {
+        self.patch_rect
     }
 
     /// Grid position `g` held to the patch, and whether it was outside.
@@ -415,6 +416,18 @@ impl Proxy {
         }
         (held(f, coupling.max_force), corners, w)
     }
+}
+
+/// The rectangle (Q24 mm, `[x_lo, x_hi, y_lo, y_hi]`) of a grid of `spacing` (Q24 mm)
+/// whose nodes run `0 … last` per axis, in the frame with node `centre` at the origin.
+fn grid_rect(centre: [i32; 2], last: [i32; 2], spacing: i32) -> [i32; 4] {
+    let at = |k: i32| sat(mul_wide(k, spacing));
+    [
+        at(-centre[0]),
+        at(last[0] - centre[0]),
+        at(-centre[1]),
+        at(last[1] - centre[1]),
+    ]
 }
 
 /// Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after `>> COUPLING_SH`.

@@ -160,7 +160,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
         // Past the patch's edge, the goal is the point above the nearest point of it.
-        proxy.update(&self.view(proxy), proxy.held_to_patch_xy(p));
+        proxy.update(&self.view(proxy), q::held_to(proxy.patch_rect(), p));
         self.proxy_substeps(p, probe_vel, proxy);
         self.device_force()
     }

@@ -10,7 +10,7 @@ use crate::q::{self, mul_wide, sat, V3};
 use crate::state::Node;
 use crate::topology::{surface_node, Edge, GROUND};
 use crate::units::{from_f64, to_f64, Force, Length, DIR_FRAC, LEN_FRAC};
-use crate::window::{continued, held_to, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
+use crate::window::{continued, pack_ends, unpack_ends, Window, WindowConfig, FLIP, NONE};
 
 /// Where a spring's end is on the patch's grid: `(a, b, layer)` (layer 1: the base).
 type Key = [i32; 3];
@@ -173,6 +173,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             shifts: 0,
             cap,
             inv_s: from_f64(1.0 / s, 30),
+            half: [w, h].map(|k| sat(mul_wide(k as i32 - 1, spacing) >> 1)),
             heights: [0; EDGES],
             ends: core::array::from_fn(|e| pack_ends(keys[e])),
         };
@@ -306,21 +307,22 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         proxy: &mut Proxy,
         window: &mut Window<EDGES, CAP>,
     ) -> [Force; 3] {
-        let in_window = |w: &Window<EDGES, CAP>| {
-            let o = w.origin();
+        // The probe in the patch frame whose origin is `o`.
+        let in_frame = |o: [i32; 2]| {
             let p = probe.map(Length::to_bits);
             [p[0].saturating_sub(o[0]), p[1].saturating_sub(o[1]), p[2]]
         };
-        let mut p = in_window(window);
+        let o = window.origin();
+        let mut p = in_frame(o);
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         let frame = cap_frame(window);
         // The contact's goal on a flat tissue: the probe with its `xy` held to the
         // tissue's rectangle (past the tissue's edge, the point above the nearest point of
         // the tissue). On a cap, the radial line through the probe itself (past the edge
         // the cap falls away below the edge's rim, and the contact ends there).
-        let tissue = window.tissue_rect();
+        let tissue = window.tissue_rect(o);
         match &frame {
-            None => proxy.update(&self.view(proxy), held_to(tissue, p)),
+            None => proxy.update(&self.view(proxy), q::held_to(tissue, p)),
             Some(f) => proxy.update_cap(&self.cap_view(proxy, window), f, p, tissue),
         }
         let g = proxy.grid_position().unwrap_or_else(|| proxy.grid_of(p));
@@ -333,7 +335,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             self.shift(window, [0, d[1]], proxy);
         }
         if d != [0, 0] {
-            p = in_window(window);
+            p = in_frame(window.origin());
         }
         self.probe_prev = p;
         if CAP && window.is_cap() {

@@ -95,18 +95,7 @@ fn bad_ranges_name_the_argument() {
 #[test]
 fn negative_numbers_with_signed_exponents_are_values() {
     let run = |from: &str, step: &str| {
-        let out = mccs_ok(&[
-            "curve",
-            "--params",
-            "params/table2.toml",
-            "--from",
-            from,
-            "--to",
-            "0.01",
-            "--step",
-            step,
-        ]);
-        String::from_utf8(out.stdout).unwrap()
+        String::from_utf8(mccs_ok(&curve_table2(from, "0.01", step)).stdout).unwrap()
     };
     let decimal = run("-0.01", "0.005");
     assert!(decimal.lines().nth(1).unwrap().starts_with("-0.01,"));
@@ -143,17 +132,7 @@ fn negative_numbers_with_signed_exponents_are_values() {
     // A pair whose first number is negative, named by its own check (was clap's
     // `unexpected argument '-1'`).
     assert_one_line_error(
-        &mccs(&[
-            "replay",
-            "--params",
-            "params/table2.toml",
-            "--probe",
-            "params/palpation.csv",
-            "--tissue",
-            "64,64",
-            "--friction",
-            "-1e-3,0",
-        ]),
+        &mccs(&[&PALPATION[..7], &["--friction", "-1e-3,0"]].concat()),
         &["--friction: friction: mu_s and mu_k must be within [0, 2]"],
     );
     // In the other subcommands' numbers too: a negative indentation, named.
@@ -179,26 +158,7 @@ fn negative_numbers_with_signed_exponents_are_values() {
 #[test]
 fn fixed_curve_off_its_domain_warns_and_refuses_what_it_cannot_hold() {
     let curve = |from: &str, to: &str, step: &str| {
-        mccs(&[
-            "curve",
-            "--params",
-            "params/table2.toml",
-            "--from",
-            from,
-            "--to",
-            to,
-            "--step",
-            step,
-            "--backend",
-            "fixed",
-        ])
-    };
-    let rows = |out: &Output| -> Vec<Vec<f64>> {
-        String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-            .collect()
+        mccs(&[&curve_table2(from, to, step)[..], &["--backend", "fixed"]].concat())
     };
     let above = curve("1.3", "1.5", "0.1");
     assert!(above.status.success());
@@ -208,13 +168,13 @@ fn fixed_curve_off_its_domain_warns_and_refuses_what_it_cannot_hold() {
         "{err}"
     );
     let law = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
-    for r in rows(&above) {
+    for r in numbers(&above) {
         // What the warning is about: the tangent, under the law by more than 1 %.
         assert!(r[1] < 0.99 * law.force(r[0]), "{r:?}");
     }
     let below = curve("-3", "-1", "0.5");
     assert!(below.status.success() && below.stderr.is_empty());
-    for r in rows(&below) {
+    for r in numbers(&below) {
         assert!(
             (r[1] - law.force(r[0])).abs() < 1e-5 * law.force(r[0]).abs(),
             "{r:?}"
@@ -229,5 +189,5 @@ fn fixed_curve_off_its_domain_warns_and_refuses_what_it_cannot_hold() {
     }
     let edge = curve("-128", "-127", "1");
     assert!(edge.status.success());
-    assert_eq!(rows(&edge).len(), 2);
+    assert_eq!(numbers(&edge).len(), 2);
 }

@@ -215,6 +215,30 @@ fn help_usage_and_the_demo_check() {
     }
 }
 
+/// A command's CSV rows as numbers (the header left out).
+fn numbers(out: &Output) -> Vec<Vec<f64>> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
+/// `mccs curve` on Table 2's spring from `from` to `to` by `step`.
+fn curve_table2<'a>(from: &'a str, to: &'a str, step: &'a str) -> [&'a str; 9] {
+    [
+        "curve",
+        "--params",
+        "params/table2.toml",
+        "--from",
+        from,
+        "--to",
+        to,
+        "--step",
+        step,
+    ]
+}
+
 /// The palpation replayed on a 64 × 64 tissue with friction 0.6 / 0.4.
 const PALPATION: [&str; 9] = [
     "replay",
@@ -289,28 +313,7 @@ fn long_runs_report_progress_on_stderr() {
 fn a_closed_stdout_ends_the_run_quietly() {
     use std::io::{BufRead, BufReader};
     use std::process::Stdio;
-    let runs: [&[&str]; 2] = [
-        &[
-            "curve",
-            "--params",
-            "params/table2.toml",
-            "--from",
-            "0",
-            "--to",
-            "0.9",
-            "--step",
-            "0.00001",
-        ],
-        &[
-            "replay",
-            "--params",
-            "params/table2.toml",
-            "--probe",
-            "params/palpation.csv",
-            "--tissue",
-            "64,64",
-        ],
-    ];
+    let runs: [&[&str]; 2] = [&curve_table2("0", "0.9", "0.00001"), &PALPATION[..7]];
     for args in runs {
         let mut child = Command::new(env!("CARGO_BIN_EXE_mccs"))
             .args(args)

@@ -3,16 +3,6 @@
 
 use super::*;
 
-/// A replay's CSV rows as numbers (the header left out).
-fn numbers(out: Output) -> Vec<Vec<f64>> {
-    String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect()
-}
-
 /// The rows of Table 2's 64 × 64 tissue roamed along `traj`, with `extra` arguments.
 fn roam_table2(traj: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
     let mut args = vec![
@@ -25,7 +15,7 @@ fn roam_table2(traj: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
         "64,64",
     ];
     args.extend_from_slice(extra);
-    numbers(mccs_ok(&args))
+    numbers(&mccs_ok(&args))
 }
 
 /// `(|F_r|, |F_f − F_r|)`: the reference row's force and how far the other's is from it.
@@ -160,7 +150,7 @@ fn replay_roams_in_the_core_as_in_the_reference() {
     let run = |extra: &[&str]| -> Vec<Vec<f64>> {
         let mut args = PALPATION.to_vec();
         args.extend_from_slice(extra);
-        numbers(mccs_ok(&args))
+        numbers(&mccs_ok(&args))
     };
     // Flat, and over a cap (R = 200 mm: the path's 1 mm below the top is 0.44 … 1 mm
     // deep); and flat with the symplectic integrator option in both backends.
@@ -221,7 +211,7 @@ fn the_reference_backend_runs_the_heaviest_damping() {
             "--backend",
             backend,
         ]);
-        numbers(out)
+        numbers(&out)
     };
     // The case is over the core's cap for the twin's rule, and under the twin's own.
     let law = mccs_host::reference::Reference::new(&mccs::Params::TABLE2).unwrap();
