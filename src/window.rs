@@ -59,8 +59,7 @@ pub struct Window<const EDGES: usize, const CAP: bool = false> {
     pub(crate) cap: Option<crate::cap::Cap>,
     /// `1/s`, Q30 per mm.
     pub(crate) inv_s: i32,
-    /// The tissue's half extents `(W − 1) s / 2`, `(H − 1) s / 2`, Q24 mm (as
-    /// [`Window::origin`] rounds them).
+    /// The tissue's half extents `(W − 1) s / 2`, `(H − 1) s / 2`, Q24 mm.
     pub(crate) half: [i32; 2],
     /// On a cap: the rest heights of the window's `n × n` surface nodes (Q24 mm, node
     /// `(a, b)` at `a n + b`), in the first `n²` slots (the standard patch has

@@ -102,8 +102,8 @@ pub struct Proxy {
     n: i32,
     /// Spacing, Q24 mm.
     spacing: i32,
-    /// The patch's rectangle in the patch frame (Q24 mm, [`grid_rect`]): its nodes
-    /// `0 … n − 1`, the centre node `n/2` at the origin.
+    /// The patch's rectangle in the patch frame, Q24 mm (`[x_lo, x_hi, y_lo, y_hi]`):
+    /// its nodes `0 … n − 1`, the centre node `n/2` at the origin.
     patch_rect: [i32; 4],
     /// `1/s`, Q30 per mm.
     inv_s: i32,
@@ -157,11 +157,14 @@ impl Proxy {
         } else {
             tan_small(0.6 * libm::atan(c.mu_k))
         };
-        let (n, spacing) = (c.grid as i32, from_f64(c.spacing, LEN_FRAC));
+        // The patch's rectangle: its nodes `0 … n − 1`, the centre node `n/2` at the
+        // origin.
+        let edge = |k: usize| from_f64(k as f64 * c.spacing, LEN_FRAC);
+        let (lo, hi) = (-edge(c.grid / 2), edge(c.grid - 1 - c.grid / 2));
         Ok(Proxy {
-            n,
-            spacing,
-            patch_rect: grid_rect([n / 2; 2], [n - 1; 2], spacing),
+            n: c.grid as i32,
+            spacing: from_f64(c.spacing, LEN_FRAC),
+            patch_rect: [lo, hi, lo, hi],
             inv_s: from_f64(1.0 / c.spacing, 30),
             mu_s: from_f64(c.mu_s, G_FRAC),
             mu_k: from_f64(c.mu_k, G_FRAC),
@@ -294,7 +297,7 @@ impl Proxy {
         self.held_to_patch(g)
     }
 
-    /// The patch's rectangle in the patch frame (Q24 mm, [`grid_rect`]).
+    /// The patch's rectangle in the patch frame (Q24 mm, `[x_lo, x_hi, y_lo, y_hi]`).
     pub(crate) fn patch_rect(&self) -> [i32; 4] {
         self.patch_rect
     }
@@ -416,18 +419,6 @@ impl Proxy {
         }
         (held(f, coupling.max_force), corners, w)
     }
-}
-
-/// The rectangle (Q24 mm, `[x_lo, x_hi, y_lo, y_hi]`) of a grid of `spacing` (Q24 mm)
-/// whose nodes run `0 … last` per axis, in the frame with node `centre` at the origin.
-fn grid_rect(centre: [i32; 2], last: [i32; 2], spacing: i32) -> [i32; 4] {
-    let at = |k: i32| sat(mul_wide(k, spacing));
-    [
-        at(-centre[0]),
-        at(last[0] - centre[0]),
-        at(-centre[1]),
-        at(last[1] - centre[1]),
-    ]
 }
 
 /// Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after `>> COUPLING_SH`.
