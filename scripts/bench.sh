@@ -3,6 +3,9 @@
 # firmware checks its core's budgets in bench/budgets.txt and exits with failure on a
 # breach of an enforced one; this script then compares every figure with the committed
 # baseline bench/baseline.txt and fails if any grew by more than 5 %.
+# With it, the `table_new` firmware (firmware/src/bin/table_new.rs): what a force table
+# built at a device's start-up costs, in instructions and stack, and in flash the code
+# only its builder reaches (scripts/code_size.py, into target/qemu/code-size.txt).
 # `scripts/bench.sh --update` rewrites the baseline instead of comparing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,25 +27,42 @@ out=target/qemu/bench.txt
 : > "$out"
 status=0
 build_decoder --quiet
-echo "bench: building the bench firmware for m4f, m3 and m0" >&2
-cargo build --quiet --release -p mccs-firmware --bin bench \
+echo "bench: building the bench and table_new firmware for m4f, m3 and m0" >&2
+cargo build --quiet --release -p mccs-firmware --bin bench --bin table_new \
   --target thumbv7em-none-eabihf --target thumbv7m-none-eabi --target thumbv6m-none-eabi
 # The three cores run side by side (each QEMU is one thread; under -icount their counts
 # do not depend on the host's load); each one's exit status in its .rc file.
-echo "bench: running m4f, m3 and m0 in QEMU side by side (about 30 s)" >&2
+echo "bench: running m4f, m3 and m0 in QEMU side by side (about 35 s)" >&2
+# `run_bin CORE BIN LOG`: the firmware in QEMU, its log decoded, its status in LOG.rc.
+run_bin() {
+  local t
+  t=$(core_target "$1")
+  rm -f "$3.rc"
+  set +e
+  timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin "$2" \
+      < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
+    | "$DECODER" "target/$t/release/$2" > "$3"
+  echo "${PIPESTATUS[0]}" > "$3.rc"
+}
 for core in m4f m3 m0; do
-  t=$(core_target "$core")
-  log="target/qemu/bench-$core.log"
-  rm -f "$log.rc"
   (
-    set +e
-    timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin bench \
-        < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
-      | "$DECODER" "target/$t/release/bench" > "$log"
-    echo "${PIPESTATUS[0]}" > "$log.rc"
+    run_bin "$core" bench "target/qemu/bench-$core.log"
+    run_bin "$core" table_new "target/qemu/table-new-$core.log"
   ) &
 done
 wait
+: > target/qemu/code-size.txt
+for core in m4f m3 m0; do
+  log="target/qemu/table-new-$core.log"
+  grep -E "^BENCH " "$log" >> "$out" || true
+  if [ "$(cat "$log.rc" 2> /dev/null)" != 0 ] || ! grep -q "^BENCH " "$log"; then
+    echo "bench: the $core table_new firmware failed (see $log)" >&2
+    status=1
+  fi
+  python3 scripts/code_size.py "target/$(core_target "$core")/release/table_new" "$core" \
+    'mccs_firmware::entry::table_new' table_new >> target/qemu/code-size.txt || status=1
+done
+cat target/qemu/code-size.txt
 for core in m4f m3 m0; do
   log="target/qemu/bench-$core.log"
   rc=$(cat "$log.rc" 2> /dev/null || echo missing)

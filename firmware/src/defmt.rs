@@ -21,7 +21,6 @@ impl Format for DemoError {
         match self {
             Self::Topology(e) => write!(f, "{}", e),
             Self::Solver(e) => write!(f, "{}", e),
-            Self::Table(e) => write!(f, "{}", e),
             Self::Path(e) => write!(f, "{}", e),
             Self::Contact(e) => write!(f, "{}", e),
         }

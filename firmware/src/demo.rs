@@ -3,8 +3,9 @@
 //! slide 30 mm, press harder, slide back, lift) through a proxy with friction on a flat
 //! 64 × 64 Table 2 tissue at 2.5 mm, which the core's standard patch follows as a window
 //! ([`Roaming`]); 1.25 s in, mid-slide, a switch to a stiffer tissue
-//! ([`swapped_params`]: the cone's shear modulus × 1.25), built by the main loop and
-//! handed over through a [`Mailbox`](crate::mailbox::Mailbox). Each core runs the
+//! ([`STIFFER`]: the cone's shear modulus × 1.25, its table emitted by `mccs table`),
+//! prepared by the main loop and handed over through a
+//! [`Mailbox`](crate::mailbox::Mailbox). Each core runs the
 //! [`DemoSpec`] that fits its instruction budget.
 
 use crate::controller::{Controller, Roaming};
@@ -12,8 +13,8 @@ use crate::device::SimulatedDevice;
 use crate::probe_path::{palpation_path, PathError, ProbePath};
 use crate::target::Core;
 use mccs::{
-    Arith, ForceTable64, Narrow, ParamSet, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
-    SolverError, TableError, Topology, TopologyError, Wide, WindowConfig,
+    Arith, ForceTable64, Narrow, ParamSet, ProxyConfig, ProxyError, Solver, SolverConfig,
+    SolverError, Topology, TopologyError, Wide, WindowConfig,
 };
 
 /// A demo configuration: what each core runs within its instruction budget.
@@ -178,16 +179,17 @@ impl DemoSpec {
         }
     }
 
-    /// The swapped parameter set for this spec's patch (software floating point: for the
-    /// main loop, not the tick).
+    /// The swapped parameter set for this spec's patch: [`STIFFER`]'s table with the
+    /// substeps and coefficients it needs (software floating point: for the main loop,
+    /// not the tick).
     #[inline(never)]
     pub fn swapped_set<const N: usize, const E: usize, A: Arith>(
         &self,
     ) -> Result<ParamSet<64, A>, DemoError> {
         let topo =
             Topology::<N, E>::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
-        let table = ForceTable64::new(&swapped_params()).map_err(DemoError::Table)?;
-        Solver::<N, E, 64, A>::prepare_for(&topo, table, &self.config()).map_err(DemoError::Solver)
+        Solver::<N, E, 64, A>::prepare_for(&topo, STIFFER, &self.config())
+            .map_err(DemoError::Solver)
     }
 }
 
@@ -241,12 +243,13 @@ pub type DemoController = DemoControllerOf<37, 214>;
 /// M3 and M0 demos, which must fit 16 KiB of RAM on the M0.
 pub type SmallDemoController = DemoControllerOf<10, 61>;
 
-/// The tissue switched to mid-run: Table 2 with the cone's shear modulus × 1.25.
-pub fn swapped_params() -> Params {
-    let mut p = Params::TABLE2;
-    p.cone.shear_modulus *= 1.25;
-    p
-}
+/// The demo's first tissue: the paper's Table 2 spring (`params/table2.toml`), its
+/// table as `mccs table` emits it.
+pub static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
+
+/// The tissue switched to mid-run: Table 2 with the cone's shear modulus × 1.25
+/// (`params/table2-stiffer.toml`), its table as `mccs table` emits it.
+pub static STIFFER: ForceTable64 = include!("../../tables/table2_stiffer.rs");
 
 /// Why the demo could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -255,8 +258,6 @@ pub enum DemoError {
     Topology(TopologyError),
     /// The solver or a parameter set.
     Solver(SolverError),
-    /// The swapped table.
-    Table(TableError),
     /// The probe path.
     Path(PathError),
     /// The proxy or the window.
@@ -268,7 +269,6 @@ impl core::fmt::Display for DemoError {
         match self {
             Self::Topology(e) => e.fmt(f),
             Self::Solver(e) => e.fmt(f),
-            Self::Table(e) => e.fmt(f),
             Self::Path(e) => e.fmt(f),
             Self::Contact(e) => e.fmt(f),
         }
@@ -302,7 +302,6 @@ pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
 }
 
 fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
-    static TABLE2: ForceTable64 = include!("../../tables/table2.rs");
     let mut ctl: DemoControllerIn<37, 214, A> = spec.controller(&TABLE2)?;
     let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
     for tick in 0..spec.ticks() {

@@ -9,6 +9,13 @@ use mccs::{
     Topology, Window,
 };
 
+/// [`ForceTable64::new`], never inlined: a force table built at a device's start-up, held
+/// to the product's bound (the `table_new` firmware measures it).
+#[inline(never)]
+pub fn table_new(params: &mccs::Params) -> Result<ForceTable64, mccs::TableError> {
+    ForceTable64::new(params)
+}
+
 /// One [`ForceTable64::force_and_stiffness`] evaluation, never inlined.
 #[inline(never)]
 pub fn force_and_stiffness(table: &ForceTable64, strain: Strain) -> (Force, Stiffness) {

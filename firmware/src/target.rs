@@ -16,6 +16,24 @@ pub enum Core {
 }
 
 impl Core {
+    /// The clock (MHz) and cycles per instruction (×100) that turn an instruction count
+    /// into time on a real part: an STM32F405 at 168 MHz (flash behind the ART
+    /// accelerator), an LM3S6965 at 50 MHz, an STM32F0-class M0 at 48 MHz (one flash
+    /// wait state). Estimates, not measurements (QEMU models no cycles).
+    pub const fn clock_estimate(self) -> (u32, u32) {
+        match self {
+            Self::M4F => (168, 125),
+            Self::M3 => (50, 125),
+            Self::M0 => (48, 150),
+        }
+    }
+
+    /// `instructions` as milliseconds at [`Core::clock_estimate`].
+    pub const fn ms_at_clock(self, instructions: u64) -> u64 {
+        let (mhz, cpi) = self.clock_estimate();
+        instructions * cpi as u64 / 100 / (mhz as u64 * 1000)
+    }
+
     /// `m4f`, `m3` or `m0`.
     pub const fn name(self) -> &'static str {
         match self {

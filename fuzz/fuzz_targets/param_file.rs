@@ -10,7 +10,7 @@ fuzz_target!(|text: &str| {
             assert!(p.validate().is_ok());
             let law = mccs::Law::new(&p).expect("validated");
             let _ = mccs_host::reference::Reference::new(&p).expect("validated");
-            let _ = mccs::ForceTable64::from_law(&law, -0.5, 0.95);
+            let _ = mccs::ForceTable64::one_placement_unmeasured(&law, -0.5, 0.95);
             let again = mccs_host::paramfile::parse(&mccs_host::paramfile::to_toml(&p), Path::new("x"));
             assert_eq!(again, Ok(p), "round trip");
         }

@@ -9,8 +9,8 @@ use crate::reference::Reference;
 use crate::roam::{Friction, RoamConfig, RoamError, RoamTwin, Tissue};
 use crate::trajectory::Trajectory;
 use mccs::{
-    Arith, ForceTable64, Length, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
-    SolverError, Topology, WindowConfig,
+    Arith, ForceTable, Length, Params, ProxyConfig, ProxyError, Solver, SolverConfig, SolverError,
+    Topology, WindowConfig,
 };
 
 /// Capacities of the fixed backend's solver: N = 12 has 101 node slots and 558 springs.
@@ -85,42 +85,53 @@ pub struct Replay {
 }
 
 impl Replay {
-    /// Runs `traj` through the patch with `params`; `row` gets each tick's output.
+    /// Runs `traj` through the patch with `params`; `row` gets each tick's output. The
+    /// fixed-point engines run the table [`ForceTable::new`] builds (65 knots, held to
+    /// the product's bound).
     pub fn run(
         &self,
         params: &Params,
+        traj: &Trajectory,
+        row: impl FnMut(Row),
+    ) -> Result<(), ReplayError> {
+        self.run_with::<64>(params, None, traj, row)
+    }
+
+    /// [`Replay::run`] with the fixed-point engines on `table` (built for `params`; `None`:
+    /// [`ForceTable::new`]'s); the reference engine runs the law of `params`.
+    pub fn run_with<const S: usize>(
+        &self,
+        params: &Params,
+        table: Option<&ForceTable<S>>,
         traj: &Trajectory,
         mut row: impl FnMut(Row),
     ) -> Result<(), ReplayError> {
         match self.engine {
             Engine::Reference => self.run_twin(params, traj, &mut row),
-            Engine::Wide => self.run_fixed(params, traj, mccs::Wide, &mut row),
-            Engine::Narrow => self.run_fixed(params, traj, mccs::Narrow, &mut row),
+            Engine::Wide => self.run_fixed(params, table, traj, mccs::Wide, &mut row),
+            Engine::Narrow => self.run_fixed(params, table, traj, mccs::Narrow, &mut row),
         }
     }
 
-    fn run_fixed<A: Arith>(
+    fn run_fixed<A: Arith, const S: usize>(
         &self,
         params: &Params,
+        table: Option<&ForceTable<S>>,
         traj: &Trajectory,
         arith: A,
         row: &mut dyn FnMut(Row),
     ) -> Result<(), ReplayError> {
-        let mut s = self.solver(params, self.spacing, arith)?;
+        let mut s = self.solver(params, table, self.spacing, arith)?;
         let nodes = s.topology().node_count() as u16;
         let contact = s.topology().contact();
         let mm = |x: [Length; 3]| x.map(|c| c.to_num::<f64>());
         for (time, p) in traj.ticks(self.config.tick_hz) {
             let f = s.step(p.map(Length::saturating_from_num));
-            let max_disp = (1..nodes)
-                .filter_map(|i| s.displacement(i))
-                .map(|d| norm(mm(d)))
-                .fold(0.0, f64::max);
             row(Row {
                 time,
                 force: f.map(|c| c.to_num::<f64>()),
                 contact: s.displacement(contact).map(mm).unwrap_or([0.0; 3]),
-                max_disp,
+                max_disp: max_disp_fixed(&s, nodes),
             });
         }
         Ok(())
@@ -141,12 +152,11 @@ impl Replay {
             let disp = |i: usize| -> [f64; 3] {
                 std::array::from_fn(|k| twin.x[i][k] - twin.mesh.rest[i][k])
             };
-            let max_disp = (0..twin.x.len()).map(|i| norm(disp(i))).fold(0.0, f64::max);
             row(Row {
                 time,
                 force,
                 contact: disp(c),
-                max_disp,
+                max_disp: max_disp_twin(&twin),
             });
         }
         Ok(())
@@ -154,14 +164,19 @@ impl Replay {
 }
 
 impl Replay {
-    /// The fixed-point solver of the standard patch at `spacing`.
-    fn solver<A: Arith>(
+    /// The fixed-point solver of the standard patch at `spacing`, on `table` (`None`:
+    /// [`ForceTable::new`]'s for `params`).
+    fn solver<A: Arith, const S: usize>(
         &self,
         params: &Params,
+        table: Option<&ForceTable<S>>,
         spacing: f64,
         arith: A,
-    ) -> Result<Solver<FIXED_NODES, FIXED_EDGES, 64, A>, ReplayError> {
-        let table = ForceTable64::new(params).map_err(ReplayError::Table)?;
+    ) -> Result<Solver<FIXED_NODES, FIXED_EDGES, S, A>, ReplayError> {
+        let table = match table {
+            Some(t) => *t,
+            None => ForceTable::<S>::new(params).map_err(ReplayError::Table)?,
+        };
         let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(self.grid, spacing)
             .map_err(ReplayError::Topology)?;
         Solver::with_arith(topo, table, &self.config, arith).map_err(ReplayError::Solver)
@@ -210,6 +225,8 @@ pub struct RoamRow {
     pub slipping: bool,
     /// Window shifts so far.
     pub window_shifts: u32,
+    /// The largest |displacement| from rest of any node of the window, mm.
+    pub max_disp: f64,
 }
 
 impl Replay {
@@ -222,26 +239,40 @@ impl Replay {
         params: &Params,
         traj: &Trajectory,
         roaming: &Roaming,
+        row: impl FnMut(RoamRow),
+    ) -> Result<(), ReplayError> {
+        self.roam_with::<64>(params, None, traj, roaming, row)
+    }
+
+    /// [`Replay::roam`] with the fixed-point engines on `table`, as [`Replay::run_with`].
+    pub fn roam_with<const S: usize>(
+        &self,
+        params: &Params,
+        table: Option<&ForceTable<S>>,
+        traj: &Trajectory,
+        roaming: &Roaming,
         mut row: impl FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
         match self.engine {
             Engine::Reference => self.roam_twin(params, traj, roaming, &mut row),
-            Engine::Wide => self.roam_fixed(params, traj, roaming, mccs::Wide, &mut row),
-            Engine::Narrow => self.roam_fixed(params, traj, roaming, mccs::Narrow, &mut row),
+            Engine::Wide => self.roam_fixed(params, table, traj, roaming, mccs::Wide, &mut row),
+            Engine::Narrow => self.roam_fixed(params, table, traj, roaming, mccs::Narrow, &mut row),
         }
     }
 
     /// The core's roaming ([`mccs::Solver::step_roaming`]).
-    fn roam_fixed<A: Arith>(
+    fn roam_fixed<A: Arith, const S: usize>(
         &self,
         params: &Params,
+        table: Option<&ForceTable<S>>,
         traj: &Trajectory,
         roaming: &Roaming,
         arith: A,
         row: &mut dyn FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
         let spacing = roaming.tissue.spacing;
-        let mut s = self.solver(params, spacing, arith)?;
+        let mut s = self.solver(params, table, spacing, arith)?;
+        let nodes = s.topology().node_count() as u16;
         let mut proxy = s
             .proxy(&ProxyConfig {
                 grid: self.grid,
@@ -282,6 +313,7 @@ impl Replay {
                 contact: proxy.grid_position().is_some(),
                 slipping: proxy.slipping(),
                 window_shifts: window.shifts(),
+                max_disp: max_disp_fixed(&s, nodes),
             });
         }
         Ok(())
@@ -317,10 +349,29 @@ impl Replay {
                 contact: contact.is_some(),
                 slipping: contact.is_some_and(|c| c.slip.0),
                 window_shifts: twin.shifts,
+                max_disp: max_disp_twin(twin.window()),
             });
         }
         Ok(())
     }
+}
+
+/// The largest |displacement| from rest of the core's free nodes `1 … nodes − 1`, mm.
+fn max_disp_fixed<const N: usize, const E: usize, const S: usize, A: Arith>(
+    s: &Solver<N, E, S, A>,
+    nodes: u16,
+) -> f64 {
+    (1..nodes)
+        .filter_map(|i| s.displacement(i))
+        .map(|d| norm(d.map(|c| c.to_num::<f64>())))
+        .fold(0.0, f64::max)
+}
+
+/// The largest |displacement| from rest of the twin's nodes, mm.
+fn max_disp_twin(twin: &Twin) -> f64 {
+    (0..twin.x.len())
+        .map(|i| norm(std::array::from_fn(|k| twin.x[i][k] - twin.mesh.rest[i][k])))
+        .fold(0.0, f64::max)
 }
 
 fn norm(v: [f64; 3]) -> f64 {

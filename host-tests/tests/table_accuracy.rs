@@ -354,7 +354,7 @@ proptest! {
         // transition Δ(F_T) (a jump in curvature; see the test below). The largest errors
         // left are where a cubic cannot follow the law: the transition inside the first
         // segment (Δ(P) closer to it), or the cone's steep rise just below Δ(P) when P is
-        // close to F_C (`a_devices_table_below_a_late_preload`): a device's table
+        // close to F_C (`one_placement_misses_a_late_preload_the_best_meets_it`): one placement
         // (`ForceTable::new`, one placement, unmeasured) promises no bound. 1.3e-2 seen
         // (2,000 cases, PROPTEST_RNG_SEED=2); 3e-2 asserted, and its own measure
         // (`ForceTable::measured`, what a device can log) must see it.
@@ -670,12 +670,12 @@ fn the_spring_loop_runs_a_lower_corner_as_the_kernel_does() {
 }
 
 /// Found by `random_springs_any_preload` (2026-11-27): a preload at 0.85 `F_C` puts its
-/// kink `Δ(P)` on the cone's steep rise toward its solid point. A device's table (one
-/// placement, `ForceTable::new`) misses the product's bound there by far (8.2e-3 of
-/// `F(0.95)` just below `Δ(P)`), and says so when measured; the builder's best
-/// (`ForceTable::with_bound`, what `mccs table` emits) meets it.
+/// kink `Δ(P)` on the cone's steep rise toward its solid point. One placement
+/// (`ForceTable::one_placement_unmeasured`) misses the product's bound there by far (8.2e-3 of `F(0.95)` just below `Δ(P)`), and says so
+/// when measured; the builder's best (`ForceTable::new`, what `mccs table` emits) meets
+/// it.
 #[test]
-fn a_devices_table_below_a_late_preload() {
+fn one_placement_misses_a_late_preload_the_best_meets_it() {
     let p = Params {
         cone: mccs::Cone {
             wire_diameter: 0.10737573340468612,
@@ -695,9 +695,9 @@ fn a_devices_table_below_a_late_preload() {
     };
     let r = Reference::new(&p).unwrap();
     let law = mccs::Law::new(&p).unwrap();
-    let device = ForceTable::<64>::new(&p).unwrap();
-    let s = sweep(&r, &device);
-    let own = device
+    let single = ForceTable::<64>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    let s = sweep(&r, &single);
+    let own = single
         .measured(&law, DOMAIN.0, DOMAIN.1)
         .max_error()
         .unwrap();
@@ -709,8 +709,7 @@ fn a_devices_table_below_a_late_preload() {
         s.max_force > 1e-3 && own.force >= 0.5 * s.max_force,
         "{s:?} {own:?}"
     );
-    let best = ForceTable::<64>::with_bound(&p, DOMAIN.0, DOMAIN.1, &mccs::TableBound::PRODUCT)
-        .expect("the builder's best meets the bound");
+    let best = ForceTable::<64>::new(&p).expect("the builder's best meets the bound");
     let s = sweep(&r, &best);
     assert!(s.max_force <= 2e-5 * 1.02 + 1e-6, "{s:?}");
 }

@@ -2,9 +2,9 @@
 //! when it is built for emission or against a bound ([`ForceTable::measured`],
 //! [`ForceTable::with_bound`]; every table `mccs table` emits) and carried with it
 //! (`RawTable::err_force_ppb`, `err_stiffness_ppb`; [`ForceTable::max_error`]), and the
-//! bound the product promises ([`TableBound::PRODUCT`]). A table built on a device with
-//! [`ForceTable::new`] is not measured unless asked: the measurement costs about 4 KiB
-//! of flash and about `65 S + 1000` evaluations of the `f64` law.
+//! bound the product promises ([`TableBound::PRODUCT`]). Every table [`ForceTable::new`]
+//! builds is measured: about `65 S + 1000` evaluations of the `f64` law per placement
+//! tried.
 //!
 //! The measurement ([`measure`]) evaluates the table and the law at every knot and at
 //! [`POINTS_PER_SEGMENT`] points inside each segment, at as many points on the lines

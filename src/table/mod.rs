@@ -114,8 +114,13 @@ pub const CORNER_SEGMENTS: usize = CORNER_OCTAVES * CORNER_PER_OCTAVE;
 /// `log2(CORNER_PER_OCTAVE)`.
 const CORNER_BITS: u32 = CORNER_PER_OCTAVE.trailing_zeros();
 
-/// The default strain domain `[ε_min, ε_max]`.
+/// The default strain domain `[ε_min, ε_max]`: every table the solvers run on the host,
+/// and `mccs table` without `--from`/`--to`.
 pub const DEFAULT_DOMAIN: (f64, f64) = (-0.5, 0.95);
+
+/// The default knot count, everywhere (`mccs table`, every `--backend fixed`, the
+/// firmware's [`ForceTable64`]): 64 segments.
+pub const DEFAULT_KNOTS: usize = 65;
 
 /// The raw contents of a [`ForceTable`], as emitted by `mccs table` for `include!`.
 /// In declaration order (`repr(C)`): the header before the segments, so that the
@@ -218,8 +223,9 @@ pub struct RawTable<const S: usize> {
 }
 
 /// A tabulated inverse law with `S` segments (`S + 1` knots); see the module docs. It is
-/// built by [`ForceTable::new`], [`ForceTable::with_domain`] or [`ForceTable::from_law`]
-/// (`builder/`), or wraps a table emitted by `mccs table` ([`ForceTable::from_raw`]).
+/// built and held to the product's bound by [`ForceTable::new`] or
+/// [`ForceTable::with_domain`] (`builder/`: what `mccs table` emits), or wraps a table
+/// emitted by `mccs table` ([`ForceTable::from_raw`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(transparent)]
 pub struct ForceTable<const S: usize> {
@@ -276,7 +282,8 @@ impl<const S: usize> ForceTable<S> {
 
     /// The largest force and stiffness errors against the `f64` law over the table's
     /// domain, measured when it was built ([`measure`]): what the firmware runs with.
-    /// `None` for a table built without measuring ([`ForceTable::new`] and the like).
+    /// `None` for a table built without measuring
+    /// ([`ForceTable::one_placement_unmeasured`]).
     pub fn max_error(&self) -> Option<TableBound> {
         let r = &self.raw;
         if r.err_force_ppb == UNMEASURED && r.err_stiffness_ppb == UNMEASURED {

@@ -32,7 +32,7 @@ mod firmware {
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
     use cortex_m_rt::{entry, exception};
     use fw_common::exit;
-    use mccs::{DefaultArith, ForceTable64, ParamSet};
+    use mccs::{DefaultArith, ParamSet};
     use mccs_firmware::demo::{self, DemoSpec};
     use mccs_firmware::target::{Core, CORE};
     use mccs_firmware::{Mailbox, Shared, Telemetry};
@@ -54,9 +54,6 @@ mod firmware {
 
     /// Log every this many ticks (every 0.1 s).
     const TRACE_EVERY: u32 = SPEC.tick_hz / 10;
-
-    /// The Table 2 force table, emitted by `mccs table` (no start-up build needed).
-    static TABLE2: ForceTable64 = include!("../../../tables/table2.rs");
 
     /// What the tick's first run built.
     #[derive(Clone, Copy)]
@@ -202,7 +199,7 @@ mod firmware {
     /// space is free again before the ticks start (the M0 has 16 KiB of RAM).
     #[inline(never)]
     fn init(slot: &mut Option<Ctl>) {
-        if SPEC.controller_into(&TABLE2, slot).is_err() {
+        if SPEC.controller_into(&demo::TABLE2, slot).is_err() {
             *slot = None;
         }
         if let Some(ctl) = slot {

@@ -1,7 +1,7 @@
 //! `mccs curve`: the law `F(ε)` and `dF/dε` on a strain grid, from the reference or from
 //! the fixed-point table.
 
-use super::table::{table, with_table, Domain};
+use super::table::{build, with_knots, Domain, TableArgs};
 
 use super::{arg_error, csv_error, file_error, fmt_strain, io_error, Backend, CliError};
 use crate::paramfile;
@@ -30,9 +30,8 @@ pub(super) struct Args {
     /// Evaluation backend.
     #[arg(long, value_enum, default_value_t = Backend::Reference)]
     backend: Backend,
-    /// Knots of the fixed-point table (17, 33, 65 or 129; `--backend fixed` only).
-    #[arg(long, default_value_t = 65)]
-    knots: usize,
+    #[command(flatten)]
+    table: TableArgs,
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
@@ -40,6 +39,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let strains = strain_grid(a.from, a.to, a.step)?;
     let rows = match a.backend {
         Backend::Reference => {
+            a.table.only_with_fixed()?;
             let r = Reference::new(&p).map_err(|e| file_error(&a.params, e))?;
             strains
                 .iter()
@@ -58,7 +58,8 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                     ));
                 }
             }
-            let rows = with_table!(a.knots, &p, &a.params, Domain::Default, |t| {
+            let rows = with_knots!(a.table.knots(), |S| {
+                let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
                 fixed_curve(&t, &strains)
             });
             warn_outside_domain(&p, &strains);

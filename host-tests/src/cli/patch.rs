@@ -3,8 +3,8 @@
 
 use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs};
 use super::progress::Simulated;
-use super::table::solver_table;
-use super::{arg_error, csv_error, file_error, fmt_given, fmt_strain, io_error, CliError};
+use super::table::{build, with_knots, Domain, TableArgs};
+use super::{arg_error, csv_error, file_error, fmt_given, fmt_strain, io_error, Backend, CliError};
 use crate::paramfile;
 use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, TWIN_MAX_SUBSTEPS};
 use crate::reference::Reference;
@@ -26,12 +26,17 @@ pub(super) struct Args {
     /// Length of the run, s (≤ 60).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     duration: f64,
+    #[command(flatten)]
+    table: TableArgs,
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let run = PatchRun::new(a.patch, a.indent, a.duration)?;
+    if a.patch.backend == Backend::Reference {
+        a.table.only_with_fixed()?;
+    }
     let p = paramfile::read(&a.params)?;
-    let rows = run.reactions(&p, &a.params)?;
+    let rows = run.reactions(&p, &a.params, &a.table)?;
     let mut w = csv::Writer::from_writer(out);
     w.write_record(["time_s", "reaction_n"])
         .map_err(csv_error)?;
@@ -91,15 +96,28 @@ impl PatchRun {
         Simulated::new("patch", self.time(self.ticks - 1))
     }
 
-    /// `(time_s, reaction_n)` per tick of the fixed-point core in arithmetic `A`.
+    /// `(time_s, reaction_n)` per tick of the fixed-point core in arithmetic `A`, on the
+    /// table `mccs table` emits for `p` with `table`'s knots.
     fn fixed<A: Arith>(
         &self,
         p: &Params,
         file: &Path,
+        table: &TableArgs,
         cfg: &SolverConfig,
         arith: A,
     ) -> Result<Vec<(f64, f64)>, CliError> {
-        let table = solver_table(p, file)?;
+        with_knots!(table.knots(), |S| {
+            let t = build::<S>(p, file, Domain::Default, table.accept_error, true)?;
+            self.fixed_on(t, cfg, arith)
+        })
+    }
+
+    fn fixed_on<A: Arith, const S: usize>(
+        &self,
+        table: mccs::ForceTable<S>,
+        cfg: &SolverConfig,
+        arith: A,
+    ) -> Result<Vec<(f64, f64)>, CliError> {
         let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(
             self.patch.grid,
             self.patch.spacing,
@@ -151,8 +169,13 @@ impl PatchRun {
             .collect())
     }
 
-    /// `(time_s, reaction_n)` per tick.
-    pub fn reactions(&self, p: &Params, file: &Path) -> Result<Vec<(f64, f64)>, CliError> {
+    /// `(time_s, reaction_n)` per tick; the fixed-point core's table as `table` asks.
+    pub(crate) fn reactions(
+        &self,
+        p: &Params,
+        file: &Path,
+        table: &TableArgs,
+    ) -> Result<Vec<(f64, f64)>, CliError> {
         let cfg = SolverConfig {
             tick_hz: self.patch.rate,
             integrator: self.patch.integrator.into(),
@@ -160,8 +183,8 @@ impl PatchRun {
         };
         match self.patch.engine() {
             Engine::Reference => self.twin(p, file, &cfg),
-            Engine::Wide => self.fixed(p, file, &cfg, mccs::Wide),
-            Engine::Narrow => self.fixed(p, file, &cfg, mccs::Narrow),
+            Engine::Wide => self.fixed(p, file, table, &cfg, mccs::Wide),
+            Engine::Narrow => self.fixed(p, file, table, &cfg, mccs::Narrow),
         }
     }
 }

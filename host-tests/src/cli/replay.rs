@@ -3,8 +3,8 @@
 
 use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs, TuningArgs};
 use super::progress::Simulated;
-use super::table::solver_table;
-use super::{arg_error, file_error, io_error, CliError, OUTPUT_CLOSED};
+use super::table::{build, with_knots, Domain, TableArgs};
+use super::{arg_error, file_error, io_error, Backend, CliError, OUTPUT_CLOSED};
 use crate::paramfile;
 use crate::replay::{Engine, Replay, ReplayError, RoamRow, Roaming};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
@@ -26,6 +26,8 @@ pub(super) struct Args {
     patch: PatchArgs,
     #[command(flatten)]
     tuning: TuningArgs,
+    #[command(flatten)]
+    table: TableArgs,
     /// Roam a tissue of W,H nodes (3 … 64 each, at --spacing; --grid is the window) with
     /// a proxy that slides on its surface; the trajectory is then in the tissue's frame
     /// (origin at its centre, top at z = 0).
@@ -120,8 +122,36 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     };
     let roaming = a.roaming()?;
     let p = paramfile::read(&a.params)?;
-    // The table is built (and its errors named) before the trajectory is read.
-    solver_table(&p, &a.params)?;
+    match a.patch.backend {
+        Backend::Reference => {
+            a.table.only_with_fixed()?;
+            replay::<64>(&a, &p, cfg, roaming, None, out)
+        }
+        Backend::Fixed => with_knots!(a.table.knots(), |S| {
+            // The table is built (and its errors named) before the trajectory is read.
+            let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
+            replay::<S>(&a, &p, cfg, roaming, Some(&t), out)
+        }),
+    }
+}
+
+/// The columns every mode prints first, in this order; each mode's own follow
+/// ([`GLUED_COLUMNS`], [`ROAMING_COLUMNS`]).
+pub const LEADING_COLUMNS: &str = "time_s,fx_n,fy_n,fz_n,max_disp_mm";
+/// A glued replay's own columns: the contact node's displacement from rest.
+pub const GLUED_COLUMNS: &str = "contact_dx_mm,contact_dy_mm,contact_dz_mm";
+/// A roaming replay's own columns: the proxy, the contact's state, the window's shifts.
+pub const ROAMING_COLUMNS: &str = "proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts";
+
+/// The replay of `a`'s trajectory on `table` (`None`: the reference backend).
+fn replay<const S: usize>(
+    a: &Args,
+    p: &mccs::Params,
+    cfg: SolverConfig,
+    roaming: Option<Roaming>,
+    table: Option<&mccs::ForceTable<S>>,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
     let traj = trajectory::read(&a.probe).map_err(|e| CliError::new(e.to_string()))?;
     let replay = Replay {
         grid: a.patch.grid,
@@ -148,16 +178,17 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     match roaming {
         Some(roaming) => csv(
             w,
-            "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts",
+            &format!("{LEADING_COLUMNS},{ROAMING_COLUMNS}"),
             |row| {
-                replay.roam(&p, &traj, &roaming, |r: RoamRow| {
+                replay.roam_with(p, table, &traj, &roaming, |r: RoamRow| {
                     progress.at(r.time);
                     row(format!(
-                        "{},{},{},{},{},{},{},{},{},{}",
+                        "{},{},{},{},{},{},{},{},{},{},{}",
                         fmt_time(r.time),
                         r.force[0],
                         r.force[1],
                         r.force[2],
+                        r.max_disp,
                         r.proxy[0],
                         r.proxy[1],
                         r.proxy[2],
@@ -171,9 +202,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         ),
         None => csv(
             w,
-            "time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm",
+            &format!("{LEADING_COLUMNS},{GLUED_COLUMNS}"),
             |row| {
-                replay.run(&p, &traj, |r| {
+                replay.run_with(p, table, &traj, |r| {
                     progress.at(r.time);
                     row(format!(
                         "{},{},{},{},{},{},{},{}",
@@ -181,10 +212,10 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                         r.force[0],
                         r.force[1],
                         r.force[2],
+                        r.max_disp,
                         r.contact[0],
                         r.contact[1],
                         r.contact[2],
-                        r.max_disp
                     ))
                 })
             },

@@ -4,6 +4,7 @@
 
 mod curve;
 mod fit;
+mod one_table;
 mod patch;
 mod replay;
 mod table;

@@ -3,6 +3,15 @@
 
 use super::*;
 
+/// Columns of a roaming replay's rows (`mccs replay --tissue`): after the leading
+/// `time_s,fx_n,fy_n,fz_n,max_disp_mm`, the proxy, the contact, slipping, the window's
+/// shifts.
+const MAX_DISP: usize = 4;
+const PROXY: usize = 5;
+const CONTACT: usize = 8;
+const SLIPPING: usize = 9;
+const SHIFTS: usize = 10;
+
 /// The rows of Table 2's 64 × 64 tissue roamed along `traj`, with `extra` arguments.
 fn roam_table2(traj: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
     let mut args = vec![
@@ -37,7 +46,7 @@ fn replay_roams_a_tissue_with_friction() {
     assert_eq!(
         lines.next(),
         Some(
-            "time_s,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts"
+            "time_s,fx_n,fy_n,fz_n,max_disp_mm,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts"
         )
     );
     let rows: Vec<Vec<f64>> = lines
@@ -48,7 +57,7 @@ fn replay_roams_a_tissue_with_friction() {
     // at μ_k = 0.4 of the normal force (the rest normal is z on a flat tissue).
     for r in rows.iter().filter(|r| (1.0..3.5).contains(&r[0])) {
         assert_eq!(
-            (r[7], r[8]),
+            (r[CONTACT], r[SLIPPING]),
             (1.0, 1.0),
             "t = {}: not a slipping contact",
             r[0]
@@ -62,8 +71,20 @@ fn replay_roams_a_tissue_with_friction() {
     }
     // 30 mm out and back across a 2.5 mm grid: the window moved at every node.
     let last = rows.last().unwrap();
-    assert!(last[9] >= 20.0, "{} window shifts", last[9]);
-    assert_eq!((last[1], last[2], last[3], last[7]), (0.0, 0.0, 0.0, 0.0));
+    assert!(last[SHIFTS] >= 20.0, "{} window shifts", last[SHIFTS]);
+    assert_eq!(
+        (last[1], last[2], last[3], last[CONTACT]),
+        (0.0, 0.0, 0.0, 0.0)
+    );
+    // The window's nodes deform under the press and are back at rest after the lift.
+    let pressed = rows.iter().filter(|r| r[CONTACT] == 1.0);
+    assert!(
+        pressed.clone().all(|r| r[MAX_DISP] > 0.0),
+        "a contact that moves no node"
+    );
+    let most = pressed.map(|r| r[MAX_DISP]).fold(0.0, f64::max);
+    assert!(most > 0.5, "the deepest press moves a node {most} mm");
+    assert!(last[MAX_DISP] < 1e-6, "not at rest: {} mm", last[MAX_DISP]);
 }
 
 #[test]
@@ -174,16 +195,18 @@ fn replay_roams_in_the_core_as_in_the_reference() {
                     "{extra:?} t = {}: {f:?} against {r:?}",
                     r[0]
                 );
-                let proxy =
-                    ((f[4] - r[4]).powi(2) + (f[5] - r[5]).powi(2) + (f[6] - r[6]).powi(2)).sqrt();
+                let proxy = ((f[PROXY] - r[PROXY]).powi(2)
+                    + (f[PROXY + 1] - r[PROXY + 1]).powi(2)
+                    + (f[PROXY + 2] - r[PROXY + 2]).powi(2))
+                .sqrt();
                 assert!(
                     proxy <= 0.01,
                     "{extra:?} t = {}: the proxy is {proxy} mm off",
                     r[0]
                 );
                 assert_eq!(
-                    (f[7], f[8], f[9]),
-                    (r[7], r[8], r[9]),
+                    (f[CONTACT], f[SLIPPING], f[SHIFTS]),
+                    (r[CONTACT], r[SLIPPING], r[SHIFTS]),
                     "{extra:?} t = {}: contact, slip, shifts",
                     r[0]
                 );
@@ -289,8 +312,17 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
                     "{args:?} t = {}: {f:?} vs {r:?}",
                     r[0]
                 );
-                assert_eq!((f[7], f[8]), (r[7], r[8]), "{args:?} t = {}", r[0]);
-                assert!((f[9] - r[9]).abs() <= 1.0, "{args:?} t = {}: shifts", r[0]);
+                assert_eq!(
+                    (f[CONTACT], f[SLIPPING]),
+                    (r[CONTACT], r[SLIPPING]),
+                    "{args:?} t = {}",
+                    r[0]
+                );
+                assert!(
+                    (f[SHIFTS] - r[SHIFTS]).abs() <= 1.0,
+                    "{args:?} t = {}: shifts",
+                    r[0]
+                );
                 // Pushed straight out past the flat edge (x > 78.75, y = 0.2), frictionless:
                 // no lateral force.
                 if shape.is_empty() && friction == "0,0" && (1.34..1.5).contains(&r[0]) {
@@ -298,8 +330,8 @@ fn roaming_off_the_edge_and_diagonally_agrees_with_the_core() {
                 }
             }
             let (f, r) = (fixed.last().unwrap(), reference.last().unwrap());
-            assert_eq!(f[9], r[9], "{args:?}: shifts at the end");
-            assert!(r[9] > 200.0, "{args:?}: {} shifts", r[9]);
+            assert_eq!(f[SHIFTS], r[SHIFTS], "{args:?}: shifts at the end");
+            assert!(r[SHIFTS] > 200.0, "{args:?}: {} shifts", r[SHIFTS]);
         }
     }
 }
@@ -371,12 +403,20 @@ fn a_friction_cone_wider_than_the_window_still_slips() {
         };
         let most = fixed.iter().map(ratio).fold(0.0, f64::max);
         assert!(most <= 2.0 * 1.01, "{args:?}: tangential {most} × normal");
-        assert!(fixed.iter().any(|r| r[8] == 1.0), "{args:?}: never slipped");
+        assert!(
+            fixed.iter().any(|r| r[SLIPPING] == 1.0),
+            "{args:?}: never slipped"
+        );
         for (f, r) in fixed.iter().zip(&reference) {
-            assert_eq!((f[7], f[8]), (r[7], r[8]), "{args:?} t = {}", r[0]);
+            assert_eq!(
+                (f[CONTACT], f[SLIPPING]),
+                (r[CONTACT], r[SLIPPING]),
+                "{args:?} t = {}",
+                r[0]
+            );
         }
         assert!(
-            fixed.last().unwrap()[9] >= 9.0,
+            fixed.last().unwrap()[SHIFTS] >= 9.0,
             "{args:?}: the window stayed"
         );
     }
@@ -451,12 +491,12 @@ fn over_a_caps_edge_the_core_and_the_reference_agree() {
         assert_eq!(fixed.len(), reference.len());
         let mut slips = 0;
         for (f, r) in fixed.iter().zip(&reference) {
-            assert_eq!(f[7], r[7], "{friction} t = {}: contact", r[0]);
-            slips += usize::from(f[8] != r[8]);
+            assert_eq!(f[CONTACT], r[CONTACT], "{friction} t = {}: contact", r[0]);
+            slips += usize::from(f[SLIPPING] != r[SLIPPING]);
             let (_, gap) = force_gap(f, r);
             assert!(gap <= 0.15, "{friction} t = {}: {f:?} vs {r:?}", r[0]);
         }
         assert!(slips <= 1, "{friction}: {slips} ticks slip apart");
-        assert!(reference.iter().any(|r| r[0] > 3.0 && r[7] == 0.0));
+        assert!(reference.iter().any(|r| r[0] > 3.0 && r[CONTACT] == 0.0));
     }
 }

@@ -164,18 +164,18 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
                 "kinked.toml",
                 "misses the bound",
                 "k_p/k = 7.14e0",
-                "a narrower domain meets it: --to ",
+                "a narrower domain meets it: mccs table --to ",
                 " (measured: force ",
-                " or --from ",
+                " or mccs table --from ",
                 "--accept-error",
             ],
         );
         let err = String::from_utf8_lossy(&out.stderr);
-        let to = word_after(&err, "meets it: --to ");
+        let to = word_after(&err, "meets it: mccs table --to ");
         let measured = err.split("(measured: ").nth(1).unwrap();
-        let measured = measured.split(") or --from").next().unwrap();
+        let measured = measured.split(") or mccs table --from").next().unwrap();
         assert!(to.parse::<f64>().unwrap() < 0.95, "{err}");
-        let from = word_after(&err, " or --from ");
+        let from = word_after(&err, " or mccs table --from ");
         assert!(from.parse::<f64>().unwrap() > -0.5, "{err}");
         let ok = mccs(&["table", "--params", path, "--knots", knots, "--from", from]);
         assert!(
@@ -209,8 +209,8 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
         &out,
         &[
             "kinked.toml",
-            "a narrower domain meets it: --to 0.",
-            " or --from 0.",
+            "a narrower domain meets it: mccs table --to 0.",
+            " or mccs table --from 0.",
         ],
     );
     // A spring 1,000 times weaker than Table 2: half an LSB of the output formats is over
@@ -258,22 +258,27 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
             .contains("OVER the product's bound"),
         "{src}"
     );
-    // The solvers run it, with a warning.
-    let out = mccs(&[
-        "curve",
-        "--params",
-        path,
-        "--from",
-        "0",
-        "--to",
-        "0.5",
-        "--step",
-        "0.25",
-        "--backend",
-        "fixed",
-    ]);
+    // The fixed-point paths refuse it with the same line (at their knots), and run it
+    // under --accept-error, with a warning.
+    let curve = |extra: &[&str]| {
+        let args = [
+            &[
+                "curve", "--params", path, "--from", "0", "--to", "0.5", "--step", "0.25",
+            ][..],
+            &["--backend", "fixed"],
+            extra,
+        ]
+        .concat();
+        mccs(&args)
+    };
+    let table65 = mccs(&["table", "--params", path]);
+    let out = curve(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.stderr, table65.stderr);
+    let out = curve(&["--accept-error"]);
     assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("misses the accuracy bound"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("misses the bound"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("used anyway (--accept-error)"));
 }
 
 /// The word after `marker` in `text` (an option's value in a refusal's advice).
@@ -299,12 +304,12 @@ fn a_large_springs_refusal_names_a_narrower_domain() {
         &[
             "big.toml",
             "the 129-knot table misses the bound",
-            "a narrower domain meets it: --from ",
+            "a narrower domain meets it: mccs table --from ",
             "--accept-error",
         ],
     );
     let err = String::from_utf8_lossy(&out.stderr);
-    let from = word_after(&err, "meets it: --from ");
+    let from = word_after(&err, "meets it: mccs table --from ");
     assert!(from.parse::<f64>().unwrap() > -0.5, "{err}");
     let ok = mccs(&["table", "--params", path, "--knots", "129", "--from", from]);
     assert!(

@@ -4,7 +4,7 @@
 use super::*;
 
 /// The law's inner corner `Δ(max(F_T, P))` on a knot, as a device builds the table
-/// (`ForceTable::from_law`, 129 knots), checked against the independent reference:
+/// (`ForceTable::one_placement_unmeasured`, 129 knots), checked against the independent reference:
 /// - a soft series spring preloaded above `F_T`: the knot on `Δ(P)` takes the law's value
 ///   at the kink, `P`. It took the law's value at its own strain, rounded to Q24, half an
 ///   LSB on the steep side, which bent the soft side's first cubic: stiffness errors of
@@ -17,7 +17,7 @@ fn the_inner_corner_is_on_a_knot_and_meets_the_bound() {
     for (ratio, preload) in [(2e-3, 1.2), (5e-3, 2.0), (12.4, 0.65), (10.0, 0.3)] {
         let p = preloaded(ratio, preload);
         let law = mccs::Law::new(&p).unwrap();
-        let t = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1).unwrap();
+        let t = ForceTable::<128>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1).unwrap();
         let m = independent(&p, &t);
         println!(
             "CORNER case=kp{ratio:e}_p{preload} force={:.1e} stiffness={:.1e}",
@@ -140,7 +140,7 @@ fn a_lower_corner_under_the_grid_from_a_steep_kink() {
 /// `every_table_meets_the_bound_or_is_refused_with_what_it_reached` (near-cylindrical
 /// cones: a short nonlinear phase below the kink) that were refused before: each now
 /// meets the bound, as the independent reference confirms, where the uniform grid
-/// alone (a device's table) does not.
+/// alone (one placement) does not.
 #[test]
 fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
     // (name, spring, whether the corner ends at the domain's end, not the solid point.)
@@ -214,9 +214,9 @@ fn a_preload_near_the_solid_point_gets_the_grid_below_its_kink() {
         let s = r.series.unwrap();
         let e_p = r.delta(s.preload);
         assert!(s.preload > 0.8 * r.f_c && e_p < DOMAIN.1, "{name}");
-        // A device's table (the uniform grid alone) misses the bound.
+        // One placement (the uniform grid alone) misses the bound.
         let law = mccs::Law::new(&p).unwrap();
-        let plain = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1).unwrap();
+        let plain = ForceTable::<128>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1).unwrap();
         let before = independent(&p, &plain);
         assert!(!before.within(&TableBound::PRODUCT), "{name}: {before:?}");
         let t = ForceTable::<128>::with_bound(&p, DOMAIN.0, DOMAIN.1, &TableBound::PRODUCT)

@@ -5,7 +5,7 @@ use super::*;
 /// A small spring (Table 2 with both shear moduli scaled to `F(0.95)` ≈ 0.2 N, no
 /// preload, and `k` 0.9 LSB above a Q16 value): the line below the kink with its slope
 /// floored to Q16 alone would miss the force bound at the domain's tension end (0.9 of
-/// a slope LSB there is 6.9e-6 N, 3.4e-5 of 0.2 N: a device's table, from the kink, was
+/// a slope LSB there is 6.9e-6 N, 3.4e-5 of 0.2 N: one placement, from the kink, was
 /// over it before `RawTable::slope_lo`). With the line's force slope in Q28 a device's
 /// table meets the bound by itself, as the independent reference confirms, and so does
 /// `mccs table`'s.
@@ -17,7 +17,7 @@ fn a_small_springs_line_below_holds_the_bound() {
     let r = Reference::new(&p).unwrap();
     assert!((r.force(DOMAIN.1) - 0.2).abs() < 1e-3 && r.strain_t() > DOMAIN.0);
     let law = mccs::Law::new(&p).unwrap();
-    let device = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1)
+    let device = ForceTable::<128>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1)
         .unwrap()
         .measured(&law, DOMAIN.0, DOMAIN.1);
     assert!(device.tabulated_range().0.to_num::<f64>() > 0.0);
@@ -159,7 +159,7 @@ fn the_table_rounds_to_the_nearest_lsb() {
     let p = table2_at(0.2);
     let r = Reference::new(&p).unwrap();
     let law = mccs::Law::new(&p).unwrap();
-    let t = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1).unwrap();
+    let t = ForceTable::<128>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1).unwrap();
     assert_eq!(t.raw().shift, 12);
     let (lo, hi) = (t.raw().strain_lo, t.raw().strain_hi);
     let n = 100_000;
@@ -201,7 +201,7 @@ fn the_line_below_rounds_to_the_nearest_lsb() {
         ("kink_q16", table2_at(50.0), DOMAIN.0, false),
     ] {
         let law = mccs::Law::new(&p).unwrap();
-        let t = ForceTable::<128>::from_law(&law, from, DOMAIN.1).unwrap();
+        let t = ForceTable::<128>::one_placement_unmeasured(&law, from, DOMAIN.1).unwrap();
         let raw = t.raw();
         assert_eq!(mccs::table::fine_line(raw.stiffness_lo), fine, "{case}");
         let k = raw.slope_lo as f64 / (1u64 << raw.slope_lo_frac()) as f64;

@@ -45,7 +45,7 @@ fn smallest_stiffness(r: &Reference) -> f64 {
 }
 
 /// A random valid spring and its `k_p/k`.
-fn spring(rng: &mut impl Rng) -> (Params, f64) {
+pub(crate) fn spring(rng: &mut impl Rng) -> (Params, f64) {
     loop {
         let u: [f64; 13] = core::array::from_fn(|_| rng.random_range(0.0..1.0));
         let decade = |i: usize| 10f64.powf(u[i] - 0.5);

@@ -4,17 +4,17 @@
 use super::*;
 
 /// `from_law_best` (what `mccs table` emits) is never worse than the placement a device
-/// takes (`from_law`, the first that builds), on 200 random springs: its largest error
+/// takes (`one_placement_unmeasured`, the first that builds), on 200 random springs: its largest error
 /// relative to the product's bound is at most the other's. Prints how many it improved.
 #[test]
-fn the_best_placement_is_no_worse_than_a_devices() {
+fn the_best_placement_is_no_worse_than_one_placement() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
     let ratio = |t: &ForceTable<128>| t.max_error().unwrap().ratio_to(&TableBound::PRODUCT);
     let (mut compared, mut improved) = (0, 0);
     for _ in 0..200 {
         let (p, _) = spring(&mut rng);
         let law = mccs::Law::new(&p).unwrap();
-        let first = ForceTable::<128>::from_law(&law, DOMAIN.0, DOMAIN.1)
+        let first = ForceTable::<128>::one_placement_unmeasured(&law, DOMAIN.0, DOMAIN.1)
             .map(|t| t.measured(&law, DOMAIN.0, DOMAIN.1));
         let best = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1);
         match (first, best) {
@@ -76,11 +76,28 @@ fn named_springs_report_their_bound() {
         let t129 = ForceTable::<128>::from_law_best(&law, DOMAIN.0, DOMAIN.1).unwrap();
         let graded = (t65.corner().is_some(), t129.corner().is_some());
         let segments = (t65.corner_segments(), t129.corner_segments());
-        assert_eq!(
-            ForceTable::<128>::new(&p).unwrap().max_error(),
-            None,
-            "not measured unless asked"
-        );
+        // `ForceTable::new` is that table held to the product's bound: the same table
+        // where it meets it, else the typed refusal with what it reached.
+        let bounded = ForceTable::<128>::new(&p);
+        match (bounded, t129.max_error().unwrap()) {
+            (Ok(b), e) => assert!(b == t129 && e.within(&TableBound::PRODUCT), "{name}"),
+            (
+                Err(TableError::BoundNotMet {
+                    force_ppb,
+                    stiffness_ppb,
+                }),
+                e,
+            ) => {
+                assert!(!e.within(&TableBound::PRODUCT), "{name}");
+                let raw = t129.raw();
+                assert_eq!(
+                    (force_ppb, stiffness_ppb),
+                    (raw.err_force_ppb, raw.err_stiffness_ppb),
+                    "{name}"
+                );
+            }
+            (Err(other), _) => panic!("{name}: {other}"),
+        }
         let m = independent(&p, &t129);
         // A graded corner's stiffness steps by several Q16 LSBs, its error peaking in
         // windows narrower than the usual sweep's points (see

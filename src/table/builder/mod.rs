@@ -21,26 +21,24 @@ use corner::{corner_inner, CornerEnd};
 use grid::Align;
 
 impl<const S: usize> ForceTable<S> {
-    /// Builds the table for `params` over the default domain [−0.5, 0.95]: one
-    /// placement of the uniform grid ([`ForceTable::from_law`]), not measured and held to
-    /// no bound. That serves Table 2 and springs like it; a spring whose law bends hard
-    /// (a stiff series spring near its solid point, a preload near `F_C`) can be far
-    /// outside the product's bound (`docs/accuracy.md`, "Accuracy against the f64
-    /// reference"). For a table held to the bound, use `mccs table` and `include!` its
-    /// output, or [`ForceTable::with_bound`]; [`ForceTable::measured`] and
-    /// [`ForceTable::max_error`] tell what a table reaches.
+    /// Builds the table the product ships for `params`, over the default domain
+    /// [−0.5, 0.95] ([`DEFAULT_DOMAIN`]): the best placement of its knots
+    /// ([`ForceTable::from_law_best`]), measured against the `f64` law, and refused
+    /// unless within the product's bound ([`TableBound::PRODUCT`]):
+    /// [`TableError::BoundNotMet`] carries what it reached. The table `mccs table`
+    /// emits for the same parameters and knots, bit for bit.
+    ///
+    /// Runs the `f64` law: 5 builds and measurements for a spring like Table 2, up to
+    /// 289 for one whose law bends hard. On a device, `include!` what `mccs table` emits
+    /// instead (no build, no start-up time); `docs/firmware.md` gives what a build at
+    /// start-up costs in flash and instructions.
     pub fn new(params: &Params) -> Result<Self, TableError> {
         Self::with_domain(params, DEFAULT_DOMAIN.0, DEFAULT_DOMAIN.1)
     }
 
-    /// Builds the table for `params` over the strain domain `[from, to]`, as
-    /// [`ForceTable::new`] does (one placement, not measured, no bound).
-    ///
-    /// Runs the `f64` law (software floating point on most cores): call it at start-up or
-    /// on the host (`mccs table`), never per tick.
+    /// [`ForceTable::new`] over the strain domain `[from, to]`.
     pub fn with_domain(params: &Params, from: f64, to: f64) -> Result<Self, TableError> {
-        let law = Law::new(params)?;
-        Self::from_law(&law, from, to)
+        Self::with_bound(params, from, to, &TableBound::PRODUCT)
     }
 
     /// Builds the table for `params` over `[from, to]`, and refuses it unless its
@@ -53,13 +51,19 @@ impl<const S: usize> ForceTable<S> {
         bound: &TableBound,
     ) -> Result<Self, TableError> {
         let law = Law::new(params)?;
-        let t = Self::from_law_best(&law, from, to)?;
-        if t.max_error().is_some_and(|e| e.within(bound)) {
-            Ok(t)
+        Self::from_law_best(&law, from, to)?.within(bound)
+    }
+
+    /// The table if its measured error is within `bound`, else
+    /// [`TableError::BoundNotMet`] with what it reached (an unmeasured table reaches
+    /// nothing: [`crate::table::UNMEASURED`] in both fields).
+    pub fn within(self, bound: &TableBound) -> Result<Self, TableError> {
+        if self.max_error().is_some_and(|e| e.within(bound)) {
+            Ok(self)
         } else {
             Err(TableError::BoundNotMet {
-                force_ppb: t.raw.err_force_ppb,
-                stiffness_ppb: t.raw.err_stiffness_ppb,
+                force_ppb: self.raw.err_force_ppb,
+                stiffness_ppb: self.raw.err_stiffness_ppb,
             })
         }
     }
@@ -114,21 +118,16 @@ impl<const S: usize> ForceTable<S> {
         let mut tried = [None; PLACEMENTS.len()];
         for (n, align) in PLACEMENTS.into_iter().enumerate() {
             // The placement from the domain's start is its own instance of the builder,
-            // so that a device's (`from_law`, which never takes it) carries no code for it.
+            // so that `one_placement_unmeasured`, which never takes it, carries no code for
+            // it.
+            let (seen, now) = tried.split_at_mut(n);
             let built = if align == Align::FromDomain {
-                Self::on_grid::<true, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0)
+                Self::try_uniform::<true>(law, (from, to), align, seen, &mut now[0], &mut best)
             } else {
-                Self::on_grid::<false, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0)
+                Self::try_uniform::<false>(law, (from, to), align, seen, &mut now[0], &mut best)
             };
-            match built {
-                Ok(t) if tried[..n].contains(&Some(grid_of(&t.raw))) => {}
-                Ok(t) => {
-                    tried[n] = Some(grid_of(&t.raw));
-                    Self::keep_best(t, law, (from, to), &mut best);
-                }
-                Err(e) => {
-                    first_err.get_or_insert(e);
-                }
+            if let Err(e) = built {
+                first_err.get_or_insert(e);
             }
         }
         // Where no uniform grid meets the product's bound and the solid point is inside
@@ -158,12 +157,9 @@ impl<const S: usize> ForceTable<S> {
             'above_kink: for align in [Align::Shortest, Align::Off] {
                 for margin in ABOVE_KINK_MARGINS {
                     let len = (e_end - e_p) * (1.0 - margin);
-                    if let Ok(t) =
-                        Self::on_grid::<false, true>(law, from, to, align, len, end, CORNER_OCTAVES)
-                    {
-                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
-                            break 'above_kink;
-                        }
+                    let e = Self::try_corner::<false>(law, (from, to), align, len, end, &mut best);
+                    if e <= 1.0 {
+                        break 'above_kink;
                     }
                 }
             }
@@ -177,12 +173,9 @@ impl<const S: usize> ForceTable<S> {
                 for fraction in CORNER_FRACTIONS {
                     let len = fraction * (e_p - lo);
                     let end = CornerEnd::Kink;
-                    if let Ok(t) =
-                        Self::on_grid::<false, true>(law, from, to, align, len, end, CORNER_OCTAVES)
-                    {
-                        if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
-                            break 'to_kink;
-                        }
+                    let e = Self::try_corner::<false>(law, (from, to), align, len, end, &mut best);
+                    if e <= 1.0 {
+                        break 'to_kink;
                     }
                 }
             }
@@ -199,11 +192,7 @@ impl<const S: usize> ForceTable<S> {
             // (One build: the grid's place is the corner's end, whatever the alignment.)
             let len = (e_p - lo) * LOWER_CORNER_REACH;
             let end = CornerEnd::Lower;
-            if let Ok(t) =
-                Self::on_grid::<false, true>(law, from, to, Align::Off, len, end, CORNER_OCTAVES)
-            {
-                Self::keep_best(t, law, (from, to), &mut best);
-            }
+            Self::try_corner::<false>(law, (from, to), Align::Off, len, end, &mut best);
         }
         // Still missed: a corner graded toward the law's first kink from above, under the
         // grid (`CornerEnd::Onset`), over a fraction of the curved part, and then the
@@ -224,18 +213,10 @@ impl<const S: usize> ForceTable<S> {
             let lens = ONSET_FRACTIONS.map(|f| f * curved);
             for len in lens.into_iter().chain(on_transition) {
                 let end = CornerEnd::Onset;
-                if let Ok(t) = Self::on_grid::<false, true>(
-                    law,
-                    from,
-                    to,
-                    Align::Off,
-                    len,
-                    end,
-                    CORNER_OCTAVES,
-                ) {
-                    if Self::keep_best(t, law, (from, to), &mut best) <= 1.0 {
-                        break;
-                    }
+                if Self::try_corner::<false>(law, (from, to), Align::Off, len, end, &mut best)
+                    <= 1.0
+                {
+                    break;
                 }
             }
         }
@@ -300,19 +281,73 @@ impl<const S: usize> ForceTable<S> {
             let lens = CORNER_FRACTIONS.iter().chain(more).map(|f| f * curved);
             for len in lens.chain(on_kink.clone()) {
                 let end = CornerEnd::Solid;
-                let built = if align == Align::FromDomain {
-                    Self::on_grid::<true, true>(law, from, to, align, len, end, octaves)
-                } else {
-                    Self::on_grid::<false, true>(law, from, to, align, len, end, octaves)
-                };
+                let domain = (from, to);
                 // The first within the bound is kept (each try is a build and a
                 // measurement).
-                if let Ok(t) = built {
-                    if Self::keep_best(t, law, (from, to), best) <= 1.0 {
-                        return;
-                    }
+                let e = if align == Align::FromDomain {
+                    Self::try_corner_of::<true>(law, domain, align, len, end, octaves, best)
+                } else {
+                    Self::try_corner_of::<false>(law, domain, align, len, end, octaves, best)
+                };
+                if e <= 1.0 {
+                    return;
                 }
             }
+        }
+    }
+
+    /// One placement of the uniform grid over `domain`, measured and kept in `best` where
+    /// it is the best so far, unless its grid is one of `seen` (the same table); its grid
+    /// recorded in `now`. Out of line, as [`Self::try_corner_of`].
+    #[inline(never)]
+    fn try_uniform<const TENSION: bool>(
+        law: &Law,
+        (from, to): (f64, f64),
+        align: Align,
+        seen: &[Option<(i32, i32, u32, u32)>],
+        now: &mut Option<(i32, i32, u32, u32)>,
+        best: &mut Option<(f64, Self)>,
+    ) -> Result<(), TableError> {
+        let t = Self::on_grid::<TENSION, false>(law, from, to, align, 0.0, CornerEnd::Solid, 0)?;
+        let grid = grid_of(&t.raw);
+        if !seen.contains(&Some(grid)) {
+            *now = Some(grid);
+            Self::keep_best(t, law, (from, to), best);
+        }
+        Ok(())
+    }
+
+    /// [`Self::try_corner_of`] with [`CORNER_OCTAVES`], the grid from the law's first
+    /// kink.
+    fn try_corner<const TENSION: bool>(
+        law: &Law,
+        domain: (f64, f64),
+        align: Align,
+        len: f64,
+        end: CornerEnd,
+        best: &mut Option<(f64, Self)>,
+    ) -> f64 {
+        Self::try_corner_of::<TENSION>(law, domain, align, len, end, CORNER_OCTAVES, best)
+    }
+
+    /// One placement with a graded corner ([`Self::on_grid`]), measured and kept in
+    /// `best` where it is the best so far: its error relative to the product's bound
+    /// (≤ 1 within it; infinite where it did not build). Out of line, so that the
+    /// candidate table lives in this frame only, not in its caller's beside `best` (a
+    /// device's stack: `docs/firmware.md`).
+    #[inline(never)]
+    fn try_corner_of<const TENSION: bool>(
+        law: &Law,
+        (from, to): (f64, f64),
+        align: Align,
+        len: f64,
+        end: CornerEnd,
+        octaves: usize,
+        best: &mut Option<(f64, Self)>,
+    ) -> f64 {
+        match Self::on_grid::<TENSION, true>(law, from, to, align, len, end, octaves) {
+            Ok(t) => Self::keep_best(t, law, (from, to), best),
+            Err(_) => f64::INFINITY,
         }
     }
 
@@ -329,10 +364,15 @@ impl<const S: usize> ForceTable<S> {
         e
     }
 
-    /// Builds the table for an already derived law (not measured: see
-    /// [`ForceTable::measured`]; [`ForceTable::from_law_best`] tries every placement).
+    /// One placement of the uniform grid for an already derived law, the first that
+    /// builds: **not measured and held to no bound**. That serves Table 2 and springs
+    /// like it; a spring whose law bends hard (a stiff series spring near its solid
+    /// point, a preload near `F_C`) can be far outside the product's bound
+    /// (`docs/accuracy.md`). For the tests that hold one placement to the reference;
+    /// a device calls [`ForceTable::new`] or includes what `mccs table` emits.
+    /// [`ForceTable::measured`] tells what it reaches.
     #[inline(never)]
-    pub fn from_law(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
+    pub fn one_placement_unmeasured(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         // A grid aligned on both Δ(F_T) and Δ(P) has a longer step, and its last knot may
         // then lie far enough past the solid point, on the k_p line, to leave the formats:
         // first the shortest aligned step, then the one whose last knot is closest past

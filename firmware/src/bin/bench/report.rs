@@ -7,14 +7,8 @@ use mccs::{ForceTable64, Integrator, SolverConfig, Topology};
 use mccs_firmware::target::{Core, CORE};
 
 /// Clock (MHz) and cycles per instruction (×100) assumed to turn instruction counts into
-/// time: an STM32F405 at 168 MHz (flash behind the ART accelerator), an LM3S6965 at 50
-/// MHz, an STM32F0-class M0 at 48 MHz (one flash wait state). Estimates, not
-/// measurements.
-const CLOCK: (u32, u32) = match CORE {
-    Core::M4F => (168, 125),
-    Core::M3 => (50, 125),
-    Core::M0 => (48, 150),
-};
+/// time ([`Core::clock_estimate`]).
+const CLOCK: (u32, u32) = CORE.clock_estimate();
 
 /// The figures measured in this run, by case name (64 at most; a full list only drops
 /// the budget check's view of the rest, which then reports them missing).
@@ -99,7 +93,7 @@ fn tick_of(figs: &Figures, steps: &Steps, n: u32, tick_hz: u32) -> Option<(u32, 
 /// a `BENCH` line, `case=startup n= instructions= ms_at_clock=` (the time at `CLOCK`
 /// with its cycles-per-instruction estimate).
 pub fn startup(figs: &mut Figures, n: u32, instructions: u64) {
-    let ms = instructions * CLOCK.1 as u64 / 100 / (CLOCK.0 as u64 * 1000);
+    let ms = CORE.ms_at_clock(instructions);
     figs.record("startup", u32::try_from(instructions).unwrap_or(u32::MAX));
     defmt::println!(
         "BENCH core={=str} case=startup n={=u32} instructions={=u64} ms_at_clock={=u64}",
