@@ -128,10 +128,11 @@ pub(crate) fn for_each_spring<const NODES: usize, const EDGES: usize>(
 ) {
     let base = nodes.as_mut_ptr();
     for (e, w) in topo.edges().iter().zip(warm.iter_mut()) {
-        // SAFETY: a `Topology<NODES, _>` holds at most NODES node slots and
-        // `Topology::add_edge`, the only way in, stores only indices of existing slots,
-        // never the ground as `a`, and never `a == b` (that spring would be shorter than
-        // 1 mm); its edges cannot be changed afterwards. So both pointers are in bounds
+        // SAFETY: a `Topology<NODES, _>` holds at most NODES node slots, and its edges'
+        // ends are written only by `Topology::add_edge` (its edges are private; the one
+        // way to change an edge afterwards, `Topology::set_rest_geometry`, takes no end),
+        // which stores only indices of existing slots, never the ground as `a`, and never
+        // `a == b` (that spring would be shorter than 1 mm). So both pointers are in bounds
         // of the exclusively borrowed `nodes` and point at different nodes. The shared
         // references to the ends end with the call to the kernel, before the accumulators
         // are written.

@@ -275,9 +275,24 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         self.rest.get(i).copied()
     }
 
-    /// The springs, to rewrite their rest geometry (a window moving over a cap).
-    pub(crate) fn edges_mut(&mut self) -> &mut [Edge] {
-        &mut self.edges
+    /// Sets spring `e`'s rest geometry, its direction `dir` (Q23) and `1/l0` (Q31 per mm):
+    /// a window moving over a cap (no spring `e`: nothing). Its ends cannot change here
+    /// or anywhere: [`Topology::add_edge`] is the only way an edge's ends are written, so
+    /// every edge's ends stay indices of existing slots, `a` never the ground and never
+    /// `b` — what the spring loops' unchecked node accesses rest on
+    /// (`state::for_each_spring`, `arith/wide_dsp.rs`).
+    #[inline(always)]
+    pub(crate) fn set_rest_geometry(&mut self, e: usize, dir: V3, inv_len: i32) {
+        if let Some(edge) = self.edges.get_mut(e) {
+            edge.dir = dir;
+            edge.inv_len = inv_len;
+        }
+    }
+
+    /// The same springs in reverse order (a test of an order a cap's shift refuses).
+    #[cfg(test)]
+    pub(crate) fn reverse_edges(&mut self) {
+        self.edges.reverse();
     }
 
     /// Sets free node `i`'s rest height (Q24 mm; a window moving over a cap).

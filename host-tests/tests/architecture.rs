@@ -213,3 +213,31 @@ fn the_circle_finder_finds_circles() {
     g.entry("c".into()).or_default().insert("a".into());
     assert!(circle(&g).is_some());
 }
+
+/// The spring loops read every edge's nodes without a bounds check, resting on
+/// `Topology::add_edge` being the only writer of an edge's ends: no code in the core
+/// hands out a mutable edge (`&mut Edge`, `&mut [Edge]`) or writes an edge's end.
+#[test]
+fn only_add_edge_writes_an_edges_ends() {
+    let src = root().join("src");
+    for f in files(&src) {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            let hands_out = code.contains("&mut Edge") || code.contains("&mut [Edge]");
+            // `e.a = …` or `edge.b = …`, not a comparison (`e.b == GROUND`).
+            let writes_end = ["e.a", "e.b", "edge.a", "edge.b"].iter().any(|end| {
+                code.match_indices(end).any(|(at, _)| {
+                    let rest = code[at + end.len()..].trim_start();
+                    rest.starts_with('=') && !rest.starts_with("==")
+                })
+            });
+            assert!(
+                !hands_out && !writes_end,
+                "{}:{}: {line}",
+                f.display(),
+                i + 1
+            );
+        }
+    }
+}

@@ -474,7 +474,8 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
     // and as many warm-start values (n ≤ EDGES), writes only those values and the nodes' force
     // accumulators, and reads the table's header and segments. Every node index is in
     // bounds of `nodes` and `a` is never the ground nor equal to `b`, as
-    // `Topology::add_edge`, the only way in, guarantees (see `state::for_each_spring`);
+    // `Topology::add_edge`, the only writer of an edge's ends, guarantees (see
+    // `state::for_each_spring`);
     // the segment index is masked to `S − 1` and `S` is a power of two; the layouts it
     // reads are asserted above. It saves and restores r6 and r7 itself (the registers
     // the compiler reserves), declares every other register it writes, and leaves the

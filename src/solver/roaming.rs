@@ -190,9 +190,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 }
             }
             self.set_cap_heights(&window);
-            for (e, edge) in self.topo.edges_mut().iter_mut().enumerate() {
-                (edge.dir, edge.inv_len) =
+            for e in 0..self.topo.edges().len() {
+                let (dir, inv_len) =
                     edge_geometry(&window, window.ends.get(e).copied().unwrap_or(0));
+                self.topo.set_rest_geometry(e, dir, inv_len);
             }
         }
         Ok(window)
@@ -238,8 +239,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let Some(map) = window.maps.get(dir) else {
             return;
         };
-        let edges = self.topo.edges_mut();
-        let count = edges.len();
+        let topo = &mut self.topo;
+        let count = topo.edges().len();
         let warm = &mut self.warm;
         // The source spring is copied out before the edge is written; each path writes
         // the edge itself, so that a copy does not go through the computed path's memory.
@@ -249,23 +250,17 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             if let Some(w) = warm.get_mut(e) {
                 *w = value;
             }
-            if let Some(&Edge { dir, inv_len, .. }) = edges.get(source) {
+            if let Some(&Edge { dir, inv_len, .. }) = topo.edges().get(source) {
                 let dir = if reversed {
                     dir.map(i32::saturating_neg)
                 } else {
                     dir
                 };
-                if let Some(edge) = edges.get_mut(e) {
-                    edge.dir = dir;
-                    edge.inv_len = inv_len;
-                }
+                topo.set_rest_geometry(e, dir, inv_len);
             } else {
                 let (dir, inv_len) =
                     edge_geometry(window, window.ends.get(e).copied().unwrap_or(0));
-                if let Some(edge) = edges.get_mut(e) {
-                    edge.dir = dir;
-                    edge.inv_len = inv_len;
-                }
+                topo.set_rest_geometry(e, dir, inv_len);
             }
         };
         if dir % 2 == 0 {
@@ -556,7 +551,7 @@ mod tests {
     #[test]
     fn a_cap_refuses_springs_out_of_the_order_its_shift_needs() {
         let mut topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
-        topo.edges_mut().reverse();
+        topo.reverse_edges();
         let (mut s, proxy) = patch_and_proxy(topo);
         let tissue = |cap_radius| WindowConfig {
             tissue_w: 16,
