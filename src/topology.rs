@@ -217,11 +217,13 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
                 t.add_free_node(pos(i, j, 0.0))?;
             }
         }
-        let surface = |i: usize, j: usize| -> End {
+        // (A free node that is not one is a logic error here: refused, as a bad end.)
+        let surface = |i: usize, j: usize| -> Result<End, TopologyError> {
             if fixed(i, j) {
-                End::Fixed(pos(i, j, 0.0))
+                Ok(End::Fixed(pos(i, j, 0.0)))
             } else {
-                End::Free(surface_node(n, i as i32, j as i32).unwrap_or(0) as u16)
+                let node = surface_node(n, i as i32, j as i32).ok_or(TopologyError::BadEnd)?;
+                Ok(End::Free(node as u16))
             }
         };
         let both_fixed = |p: (usize, usize), q: (usize, usize)| fixed(p.0, p.1) && fixed(q.0, q.1);
@@ -229,7 +231,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
             if both_fixed(p, q) {
                 return Ok(());
             }
-            t.add_edge(surface(p.0, p.1), surface(q.0, q.1))
+            t.add_edge(surface(p.0, p.1)?, surface(q.0, q.1)?)
         };
         for i in 0..n {
             for j in 0..n {
@@ -247,10 +249,11 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         }
         for i in 1..n - 1 {
             for j in 1..n - 1 {
-                t.add_edge(surface(i, j), End::Fixed(pos(i, j, -spacing)))?;
+                t.add_edge(surface(i, j)?, End::Fixed(pos(i, j, -spacing)))?;
             }
         }
-        let contact = surface_node(n, (n / 2) as i32, (n / 2) as i32).unwrap_or(0);
+        let contact =
+            surface_node(n, (n / 2) as i32, (n / 2) as i32).ok_or(TopologyError::BadEnd)?;
         t.set_contact(contact as u16)?;
         Ok(t)
     }

@@ -30,7 +30,8 @@ pub mod one_dof;
 pub mod probe_path;
 pub mod target;
 
-#[cfg(feature = "defmt")]
+// With the `defmt` feature, and on every firmware target, where defmt is the log.
+#[cfg(any(feature = "defmt", target_os = "none"))]
 mod defmt;
 
 pub use controller::{Contact, Controller, Fault, Glued, Roaming, Telemetry};

@@ -194,8 +194,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         proxy: &Proxy,
         force: impl Fn(&Self) -> (V3, [(usize, usize); 3], [i32; 3]),
     ) {
-        // The glued substep's two calls, written out again: shared through helpers they
-        // changed the glued path's compiled code (the M3's N = 7 substep by 4 %).
+        // The glued substep's two calls, written out again: shared through helpers, they
+        // change the glued path's compiled code (its registers).
         let count = self.topo.node_count().min(NODES);
         for _ in 0..self.substeps {
             A::spring_forces(

@@ -86,9 +86,9 @@ impl<const S: usize> ForceTable<S> {
         }
         let (c, t) = self.segment(e);
         let (sum, d) = (cubic_sum(c, t), slope(c, t));
-        // (The header's shift and scales are read only now: loaded before the cubic, they
-        // held registers across it, and the M4F's frame saved one more register and an
-        // alignment slot on every path; docs/performance.md, "The evaluation's frame". A
+        // (The header's shift and scales are read only here: loaded before the cubic, they
+        // would hold registers across it, and the M4F's frame would save one more
+        // register on every path; docs/performance.md, "The evaluation's frame". A
         // compiler fence emits no instruction.)
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         let f = sum.wrapping_shr(r.shift);
@@ -120,8 +120,8 @@ impl<const S: usize> ForceTable<S> {
     }
 
     /// [`ForceTable::force_and_stiffness`] in a lower corner, out of line: inlined, its
-    /// registers would be saved on every path (the M4F's evaluation 27 → 31 instructions
-    /// over Table 2's lines and grid); a lower corner is a rare table's.
+    /// registers would be saved on every path of every table's evaluation; a lower
+    /// corner is a rare table's.
     #[inline(never)]
     fn lower_corner_force_and_stiffness(&self, e: i32) -> (Force, Stiffness) {
         self.corner_force_and_stiffness(e)
@@ -246,9 +246,8 @@ fn line_product(p: i64) -> i32 {
 /// through its high word ([`shr_held`]: a held value is ±2048 N to within its low 12
 /// bits, beyond the clamp of every caller that holds)
 /// (the same values within ±1024 N). On the M4F one product and a select of its bits; on
-/// the other cores a branch between the two products (their loops keep their registers
-/// so: the M3's N = 5 substep 300 instructions fewer, the M0's `force_and_stiffness` 2,
-/// measured by the bench).
+/// the other cores a branch between the two products (so their loops keep their
+/// registers: the bench's substep and `force_and_stiffness` figures hold it).
 #[inline(always)]
 fn line_below<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
     line_at::<HELD, false, S>(r, e)
@@ -263,9 +262,8 @@ fn line_above<const HELD: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 
 }
 
 /// The line below the table, or with `UPPER` the line above ([`line_below`]). (Each
-/// field read where it is used, as the line below's code always did: read up front, the
-/// anchor and the force were one `ldrd` into a register the M4F's
-/// `force_and_stiffness` then saved on every path, 27 → 29 instructions.)
+/// field read where it is used: read up front, the anchor and the force would be one
+/// `ldrd` into a register the M4F's `force_and_stiffness` then saves on every path.)
 #[inline(always)]
 fn line_at<const HELD: bool, const UPPER: bool, const S: usize>(r: &RawTable<S>, e: i32) -> i32 {
     let f0 = || if UPPER { r.force_hi } else { r.force_lo };
@@ -284,8 +282,8 @@ fn line_at<const HELD: bool, const UPPER: bool, const S: usize>(r: &RawTable<S>,
             line_product(p)
         }
     };
-    // (The sum in each branch: so the M3's loop keeps its registers; a sum after the
-    // branch took its N = 5 substep from 7,970 to 8,256.)
+    // (The sum in each branch, so that the M3's loop keeps its registers: a sum after the
+    // branch spills them.)
     let d = || e.saturating_sub(e0());
     if cfg!(mccs_dsp) {
         let p = mul_wide(slope(), d());

@@ -9,7 +9,7 @@ use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
 use mccs::{ForceTable64, Solver, SolverError, Topology, TopologyError};
 use mccs_firmware::drivers::as5047p::As5047p;
-use mccs_firmware::drivers::pwm_motor::PwmMotor;
+use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
 use mccs_firmware::one_dof::{OneDofDevice, OneDofError};
 use mccs_firmware::{Controller, HapticDevice};
 
@@ -49,6 +49,90 @@ pub enum StartError<E> {
     Topology(TopologyError),
     /// The solver.
     Solver(SolverError),
+}
+
+impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
+    /// The error as the log tells it ([`StartFault`]): its type and values, the device's
+    /// error by the part that failed (its HAL error type is the board's).
+    pub fn fault(&self) -> StartFault {
+        match self {
+            Self::Config(e) => StartFault::Config(*e),
+            Self::SafeState(e) => StartFault::SafeState(match e {
+                OneDofError::Spi(_) => DevicePart::Spi,
+                OneDofError::Encoder => DevicePart::Encoder,
+                OneDofError::Motor(MotorError::Pwm(_)) => DevicePart::Pwm,
+                OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
+                OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
+            }),
+            Self::Topology(e) => StartFault::Topology(*e),
+            Self::Solver(e) => StartFault::Solver(*e),
+        }
+    }
+}
+
+/// Why the board could not start, as its log says it: a [`StartError`] without the HAL's
+/// error types, which vary by board (`Copy`, for the tick to hand to `main`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartFault {
+    /// A constant of the [`BoardConfig`].
+    Config(BoardConfigError),
+    /// Putting the device in its safe state failed, at this part.
+    SafeState(DevicePart),
+    /// The patch.
+    Topology(TopologyError),
+    /// The solver (the substeps the stability bound needs, …).
+    Solver(SolverError),
+}
+
+/// A part of the board's device.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DevicePart {
+    /// The encoder's SPI bus.
+    Spi,
+    /// The encoder's frames (too many bad ones in a row).
+    Encoder,
+    /// The motor's PWM channel.
+    Pwm,
+    /// The motor's direction pin.
+    Direction,
+    /// The motor driver's enable pin.
+    Enable,
+}
+
+impl DevicePart {
+    /// Its name in the log.
+    pub const fn name(&self) -> &'static str {
+        match self {
+            Self::Spi => "the encoder's SPI bus",
+            Self::Encoder => "the encoder's frames",
+            Self::Pwm => "the motor's PWM channel",
+            Self::Direction => "the motor's direction pin",
+            Self::Enable => "the motor driver's enable pin",
+        }
+    }
+}
+
+impl core::fmt::Display for StartFault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Config(e) => write!(f, "config: {e}"),
+            Self::SafeState(p) => write!(f, "safe state: {} failed", p.name()),
+            Self::Topology(e) => write!(f, "{e}"),
+            Self::Solver(e) => write!(f, "solver: {e}"),
+        }
+    }
+}
+
+#[cfg(target_os = "none")]
+impl defmt::Format for StartFault {
+    fn format(&self, f: defmt::Formatter) {
+        match self {
+            Self::Config(e) => defmt::write!(f, "config: {=str}", e.message()),
+            Self::SafeState(p) => defmt::write!(f, "safe state: {=str} failed", p.name()),
+            Self::Topology(e) => defmt::write!(f, "{}", e),
+            Self::Solver(e) => defmt::write!(f, "solver: {}", e),
+        }
+    }
 }
 
 /// The device, in its safe state (zero duty, driver disabled) before it is returned.

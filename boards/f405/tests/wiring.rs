@@ -503,3 +503,59 @@ fn a_press_renders_an_upward_force() {
         "duty {duty} for {f} N (expected {expected})"
     );
 }
+
+/// A start-up failure keeps its type and values to the log (`StartFault`): a tissue too
+/// stiff for the tick says how many substeps it needs; a failed part of the device, which
+/// part; a bad constant, which one.
+#[test]
+fn a_start_up_failure_says_what_failed_with_its_values() {
+    let mut stiff = Params::TABLE2;
+    stiff.cone.shear_modulus *= 40.0;
+    stiff.linear.shear_modulus *= 40.0;
+    let table = ForceTable64::new(&stiff).unwrap();
+    let log = Log::default();
+    let dev = device::device(
+        &BOARD,
+        Sensor::new(|_| 0),
+        Pwm(log.clone()),
+        Pin(log.clone(), "dir"),
+        Pin(log.clone(), "enable"),
+    )
+    .unwrap();
+    let mut slot: Option<BoardController<_>> = None;
+    let Err((e, _)) = device::controller_into(&BOARD, table, dev, &mut slot) else {
+        panic!("a tissue 40 times Table 2's started")
+    };
+    let fault = e.fault();
+    let device::StartFault::Solver(mccs::SolverError::TooManySubsteps { needed }) = fault else {
+        panic!("{fault:?}")
+    };
+    let line = fault.to_string();
+    assert!(
+        line.starts_with(&format!(
+            "solver: max_substeps: stability needs {needed} substeps per tick"
+        )),
+        "{line}"
+    );
+    assert!(slot.is_none());
+    use mccs_firmware::drivers::pwm_motor::MotorError;
+    use mccs_firmware::one_dof::OneDofError;
+    let enable: device::StartError<OneDofError<(), (), (), ()>> =
+        device::StartError::SafeState(OneDofError::Motor(MotorError::Enable(())));
+    assert_eq!(
+        enable.fault().to_string(),
+        "safe state: the motor driver's enable pin failed"
+    );
+    let spi: device::StartError<OneDofError<(), (), (), ()>> =
+        device::StartError::SafeState(OneDofError::Spi(()));
+    assert_eq!(
+        spi.fault(),
+        device::StartFault::SafeState(device::DevicePart::Spi)
+    );
+    let config: device::StartError<OneDofError<(), (), (), ()>> =
+        device::StartError::Config(BoardConfigError::Tick);
+    assert_eq!(
+        config.fault().to_string(),
+        format!("config: {}", BoardConfigError::Tick.message())
+    );
+}

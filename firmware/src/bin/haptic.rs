@@ -61,10 +61,14 @@ mod firmware {
         springs: usize,
         substeps: u32,
     }
-    static INFO: Shared<Info> = Shared::new(Info {
-        springs: 0,
-        substeps: 0,
-    });
+    /// How the tick's first run went: not yet, the controller built, or why not.
+    #[derive(Clone, Copy)]
+    enum Start {
+        Pending,
+        Built(Info),
+        Failed(demo::DemoError),
+    }
+    static START: Shared<Start> = Shared::new(Start::Pending);
     static SWAP: Mailbox<ParamSet<64>> = Mailbox::new();
     static TELEMETRY: Shared<Telemetry> = Shared::new(Telemetry::new());
     /// The longest tick so far, SysTick counts.
@@ -81,10 +85,14 @@ mod firmware {
         // stopped, so nothing is timed yet), on the interrupt's stack.
         SCB::set_pendst();
         cortex_m::asm::isb();
-        let info = INFO.get();
-        if info.substeps == 0 {
-            fail("demo controller");
-        }
+        let info = match START.get() {
+            Start::Built(info) => info,
+            Start::Failed(e) => {
+                defmt::error!("start-up failed: demo controller: {}", e);
+                exit(false)
+            }
+            Start::Pending => fail("demo controller: the tick's first run did not start"),
+        };
         let swap_substeps = post_swap();
         defmt::info!(
             "mccs haptic demo: core={=str} tick={=u32} Hz, N={=usize} window on a {=usize} x {=usize} tissue, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
@@ -199,14 +207,19 @@ mod firmware {
     /// space is free again before the ticks start (the M0 has 16 KiB of RAM).
     #[inline(never)]
     fn init(slot: &mut Option<Ctl>) {
-        if SPEC.controller_into(&demo::TABLE2, slot).is_err() {
-            *slot = None;
-        }
-        if let Some(ctl) = slot {
-            INFO.set(Info {
-                springs: ctl.solver().topology().edges().len(),
-                substeps: ctl.solver().substeps(),
-            });
+        match SPEC.controller_into(&demo::TABLE2, slot) {
+            Ok(()) => {
+                if let Some(ctl) = slot {
+                    START.set(Start::Built(Info {
+                        springs: ctl.solver().topology().edges().len(),
+                        substeps: ctl.solver().substeps(),
+                    }));
+                }
+            }
+            Err(e) => {
+                *slot = None;
+                START.set(Start::Failed(e));
+            }
         }
     }
 
@@ -221,7 +234,10 @@ mod firmware {
                 let _ = SWAP.post(set);
                 substeps
             }
-            Err(_) => fail("swapped parameter set"),
+            Err(e) => {
+                defmt::error!("start-up failed: swapped parameter set: {}", e);
+                exit(false)
+            }
         }
     }
 

@@ -152,7 +152,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// the growing one, as in a power iteration); infinite where it overflows.
     ///
     /// In block fixed point, so that a core without an FPU runs it at integer speed (in
-    /// software `f32` the M3's and M0's start-up took 22 s at their clocks): the
+    /// software floating point it takes tens of seconds at their clocks): the
     /// displacements `X` (in half units) and the velocities as displacements per step
     /// `V = 2^g v h` share one exponent, `i32` components renormalised after each step to
     /// below 2^[`STATE_BITS`], every product the rounded high word of a long multiply.

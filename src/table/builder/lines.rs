@@ -75,8 +75,8 @@ pub(super) fn lines<const S: usize>(
 /// Q20 units, exact) with this slope, such that the evaluation's
 /// `f0 + ⌊slope · (e − e0) / 2^P⌋` (`P` = 32 for a Q28 slope, 20 for a Q16 one: the
 /// product's high word, or its floor shifted) rounds the line to the nearest Q20 N instead
-/// of flooring it (issue #16: the floor put every force on the line up to a whole LSB
-/// below the law, which cost small springs their bound). With `s_j = slope · j / 2^P`, the
+/// of flooring it (a floor puts every force on the line up to a whole LSB below the law,
+/// which costs small springs their bound). With `s_j = slope · j / 2^P`, the
 /// table is `⌊L(e) + ½ − r⌋` for `e0 = e_a + j`, `f0 = ⌊f_a + ½ + s_j⌋` and
 /// `r = frac(f_a + ½ + s_j)`: the search takes the `j` (within ±1,024 strain LSBs) with
 /// the least `r`, stopping below 1/64, so that a force on the line is within

@@ -36,7 +36,7 @@ mod firmware {
     use cortex_m_rt::entry;
     use embedded_hal_bus::spi::{ExclusiveDevice, NoDelay};
     use haptic_f405::config::{self, spi_clock_hz, tick_timer, AS5047P_MAX_SPI_HZ, BOARD};
-    use haptic_f405::device::{self, BoardController, BoardDevice};
+    use haptic_f405::device::{self, BoardController, BoardDevice, StartFault};
     use haptic_f405::pins::{EncoderCs, MotorDirection, MotorEnable, Pins};
     use haptic_f405::telemetry::BoardTelemetry;
     use mccs::ForceTable64;
@@ -68,7 +68,7 @@ mod firmware {
     enum Start {
         Pending,
         Running { springs: usize, substeps: u32 },
-        Failed,
+        Failed(StartFault),
     }
     static START: Shared<Start> = Shared::new(Start::Pending);
     static TELEMETRY: Shared<BoardTelemetry> = Shared::new(BoardTelemetry::new());
@@ -80,7 +80,7 @@ mod firmware {
             fail("peripherals taken twice")
         };
         if let Err(e) = BOARD.check() {
-            fail(e.message());
+            fail_with(StartFault::Config(e));
         }
         let rcc = dp.RCC.constrain();
         // QEMU models no RCC (an HSE or PLL never reports ready): it keeps the reset
@@ -108,7 +108,7 @@ mod firmware {
         let pins = Pins::take(dp.GPIOA.split(), dp.GPIOB.split());
         let spi_hz = spi_clock_hz(clocks.pclk2().raw(), BOARD.spi_request_hz);
         if spi_hz == 0 || spi_hz > AS5047P_MAX_SPI_HZ {
-            fail(config::BoardConfigError::SpiTooFast.message());
+            fail_with(StartFault::Config(config::BoardConfigError::SpiTooFast));
         }
         let spi = Spi::new(
             dp.SPI1,
@@ -126,7 +126,7 @@ mod firmware {
         let max_duty = motor.get_max_duty();
         let device = match device::device(&BOARD, encoder, motor, pins.direction, pins.enable) {
             Ok(d) => d,
-            Err(_) => fail("device: its safe state or its constants"),
+            Err(e) => fail_with(e.fault()),
         };
 
         // QEMU's timers run at 1 GHz whatever the clock tree says.
@@ -136,7 +136,7 @@ mod firmware {
             clocks.timclk1().raw()
         };
         let Some((psc, arr)) = tick_timer(timer_clock, BOARD.tick_hz) else {
-            fail(config::BoardConfigError::Tick.message())
+            fail_with(StartFault::Config(config::BoardConfigError::Tick))
         };
         let tick = TickTimer::new(Timer::new(dp.TIM2, &clocks).release(), psc, arr);
         let watchdog = IndependentWatchdog::new(dp.IWDG);
@@ -156,8 +156,10 @@ mod firmware {
         // SAFETY: the handler shares state only through `Mailbox` and `Shared`.
         unsafe { NVIC::unmask(Interrupt::TIM2) };
         cortex_m::asm::isb();
-        let Start::Running { springs, substeps } = START.get() else {
-            fail("controller: the patch or the solver")
+        let (springs, substeps) = match START.get() {
+            Start::Running { springs, substeps } => (springs, substeps),
+            Start::Failed(fault) => fail_with(fault),
+            Start::Pending => fail("the tick's first run did not start"),
         };
         defmt::info!(
             "mccs haptic-f405: sysclk={=u32} Hz, spi={=u32} Hz (mode 1), pwm={=u32} Hz ({=u16} steps), tick={=u32} Hz, watchdog={=u32} ms; N={=usize} patch, {=usize} springs, {=u32} substeps per tick",
@@ -287,7 +289,7 @@ mod firmware {
                 *hw = Some((tick, watchdog));
             }
             // The device is in its safe state; the timer never starts.
-            Err(_) => START.set(Start::Failed),
+            Err((e, _)) => START.set(Start::Failed(e.fault())),
         }
     }
 
@@ -389,10 +391,21 @@ mod firmware {
         }
     }
 
+    /// A start-up failure, logged with its type and values (`StartFault`): as [`fail`].
+    fn fail_with(fault: StartFault) -> ! {
+        defmt::error!("start-up failed: {}", fault);
+        stop()
+    }
+
     /// A start-up failure: logged; the motor pins stay at their safe levels, the
     /// watchdog and the tick never start. In QEMU: exit with failure.
     fn fail(what: &str) -> ! {
         defmt::error!("start-up failed: {=str}", what);
+        stop()
+    }
+
+    /// Stops after a start-up failure.
+    fn stop() -> ! {
         #[cfg(feature = "qemu")]
         exit(false);
         #[cfg(not(feature = "qemu"))]
