@@ -1,5 +1,5 @@
 //! Tells the core whether its target has the Armv7E-M DSP extension (the Cortex-M4/M7:
-//! `thumbv7em-*`), whose spring loop is written in assembly (`src/arith/wide_dsp.rs`).
+//! `thumbv7em-*`), whose spring loop is written in assembly (`src/arith/wide_dsp/`).
 //! Rust does not expose the `dsp` target feature to `cfg` on stable.
 
 fn main() {

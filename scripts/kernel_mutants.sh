@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Shows that the bench firmware's kernel check (firmware/src/bin/bench/kernel_check.rs)
-# catches faults in the M4F's assembly loops (src/arith/wide_dsp.rs): puts one fault at a
+# catches faults in the M4F's assembly loops (src/arith/wide_dsp/): puts one fault at a
 # time into a scratch worktree of HEAD, runs the M4F bench up to its KERNEL line and
 # prints `MUTANT <fault>: <n> of <states> states differ`; the last line counts the
 # faults caught. Not in the test command (about 10 s per fault once built; the first
@@ -16,8 +16,8 @@ trap 'git worktree remove --force "$work" >/dev/null 2>&1 || rm -rf "$work"' EXI
 git worktree add --detach "$work" HEAD >/dev/null
 build_decoder --quiet
 export CARGO_TARGET_DIR="$root/target/mutants"
-src="$work/src/arith/wide_dsp.rs"
-cp "$src" "$work/wide_dsp.rs.orig"
+srcs=("$work/src/arith/wide_dsp/spring_loop.rs" "$work/src/arith/wide_dsp/integrate.rs")
+for f in "${srcs[@]}"; do cp "$f" "$f.orig"; done
 
 # name | text to replace (its first occurrence) | replacement
 # (The unmasked shift is the table header's own, read through the segments pointer at
@@ -54,14 +54,17 @@ echo "... building the M4F bench once in a scratch worktree (a minute or two fro
 caught=0
 for m in "${mutants[@]}"; do
   IFS='|' read -r name from to <<< "$m"
-  cp "$work/wide_dsp.rs.orig" "$src"
-  python3 - "$src" "$from" "$to" <<'EOF'
+  for f in "${srcs[@]}"; do cp "$f.orig" "$f"; done
+  python3 - "$from" "$to" "${srcs[@]}" <<'EOF'
 import sys
-p, a, b = sys.argv[1:]
-s = open(p).read()
-if a not in s:
-    sys.exit(f"kernel_mutants: '{a}' is not in {p}")
-open(p, "w").write(s.replace(a, b, 1))
+a, b, *paths = sys.argv[1:]
+for p in paths:
+    s = open(p).read()
+    if a in s:
+        open(p, "w").write(s.replace(a, b, 1))
+        break
+else:
+    sys.exit(f"kernel_mutants: '{a}' is in none of {paths}")
 EOF
   echo "... $name: building and running the M4F bench" >&2
   (cd "$work" && cargo build --quiet --release -p mccs-firmware --target $T --bin bench)

@@ -23,12 +23,12 @@
 extern crate self as mccs;
 
 pub mod arith;
-mod cap;
 pub mod coupling;
 pub mod law;
 pub mod params;
 pub mod proxy;
 pub mod q;
+pub mod shape;
 pub mod solver;
 pub mod state;
 pub mod table;
@@ -44,6 +44,7 @@ pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
 pub use proxy::{Proxy, ProxyConfig, ProxyError};
+pub use shape::{Cap, Flat, Shape, ShapeSpec, Sphere};
 pub use solver::{Bound, ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableBound,

@@ -22,7 +22,7 @@ pub const VEL_LIMIT_MM_S: f64 = 16384.0;
 /// One node's state: displacement from rest, stored velocity and the force accumulator of
 /// the current substep, together so that a spring reaches all of an end through one
 /// address. In declaration order (`repr(C)`, 36 bytes: the ARMv7E-M spring loop reads
-/// it by offset, `arith/wide_dsp.rs`).
+/// it by offset, `arith/wide_dsp/`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C)]
 pub struct Node {
@@ -130,7 +130,7 @@ pub(crate) fn for_each_spring<const NODES: usize, const EDGES: usize>(
     for (e, w) in topo.edges().iter().zip(warm.iter_mut()) {
         // SAFETY: a `Topology<NODES, _>` holds at most NODES node slots, and its edges'
         // ends are written only by `Topology::add_edge` (its edges are private; the one
-        // way to change an edge afterwards, `Topology::set_rest_geometry`, takes no end),
+        // way to change an edge afterwards, `Topology::rest_geometry`, sets no end),
         // which stores only indices of existing slots, never the ground as `a`, and never
         // `a == b` (that spring would be shorter than 1 mm). So both pointers are in bounds
         // of the exclusively borrowed `nodes` and point at different nodes. The shared

@@ -19,7 +19,7 @@ pub const GROUND: u16 = 0;
 pub const MAX_SPRINGS_PER_NODE: usize = 20;
 
 /// One spring of the patch. In declaration order (`repr(C)`, 20 bytes), so that the
-/// ARMv7E-M spring loop loads a whole edge with one `ldm` (`arith/wide_dsp.rs`).
+/// ARMv7E-M spring loop loads a whole edge with one `ldm` (`arith/wide_dsp/`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C)]
 pub struct Edge {
@@ -278,17 +278,16 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
         self.rest.get(i).copied()
     }
 
-    /// Sets spring `e`'s rest geometry, its direction `dir` (Q23) and `1/l0` (Q31 per mm):
-    /// a window moving over a cap (no spring `e`: nothing). Its ends cannot change here
-    /// or anywhere: [`Topology::add_edge`] is the only way an edge's ends are written, so
-    /// every edge's ends stay indices of existing slots, `a` never the ground and never
+    /// The springs' rest geometry, to rewrite (a window moving over a cap): a writer
+    /// that sets a spring's direction and `1/l0` and reads the springs, but cannot change
+    /// an edge's ends. [`Topology::add_edge`] is the only way an edge's ends are written,
+    /// so every edge's ends stay indices of existing slots, `a` never the ground and never
     /// `b` — what the spring loops' unchecked node accesses rest on
-    /// (`state::for_each_spring`, `arith/wide_dsp.rs`).
+    /// (`state::for_each_spring`, `arith/wide_dsp/`).
     #[inline(always)]
-    pub(crate) fn set_rest_geometry(&mut self, e: usize, dir: V3, inv_len: i32) {
-        if let Some(edge) = self.edges.get_mut(e) {
-            edge.dir = dir;
-            edge.inv_len = inv_len;
+    pub(crate) fn rest_geometry(&mut self) -> RestGeometry<'_> {
+        RestGeometry {
+            edges: &mut self.edges,
         }
     }
 
@@ -334,6 +333,30 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     /// Rest length of edge `e` (mm), from its stored `1/l0`.
     pub fn rest_length(e: &Edge) -> f64 {
         (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64
+    }
+}
+
+/// The springs of a [`Topology`] with their rest geometry open to rewriting and their ends
+/// not ([`Topology::rest_geometry`]).
+pub(crate) struct RestGeometry<'a> {
+    edges: &'a mut [Edge],
+}
+
+impl RestGeometry<'_> {
+    /// The springs.
+    #[inline(always)]
+    pub(crate) fn edges(&self) -> &[Edge] {
+        self.edges
+    }
+
+    /// Sets spring `e`'s rest direction `dir` (Q23) and `1/l0` (Q31 per mm); no spring
+    /// `e`: nothing.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, e: usize, dir: V3, inv_len: i32) {
+        if let Some(edge) = self.edges.get_mut(e) {
+            edge.dir = dir;
+            edge.inv_len = inv_len;
+        }
     }
 }
 

@@ -13,7 +13,7 @@
 //! for another topology or tick rate is refused and counted; the solver keeps its set.
 
 use crate::device::HapticDevice;
-use mccs::{Arith, DefaultArith, Force, Length, ParamSet, Proxy, Solver, Window};
+use mccs::{Arith, DefaultArith, Flat, Force, Length, ParamSet, Proxy, Shape, Solver, Window};
 
 /// How the probe touches the tissue: one tick of the solver with the probe read.
 pub trait Contact<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
@@ -38,20 +38,19 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<N
     }
 }
 
-/// The probe touching a tissue through a proxy with friction, the patch following the
-/// contact as a window ([`Solver::step_roaming`]); the probe in the tissue frame. A flat
-/// tissue by default (`Solver::window`); with `CAP` a window from `Solver::shaped_window`,
-/// flat or a cap, whose tick carries the cap's code.
+/// The probe touching a tissue of shape `Sh` (flat by default, or a cap) through a proxy
+/// with friction, the patch following the contact as a window
+/// ([`Solver::step_roaming`]); the probe in the tissue frame.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Roaming<const EDGES: usize, const CAP: bool = false> {
+pub struct Roaming<const EDGES: usize, Sh: Shape = Flat> {
     /// The proxy (from `Solver::proxy`).
     pub proxy: Proxy,
-    /// The window (from `Solver::window`, or with `CAP` `Solver::shaped_window`).
-    pub window: Window<EDGES, CAP>,
+    /// The window (from `Solver::window`).
+    pub window: Window<EDGES, Sh>,
 }
 
-impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const CAP: bool>
-    Contact<NODES, EDGES, S, A> for Roaming<EDGES, CAP>
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, Sh: Shape>
+    Contact<NODES, EDGES, S, A> for Roaming<EDGES, Sh>
 {
     fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3] {
         solver.step_roaming(probe, &mut self.proxy, &mut self.window)

@@ -13,7 +13,7 @@ use crate::device::SimulatedDevice;
 use crate::probe_path::{palpation_path, PathError, ProbePath};
 use crate::target::Core;
 use mccs::{
-    Arith, ForceTable64, Narrow, ParamSet, ProxyConfig, ProxyError, Solver, SolverConfig,
+    Arith, Flat, ForceTable64, Narrow, ParamSet, ProxyConfig, ProxyError, Solver, SolverConfig,
     SolverError, Topology, TopologyError, Wide, WindowConfig,
 };
 
@@ -163,7 +163,7 @@ impl DemoSpec {
             .proxy(&self.proxy_config())
             .map_err(DemoError::Contact)?;
         let window = solver
-            .window(&WINDOW, &proxy, x, y)
+            .window(&WINDOW, &Flat, &proxy, x, y)
             .map_err(DemoError::Contact)?;
         Ok(Roaming { proxy, window })
     }
@@ -221,7 +221,6 @@ pub const WINDOW: WindowConfig = WindowConfig {
     tissue_w: 64,
     tissue_h: 64,
     hysteresis: 0.1,
-    cap_radius: None,
 };
 
 /// The demo's friction `(μ_s, μ_k)`.

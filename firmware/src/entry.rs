@@ -80,14 +80,14 @@ pub fn tick_proxy<const N: usize, const E: usize>(
     solver.step_proxy(probe, proxy)
 }
 
-/// One tick of a solver roaming a tissue through a proxy (a flat-only window, or with
-/// `CAP` one that may lie on a cap), never inlined.
+/// One tick of a solver roaming a tissue of shape `Sh` (flat, or a cap) through a proxy,
+/// never inlined.
 #[inline(never)]
-pub fn tick_roaming<const N: usize, const E: usize, const CAP: bool>(
+pub fn tick_roaming<const N: usize, const E: usize, Sh: mccs::Shape>(
     solver: &mut Solver<N, E, 64>,
     probe: [Length; 3],
     proxy: &mut Proxy,
-    window: &mut Window<E, CAP>,
+    window: &mut Window<E, Sh>,
 ) -> [Force; 3] {
     solver.step_roaming(probe, proxy, window)
 }

@@ -9,8 +9,8 @@ use crate::reference::Reference;
 use crate::roam::{Friction, RoamConfig, RoamError, RoamTwin, Tissue};
 use crate::trajectory::Trajectory;
 use mccs::{
-    Arith, ForceTable, Length, Params, ProxyConfig, ProxyError, Solver, SolverConfig, SolverError,
-    Topology, WindowConfig,
+    Arith, Flat, ForceTable, Length, Params, Proxy, ProxyConfig, ProxyError, ShapeSpec, Solver,
+    SolverConfig, SolverError, Sphere, Topology, WindowConfig,
 };
 
 /// Capacities of the fixed backend's solver: N = 12 has 101 node slots and 558 springs.
@@ -272,7 +272,6 @@ impl Replay {
     ) -> Result<(), ReplayError> {
         let spacing = roaming.tissue.spacing;
         let mut s = self.solver(params, table, spacing, arith)?;
-        let nodes = s.topology().node_count() as u16;
         let mut proxy = s
             .proxy(&ProxyConfig {
                 grid: self.grid,
@@ -286,20 +285,38 @@ impl Replay {
             tissue_w: roaming.tissue.w,
             tissue_h: roaming.tissue.h,
             hysteresis: 0.1,
-            cap_radius: match roaming.tissue.shape {
-                crate::roam::Shape::Flat => None,
-                crate::roam::Shape::Cap { radius } => Some(radius),
-            },
         };
-        let mut ticks = traj.ticks(self.config.tick_hz).peekable();
+        match roaming.tissue.shape {
+            crate::roam::Shape::Flat => {
+                Self::roam_window(&mut s, &mut proxy, &window_config, &Flat, traj, self, row)
+            }
+            crate::roam::Shape::Cap { radius } => {
+                let cap = Sphere { radius_mm: radius };
+                Self::roam_window(&mut s, &mut proxy, &window_config, &cap, traj, self, row)
+            }
+        }
+    }
+
+    /// [`Replay::roam_fixed`]'s run on a window of `shape`.
+    fn roam_window<A: Arith, const S: usize, Spec: ShapeSpec>(
+        s: &mut Solver<FIXED_NODES, FIXED_EDGES, S, A>,
+        proxy: &mut Proxy,
+        window_config: &WindowConfig,
+        shape: &Spec,
+        traj: &Trajectory,
+        replay: &Replay,
+        row: &mut dyn FnMut(RoamRow),
+    ) -> Result<(), ReplayError> {
+        let nodes = s.topology().node_count() as u16;
+        let mut ticks = traj.ticks(replay.config.tick_hz).peekable();
         let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
         let mut window = s
-            .shaped_window(&window_config, &proxy, start[0], start[1])
+            .window(window_config, shape, proxy, start[0], start[1])
             .map_err(ReplayError::Proxy)?;
         for (time, p) in ticks {
-            let force = s.step_roaming(p.map(Length::saturating_from_num), &mut proxy, &mut window);
+            let force = s.step_roaming(p.map(Length::saturating_from_num), proxy, &mut window);
             let o = window.origin_mm().map(|c| c.to_num::<f64>());
-            let proxy_at = match s.proxy_point_in(&proxy, &window) {
+            let proxy_at = match s.proxy_point_in(proxy, &window) {
                 Some(q) => {
                     let q = q.map(|c| c.to_num::<f64>());
                     [q[0] + o[0], q[1] + o[1], q[2]]
@@ -313,7 +330,7 @@ impl Replay {
                 contact: proxy.grid_position().is_some(),
                 slipping: proxy.slipping(),
                 window_shifts: window.shifts(),
-                max_disp: max_disp_fixed(&s, nodes),
+                max_disp: max_disp_fixed(s, nodes),
             });
         }
         Ok(())

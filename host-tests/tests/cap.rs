@@ -1,11 +1,11 @@
-//! The fixed-point core roaming a spherical cap (`WindowConfig::cap_radius`) against the
+//! The fixed-point core roaming a spherical cap (`mccs::Sphere`) against the
 //! `f64` roaming twin: palpations over the cap's top and down its slope, both arithmetics,
 //! frictionless and with friction; the rest geometry a shift computes against a window
 //! built in place; the rest state kept at rest; the refusals.
 
 use mccs::{
-    Arith, ForceTable64, Length, Narrow, Params, ProxyConfig, ProxyError, Solver, SolverConfig,
-    Topology, Wide, WindowConfig,
+    Arith, Flat, ForceTable64, Length, Narrow, Params, ProxyConfig, ProxyError, ShapeSpec, Solver,
+    SolverConfig, Sphere, Topology, Wide, WindowConfig,
 };
 use mccs_host::patch::{TwinConfig, V};
 use mccs_host::reference::Reference;
@@ -17,13 +17,15 @@ const SIDE: usize = 64;
 /// A cap over the 64 × 64 tissue (half-diagonal 111.4 mm; the smallest radius is 148.5).
 const RADIUS: f64 = 150.0;
 
-fn window_config(radius: Option<f64>) -> WindowConfig {
-    WindowConfig {
-        tissue_w: SIDE,
-        tissue_h: SIDE,
-        hysteresis: 0.1,
-        cap_radius: radius,
-    }
+const TISSUE: WindowConfig = WindowConfig {
+    tissue_w: SIDE,
+    tissue_h: SIDE,
+    hysteresis: 0.1,
+};
+
+/// The cap of radius `r` mm.
+fn sphere(r: f64) -> Sphere {
+    Sphere { radius_mm: r }
 }
 
 /// The cap's surface point above `(x, y)` and its normal.
@@ -65,7 +67,7 @@ fn compare<A: Arith>(mu: (f64, f64), radius: f64, x0: f64, y0: f64) -> (f64, f64
     let mut proxy = s.proxy(&proxy_config(mu, radius)).unwrap();
     let start = palpation(x0, y0, 0);
     let mut window = s
-        .shaped_window(&window_config(Some(RADIUS)), &proxy, start[0], start[1])
+        .window(&TISSUE, &sphere(RADIUS), &proxy, start[0], start[1])
         .unwrap();
     let cfg = RoamConfig {
         tissue: Tissue::new(SIDE, SIDE, SPACING, Shape::Cap { radius: RADIUS }).unwrap(),
@@ -156,7 +158,7 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
     let mut s = fixed::<Wide>();
     let mut proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
     let mut window = s
-        .shaped_window(&window_config(Some(RADIUS)), &proxy, -40.0, -30.0)
+        .window(&TISSUE, &sphere(RADIUS), &proxy, -40.0, -30.0)
         .unwrap();
     // The probe far above the cap, moving over it: the window follows the probe.
     let mut checked = 0;
@@ -172,7 +174,7 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
         let mut fresh = fixed::<Wide>();
         let fresh_proxy = fresh.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
         let w2 = fresh
-            .shaped_window(&window_config(Some(RADIUS)), &fresh_proxy, at(ci), at(cj))
+            .window(&TISSUE, &sphere(RADIUS), &fresh_proxy, at(ci), at(cj))
             .unwrap();
         assert_eq!(w2.centre(), (ci, cj));
         for (e, (got, want)) in s
@@ -208,12 +210,10 @@ fn a_shifted_window_has_the_geometry_of_one_built_in_place() {
 /// each node within 1e-5 mm of rest.
 #[test]
 fn the_cap_at_rest_stays_at_rest() {
-    fn run<A: Arith>(cap: Option<f64>) -> f64 {
+    fn run<A: Arith, Spec: ShapeSpec>(shape: &Spec) -> f64 {
         let mut s = fixed::<A>();
         let mut proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-        let mut window = s
-            .shaped_window(&window_config(cap), &proxy, 0.0, 0.0)
-            .unwrap();
+        let mut window = s.window(&TISSUE, shape, &proxy, 0.0, 0.0).unwrap();
         let mut worst = 0.0f64;
         for t in 0..2000 {
             let x = 75.0 * (t as f64 / 2000.0);
@@ -226,8 +226,9 @@ fn the_cap_at_rest_stays_at_rest() {
         assert!(window.shifts() >= 40);
         worst
     }
-    let (flat_wide, flat_narrow) = (run::<Wide>(None), run::<Narrow>(None));
-    let (wide, narrow) = (run::<Wide>(Some(RADIUS)), run::<Narrow>(Some(RADIUS)));
+    let (flat_wide, flat_narrow) = (run::<Wide, _>(&Flat), run::<Narrow, _>(&Flat));
+    let cap = sphere(RADIUS);
+    let (wide, narrow) = (run::<Wide, _>(&cap), run::<Narrow, _>(&cap));
     println!(
         "CAPREST wide_max_disp_mm={wide:.2e} narrow_max_disp_mm={narrow:.2e} flat_wide_max_disp_mm={flat_wide:.2e} flat_narrow_max_disp_mm={flat_narrow:.2e}"
     );
@@ -235,19 +236,14 @@ fn the_cap_at_rest_stays_at_rest() {
 }
 
 /// Radii outside 4/3 of the half-diagonal … 2000 mm, a cap whose base would reach below
-/// −100 mm, (in the M0's arithmetic) springs longer than 16 mm, and a cap for a flat-only
-/// window are refused.
+/// −100 mm, and (in the M0's arithmetic) springs longer than 16 mm are refused.
 #[test]
 fn caps_the_core_cannot_run_are_refused() {
     let mut s = fixed::<Wide>();
     let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-    assert!(s
-        .shaped_window(&window_config(Some(148.5)), &proxy, 0.0, 0.0)
-        .is_ok());
+    assert!(s.window(&TISSUE, &sphere(148.5), &proxy, 0.0, 0.0).is_ok());
     for bad in [148.0, 2000.5, f64::NAN, -150.0] {
-        let got = s
-            .shaped_window(&window_config(Some(bad)), &proxy, 0.0, 0.0)
-            .err();
+        let got = s.window(&TISSUE, &sphere(bad), &proxy, 0.0, 0.0).err();
         assert_eq!(got, Some(ProxyError::Cap), "radius {bad}");
     }
     // 41 × 41 at 5 mm (±100 mm): the smallest cap's corner lies 63.9 mm down, its base
@@ -264,15 +260,13 @@ fn caps_the_core_cannot_run_are_refused() {
             ..proxy_config((0.0, 0.0), 0.0)
         })
         .unwrap();
-    let cfg = |w: usize, r: f64| WindowConfig {
+    let cfg = |w: usize| WindowConfig {
         tissue_w: w,
         tissue_h: w,
         hysteresis: 0.1,
-        cap_radius: Some(r),
     };
-    assert!(s
-        .shaped_window(&cfg(41, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0)
-        .is_ok());
+    let smallest = sphere(4.0 / 3.0 * 141.43);
+    assert!(s.window(&cfg(41), &smallest, &p, 0.0, 0.0).is_ok());
     let topo = Topology::<10, 61>::standard_patch(N, 10.0).unwrap();
     let table = ForceTable64::new(&Params::TABLE2).unwrap();
     let mut m0 = Solver::with_arith(topo, table, &SolverConfig::default(), Narrow).unwrap();
@@ -283,8 +277,7 @@ fn caps_the_core_cannot_run_are_refused() {
         })
         .unwrap();
     assert_eq!(
-        m0.shaped_window(&cfg(21, 4.0 / 3.0 * 141.43), &p, 0.0, 0.0)
-            .err(),
+        m0.window(&cfg(21), &smallest, &p, 0.0, 0.0).err(),
         Some(ProxyError::Cap)
     );
 }
@@ -296,9 +289,7 @@ mod robust {
     fn roam<A: Arith>(r_cap: f64, mu: (f64, f64), radius: f64, probes: &[(f64, f64, f64)]) {
         let mut s = fixed::<A>();
         let mut proxy = s.proxy(&proxy_config(mu, radius)).unwrap();
-        let mut window = s
-            .shaped_window(&window_config(Some(r_cap)), &proxy, 0.0, 0.0)
-            .unwrap();
+        let mut window = s.window(&TISSUE, &sphere(r_cap), &proxy, 0.0, 0.0).unwrap();
         let height = |x: f64, y: f64| (r_cap * r_cap - x * x - y * y).max(0.0).sqrt() - r_cap;
         let max = device_max();
         for &(x, y, dz) in probes {
@@ -372,7 +363,7 @@ mod robust {
 fn a_param_set_on_a_cap_is_prepared_from_the_flat_patch() {
     let mut s = fixed::<Wide>();
     let proxy = s.proxy(&proxy_config((0.0, 0.0), 0.0)).unwrap();
-    s.shaped_window(&window_config(Some(RADIUS)), &proxy, 40.0, 20.0)
+    s.window(&TISSUE, &sphere(RADIUS), &proxy, 40.0, 20.0)
         .unwrap();
     let table = ForceTable64::new(&Params::TABLE2).unwrap();
     let config = SolverConfig::default();

@@ -49,9 +49,8 @@ fn core_step<'a, A: Arith + 'a>(mu: (f64, f64), x: f64, y: f64) -> Step<'a> {
         tissue_w: 64,
         tissue_h: 64,
         hysteresis: 0.1,
-        cap_radius: None,
     };
-    let mut window = s.window(&wc, &proxy, x, y).unwrap();
+    let mut window = s.window(&wc, &mccs::Flat, &proxy, x, y).unwrap();
     Box::new(move |p| {
         let f = s.step_roaming(p.map(Length::from_num), &mut proxy, &mut window);
         (f.map(|x| x.to_num::<f64>()), proxy.slipping())

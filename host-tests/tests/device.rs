@@ -513,18 +513,15 @@ enum Mode {
 /// 64 × 64 tissue centred under the 1-DOF probe.
 fn roaming(s: &mut Solver<10, 61, 64>) -> Roaming<61> {
     let (proxy, wc) = roaming_parts(s);
-    let window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
+    let window = s.window(&wc, &mccs::Flat, &proxy, 0.0, 0.0).unwrap();
     Roaming { proxy, window }
 }
 
 /// [`roaming`] over a cap of radius 150 mm (its top under the probe).
-fn roaming_cap(s: &mut Solver<10, 61, 64>) -> Roaming<61, true> {
+fn roaming_cap(s: &mut Solver<10, 61, 64>) -> Roaming<61, mccs::Cap> {
     let (proxy, wc) = roaming_parts(s);
-    let wc = WindowConfig {
-        cap_radius: Some(150.0),
-        ..wc
-    };
-    let window = s.shaped_window(&wc, &proxy, 0.0, 0.0).unwrap();
+    let cap = mccs::Sphere { radius_mm: 150.0 };
+    let window = s.window(&wc, &cap, &proxy, 0.0, 0.0).unwrap();
     Roaming { proxy, window }
 }
 
@@ -542,7 +539,6 @@ fn roaming_parts(s: &Solver<10, 61, 64>) -> (mccs::Proxy, WindowConfig) {
         tissue_w: 64,
         tissue_h: 64,
         hysteresis: 0.1,
-        cap_radius: None,
     };
     (proxy, wc)
 }

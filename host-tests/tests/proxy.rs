@@ -191,9 +191,8 @@ mod robust {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
-            cap_radius: None,
         };
-        let mut window = s.window(&wc, &proxy, 0.0, 0.0).unwrap();
+        let mut window = s.window(&wc, &mccs::Flat, &proxy, 0.0, 0.0).unwrap();
         let max = device_max();
         for &(x, y, z) in probes {
             let f = s.step_roaming([x, y, z].map(Length::from_num), &mut proxy, &mut window);
@@ -259,10 +258,11 @@ mod roaming {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
-            cap_radius: None,
         };
         let start = path(0);
-        let mut window = s.window(&wc, &proxy, start[0], start[1]).unwrap();
+        let mut window = s
+            .window(&wc, &mccs::Flat, &proxy, start[0], start[1])
+            .unwrap();
         let cfg = RoamConfig {
             tissue: Tissue::new(64, 64, SPACING, Shape::Flat).unwrap(),
             n: N,
@@ -320,9 +320,8 @@ mod roaming {
             tissue_w: 64,
             tissue_h: 64,
             hysteresis: 0.1,
-            cap_radius: None,
         };
-        assert!(s.window(&ok, &proxy, 0.0, 0.0).is_ok());
+        assert!(s.window(&ok, &mccs::Flat, &proxy, 0.0, 0.0).is_ok());
         for bad in [
             WindowConfig { tissue_w: 4, ..ok },
             WindowConfig { tissue_h: 65, ..ok },
@@ -336,7 +335,7 @@ mod roaming {
             },
         ] {
             assert_eq!(
-                s.window(&bad, &proxy, 0.0, 0.0).err(),
+                s.window(&bad, &mccs::Flat, &proxy, 0.0, 0.0).err(),
                 Some(ProxyError::Window),
                 "{bad:?}"
             );

@@ -213,10 +213,9 @@ fn short_run<A: Arith>(
                 tissue_w: 16,
                 tissue_h: 16,
                 hysteresis: 0.1,
-                cap_radius: None,
             };
             let window = s
-                .window(&wc, &proxy, 0.0, 0.0)
+                .window(&wc, &mccs::Flat, &proxy, 0.0, 0.0)
                 .map_err(|e| TestCaseError::fail(e.to_string()))?;
             let ctl = Controller::with_contact(s, Roaming { proxy, window }, dev, 0);
             drive(case, ctl, true, seen)

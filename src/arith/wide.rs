@@ -154,7 +154,7 @@ impl Arith for Wide {
 
 /// Every spring's force, accumulated on its two nodes, in Rust: what [`Wide`] runs on
 /// every core but the Armv7E-M ones (M4F), whose loop is in assembly
-/// (`arith/wide_dsp.rs`) and must give the same bits; public so that the bench firmware
+/// (`arith/wide_dsp/`) and must give the same bits; public so that the bench firmware
 /// can check that on the M4F itself.
 #[inline(always)]
 pub fn spring_forces_portable<const S: usize, const NODES: usize, const EDGES: usize>(
@@ -278,7 +278,7 @@ fn spring<const S: usize, const LOWER: bool>(
 }
 
 /// The integrator on every node of `free`, in Rust: what [`Wide`] runs on every core but
-/// the Armv7E-M ones, whose loop is in assembly (`arith/wide_dsp.rs`) and must give the
+/// the Armv7E-M ones, whose loop is in assembly (`arith/wide_dsp/`) and must give the
 /// same bits (the bench firmware checks it on the M4F). (The scheme's flag is read per
 /// node: on the M3 that measured fewer instructions at N = 5 than two loops.)
 #[inline(always)]

@@ -1,4 +1,4 @@
-//! The proxy on a cap ([`crate::cap`]): the flat contact's model with depth, friction
+//! The proxy on a cap ([`crate::shape::Cap`]): the flat contact's model with depth, friction
 //! cone and damping along the cap's rest normal instead of `z`, as the `f64` reference
 //! (`mccs_host::roam`) has them.
 //!
@@ -17,10 +17,11 @@
 //! height blended from the triangle's corners: a unit vector to within the chord's sag,
 //! `s²/(8R²)`).
 
-use super::{damping, held, scale_to, spring, Proxy, Surface, G_FRAC};
-use crate::cap::{Cap, N16_SH};
+use super::force::{damping, held, scale_to, spring};
+use super::{Proxy, Surface, G_FRAC};
 use crate::coupling::CouplingQ;
 use crate::q::{self, mul_wide, sat, V3};
+use crate::shape::{Cap, N16_SH};
 
 /// The cap as a proxy sees it in one tick: the cap, and the patch frame's origin in the
 /// tissue frame (Q24 mm, `x` and `y`; the frames share `z`).
@@ -39,14 +40,14 @@ const LOCATE_STEPS: usize = 3;
 /// Corrections of a slip's surface point (from where the proxy was, close by).
 const SLIP_STEPS: usize = 2;
 
-/// `a · n` for a Q24 vector and a direction from [`crate::cap`] (Q29 on a Q15 grid),
+/// `a · n` for a Q24 vector and a direction from [`crate::shape::Cap`] (Q29 on a Q15 grid),
 /// Q24: one product with a 16-bit operand per axis, floored.
 fn dot(a: V3, n: V3) -> i32 {
     let p = |k: usize| q::mul_s::<15>(a[k], n[k] >> N16_SH);
     p(0).saturating_add(p(1)).saturating_add(p(2))
 }
 
-/// `x n` for a Q24 length and a direction from [`crate::cap`], Q24, floored.
+/// `x n` for a Q24 length and a direction from [`crate::shape::Cap`], Q24, floored.
 fn along(x: i32, n: V3) -> V3 {
     n.map(|c| q::mul_s::<15>(x, c >> N16_SH))
 }
@@ -82,7 +83,7 @@ impl Proxy {
     }
 
     /// The proxy's centre on the current surface of a cap (Q24 mm), when in contact.
-    pub(crate) fn centre_cap_at(&self, s: &impl Surface, f: &CapFrame) -> Option<V3> {
+    pub(super) fn centre_cap_at(&self, s: &impl Surface, f: &CapFrame) -> Option<V3> {
         self.at.map(|g| self.centre_cap(s, f, g).0)
     }
 
@@ -132,7 +133,7 @@ impl Proxy {
 
     /// [`Proxy::update`] on a cap; `tissue`: the tissue's rectangle in the patch frame
     /// (`[x_lo, x_hi, y_lo, y_hi]`, Q24 mm).
-    pub(crate) fn update_cap(
+    pub(super) fn update_cap(
         &mut self,
         s: &impl Surface,
         f: &CapFrame,
@@ -197,7 +198,7 @@ impl Proxy {
 
     /// [`Proxy::force`] on a cap: the damping along the rest normal under the proxy (the
     /// tick's update found it), the force unilateral along it.
-    pub(crate) fn force_cap(
+    pub(super) fn force_cap(
         &self,
         s: &impl Surface,
         coupling: &CouplingQ,

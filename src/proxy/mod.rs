@@ -1,13 +1,15 @@
 //! `Proxy`: a god-object contact that slides on the standard patch's surface with Coulomb
-//! friction (issue #19), in fixed point: the `f64` reference is `mccs_host::roam`
-//! (`docs/roaming.md`), whose model this follows on a flat patch that does not move.
+//! friction, in fixed point: the `f64` reference is `mccs_host::roam` (`docs/roaming.md`),
+//! whose model this follows. One update per tick and one force per substep
+//! ([`Proxy::update`], [`Proxy::force`]) for every [`Shape`] of tissue: on a flat one
+//! (`flat.rs`) or on a cap (`cap.rs`); the coupling's force and its ratios in `force.rs`.
 //!
 //! The surface is the patch's `n × n` surface nodes (outer ring fixed at rest), each
 //! cell split along its `(i, j)`–`(i+1, j+1)` diagonal. A surface point is held in grid
 //! coordinates `(u, v)` (Q16 spacings from the patch's corner), so it moves with the
 //! deformed nodes. Depth is measured along `z` (the rest normal of a flat patch).
 //!
-//! Per tick (`Proxy::update`, from `Solver::step_proxy`): the goal is the deformed
+//! Per tick on a flat tissue (`Proxy::update`): the goal is the deformed
 //! surface's point above or below the probe (found from the rest grid by a product by
 //! `1/s`, then two corrections by the deformed surface's offset: no search, no
 //! division), plus `r` up; the probe is in
@@ -26,12 +28,15 @@
 //! device maximum.
 
 mod cap;
-
-pub(crate) use cap::CapFrame;
+mod flat;
+mod force;
 
 use crate::coupling::CouplingQ;
 use crate::q::{self, mul_wide, sat, V3};
-use crate::units::{from_f64, FORCE_FRAC, LEN_FRAC, VEL_FRAC};
+use crate::shape::Shape;
+use crate::units::{from_f64, LEN_FRAC};
+use cap::CapFrame;
+use force::tan_small;
 
 /// Fraction bits of grid coordinates and weights.
 const G_FRAC: u32 = 16;
@@ -68,9 +73,6 @@ pub enum ProxyError {
     /// A cap radius outside 4/3 of the tissue's half-diagonal … 2000 mm, or a cap whose
     /// base reaches below −100 mm or whose longest spring is too long for the arithmetic.
     Cap,
-    /// A cap for a flat-only window (`Solver::window`): a cap needs
-    /// `Solver::shaped_window`.
-    FlatWindow,
 }
 
 impl ProxyError {
@@ -82,7 +84,6 @@ impl ProxyError {
             Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
             Self::Window => "window: the tissue must be n..=64 nodes a side within ±100 mm, the hysteresis 0.05 … 0.45",
             Self::Cap => "cap: the radius must be 4/3 of the tissue's half-diagonal … 2000 mm, its base above -100 mm, its springs within the arithmetic's longest",
-            Self::FlatWindow => "window: a flat-only window (Solver::window) cannot lie on a cap: use Solver::shaped_window",
         }
     }
 }
@@ -320,59 +321,6 @@ impl Proxy {
         self.at.map(|g| self.centre(s, g))
     }
 
-    /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame),
-    /// its `xy` held by the caller to the surface (the patch, or the window's tissue):
-    /// when it lies beyond the patch, the surface goes on there at rest.
-    pub(crate) fn update(&mut self, s: &impl Surface, probe: V3) {
-        let (goal_g, beyond) = self.locate(s, probe[0], probe[1]);
-        let goal = self.centre(s, goal_g);
-        if goal[2] <= probe[2] {
-            self.release();
-            return;
-        }
-        let Some(mut at) = self.at else {
-            self.at = Some(goal_g);
-            self.slipping = false;
-            return;
-        };
-        let frictionless = self.mu_s == 0 && self.mu_k == 0;
-        if frictionless {
-            self.at = Some(goal_g);
-            self.slipping = true;
-            return;
-        }
-        // The offset is measured from the goal's line, the vertical through the probe:
-        // from the goal, or, when the probe lies beyond the patch (the goal held to its
-        // edge), from the probe itself, so that a probe far from a sticking proxy still
-        // makes it slip (held, the offset stopped at the patch's edge and the proxy
-        // stuck with the force at the device's maximum).
-        let from = if beyond { probe } else { goal };
-        for pass in 0..3 {
-            let proxy = self.centre(s, at);
-            let depth = proxy[2].saturating_sub(probe[2]).max(0);
-            // The offset across z, and the cones, in Q20 (squares within i64).
-            let t = [
-                proxy[0].saturating_sub(from[0]) >> 4,
-                proxy[1].saturating_sub(from[1]) >> 4,
-            ];
-            let t2 = mul_wide(t[0], t[0]) + mul_wide(t[1], t[1]);
-            let (radius, radius2) = self.cone(pass, t2, depth);
-            if t2 <= radius2 {
-                break;
-            }
-            // On the cone: goal + t · radius/|t|, the ratio by a reciprocal square root.
-            let lambda = scale_to(radius, t2);
-            let next = [0, 1].map(|k| {
-                let off = proxy[k].saturating_sub(from[k]);
-                from[k].saturating_add(q::mul_weight(off, lambda))
-            });
-            // Past the cone only when slipping (sticking, the state test above keeps
-            // `t2` within the static cone): the next pass re-measures the depth there.
-            at = self.locate_from(s, next[0], next[1], at).0;
-        }
-        self.at = Some(at);
-    }
-
     /// The friction cone's radius at `depth` (Q24 mm; the radius Q20 and its square) for
     /// the stick–slip state, which the first `pass` of a tick sets from the square `t2`
     /// (Q20²) of the proxy's offset across the normal.
@@ -394,164 +342,80 @@ impl Proxy {
         cone(if self.slipping { self.mu_k } else { self.mu_s })
     }
 
-    /// The device's force (Q20 N) in one substep, with the probe at `probe` moving at
-    /// `probe_vel` (Q16 mm/s), and the proxy's triangle with its weights to put the
-    /// reaction (minus the force) on; zero out of contact.
-    pub(crate) fn force(
+    /// One tick's contact and friction with the probe at `probe` (Q24 mm, patch frame)
+    /// on the tissue of `frame`'s shape, whose rectangle in the patch frame is `tissue`
+    /// (`[x_lo, x_hi, y_lo, y_hi]`, Q24 mm; the patch's own for a patch alone). On a
+    /// flat tissue the goal is on the vertical line through the probe with its `xy` held
+    /// to that rectangle (past the tissue's edge, the point above the nearest point of
+    /// it); on a cap, on the radial line through the probe itself (past the edge the cap
+    /// falls away below the edge's rim, and the contact ends there).
+    #[inline(always)]
+    pub(crate) fn update<Sh: Shape>(
+        &mut self,
+        s: &impl Surface,
+        frame: &Frame<'_, Sh>,
+        probe: V3,
+        tissue: [i32; 4],
+    ) {
+        match frame.shape.cap() {
+            None => self.update_flat(s, q::held_to(tissue, probe)),
+            Some(&cap) => {
+                let f = CapFrame {
+                    cap,
+                    origin: frame.origin,
+                };
+                self.update_cap(s, &f, probe, tissue)
+            }
+        }
+    }
+
+    /// The device's force (Q20 N) in one substep on a tissue of `shape`, with the probe
+    /// at `probe` moving at `probe_vel` (Q16 mm/s), and the proxy's triangle with its
+    /// weights to put the reaction (minus the force) on; zero out of contact. The
+    /// coupling's damping acts along the rest normal under the proxy (a flat tissue's:
+    /// `z`), and the force is unilateral along it.
+    #[inline(always)]
+    pub(crate) fn force<Sh: Shape>(
         &self,
         s: &impl Surface,
+        shape: &Sh,
         coupling: &CouplingQ,
         probe: V3,
         probe_vel: V3,
     ) -> (V3, [(usize, usize); 3], [i32; 3]) {
-        let Some(g) = self.at else {
-            return ([0; 3], [(0, 0); 3], [0; 3]);
-        };
-        let (corners, w) = self.triangle(g);
-        let p = Self::blend(w, corners.map(|(a, b)| s.position(a, b)));
-        // Only the surface's normal (z) velocity enters: the damping acts along z.
-        let vz = Self::blend1(w, corners.map(|(a, b)| s.velocity(a, b)[2]));
-        let proxy = [p[0], p[1], p[2].saturating_add(self.radius)];
-        let mut f = spring(coupling, proxy, probe);
-        f[2] = f[2].saturating_add(damping(coupling, vz.saturating_sub(probe_vel[2])));
-        if f[2] < 0 {
-            return ([0; 3], corners, w);
-        }
-        (held(f, coupling.max_force), corners, w)
-    }
-}
-
-/// Q24 mm · Q16 N/mm and Q16 mm/s · Q24 N·s/mm are Q40: Q20 N after `>> COUPLING_SH`.
-const COUPLING_SH: u32 = LEN_FRAC + 16 - FORCE_FRAC;
-const _: () = assert!(VEL_FRAC + 24 - FORCE_FRAC == COUPLING_SH);
-
-/// The coupling's spring force (Q20 N) between the proxy's centre and the probe (Q24 mm).
-#[inline(always)]
-fn spring(coupling: &CouplingQ, proxy: V3, probe: V3) -> V3 {
-    core::array::from_fn(|k| {
-        sat(mul_wide(proxy[k].saturating_sub(probe[k]), coupling.stiffness) >> COUPLING_SH)
-    })
-}
-
-/// The coupling's damping force (Q20 N) for a closing speed along the normal (Q16 mm/s).
-#[inline(always)]
-fn damping(coupling: &CouplingQ, closing: i32) -> i32 {
-    sat(mul_wide(closing, coupling.damping) >> COUPLING_SH)
-}
-
-/// `f` (Q20 N) held to `max` in magnitude, never above it: the squares in Q12 from each
-/// component's magnitude rounded up (an estimate never below |f|), the scale from below
-/// (`scale_to`), the scaled components truncated toward zero.
-#[inline(always)]
-fn held(f: V3, max: i32) -> V3 {
-    let up = |x: i32| ((x.unsigned_abs() >> 8) + 1) as i32;
-    let f2: i64 = f.iter().map(|&x| mul_wide(up(x), up(x))).sum();
-    if f2 <= mul_wide(max >> 8, max >> 8) {
-        return f;
-    }
-    let lambda = scale_to(max >> 8, f2);
-    f.map(|x| {
-        let m = mul_wide(x.saturating_abs(), lambda) >> G_FRAC;
-        sat(if x < 0 { -m } else { m })
-    })
-}
-
-/// `r / √x` in Q16 for `0 < r` and `r² < x` (a value below 1): `x` a square in the
-/// square of `r`'s format. Two Newton steps for `1/√M`, `M ∈ [¼, 1)` the normalised
-/// `x`, from a table's first guess (within 4e-3), in 32-bit products: within 2e-8;
-/// the result is then floored and lowered by one unit (1.5e-5 of one), so that it is
-/// never above the exact value and a force scaled by it stays within its limit.
-fn scale_to(r: i32, x: i64) -> i32 {
-    // r/√x = r · y · 2^(e/2 − 62), y Q30: in Q16, r · y >> (46 − e/2) (e is even).
-    let (y, e) = q::rsqrt(x);
-    let sh = 46 - (e >> 1);
-    sat((q::mul_wide_u(r.max(0) as u32, y) >> sh) as i64)
-        .min(ONE_G)
-        .saturating_sub(1)
-        .max(0)
-}
-
-/// `tan x` for `0 ≤ x ≤ 0.7` (start-up: the hysteresis cone, `x = 0.6 atan μ_k ≤ 0.665`),
-/// as `sin x / cos x` from their Taylor series to `x¹⁵` and `x¹⁴`: the first omitted
-/// terms are below `0.7¹⁷/17! = 6e-18` and `0.7¹⁶/16! = 2e-16`, so the result is within
-/// 1e-15 relative of `tan` (tested against `std`). libm's `tan` costs 6 KiB of flash
-/// (its argument reduction), `tanf` 4.6 KiB; this costs a few hundred bytes.
-fn tan_small(x: f64) -> f64 {
-    let x2 = x * x;
-    let (mut sin, mut cos) = (0.0, 0.0);
-    // Horner from the highest term: sin = x Σ (−x²)^k/(2k+1)!, cos = Σ (−x²)^k/(2k)!.
-    for k in (0..8u32).rev() {
-        let (s_den, c_den) = ((2 * k + 2) * (2 * k + 3), (2 * k + 1) * (2 * k + 2));
-        sin = 1.0 - x2 * sin / s_den as f64;
-        cos = 1.0 - x2 * cos / c_den as f64;
-    }
-    x * sin / cos
-}
-
-#[cfg(test)]
-mod tests {
-    /// `rsqrt` against `f64` over its whole domain (1 … 2⁶³, log-spaced, and each power of
-    /// two's neighbours), within 2e-8 relative (the measured figure printed); `scale_to`
-    /// never above the exact ratio.
-    #[test]
-    fn rsqrt_matches_f64() {
-        let mut worst = 0.0f64;
-        let mut xs: Vec<i64> = (0..63)
-            .flat_map(|k| [(1i64 << k) - 1, 1i64 << k, (1i64 << k) + 1])
-            .collect();
-        xs.extend((0..20_000).map(|i| 2f64.powf(i as f64 * 63.0 / 20_000.0) as i64));
-        xs.push(i64::MAX);
-        for x in xs.into_iter().filter(|&x| x > 0) {
-            let (y, e) = crate::q::rsqrt(x);
-            let got = y as f64 * 2f64.powf(e as f64 / 2.0 - 62.0);
-            worst = worst.max((got * (x as f64).sqrt() - 1.0).abs());
-        }
-        println!("RSQRT max_rel_err={worst:.1e}");
-        // Its normalisation by 32-bit halves against the 64-bit one, at every power of
-        // two and its neighbours, and at 10⁵ random values of every size.
-        let mut k = 7u64;
-        let powers = (0..64).flat_map(|b| [(1u64 << b) - 1, 1u64 << b, (1u64 << b) + 1]);
-        let random = (0..100_000u32).map(|i| {
-            k = k
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            k >> (i % 64)
-        });
-        for x in powers.chain(random).chain([u64::MAX]).filter(|&x| x > 0) {
-            let e = x.leading_zeros() & !1;
-            let want = (((x << e) >> 34) as u32, e);
-            assert_eq!(crate::q::normalise(x), want, "{x:#x}");
-        }
-        assert!(worst < 2e-8, "worst relative error {worst:e}");
-        // scale_to: within two Q16 units of r/√x, and never above it, over ratios from
-        // 1e-4 to 1 and squares of every size.
-        let mut k = 1u64;
-        for i in 0..20_000u32 {
-            k = k
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            let r = (((k >> 33) as i32) & 0x3FFF_FFFF).max(1) >> (i % 30);
-            let ratio = 1e-4 + (i as f64 / 20_000.0) * (1.0 - 1e-4);
-            let x = ((r.max(1) as f64 / ratio).powi(2)) as i64;
-            if x <= (r as i64).pow(2) {
-                continue;
-            }
-            let want = r as f64 / (x as f64).sqrt() * 65536.0;
-            let got = super::scale_to(r, x) as f64;
-            assert!(got <= want && want - got <= 2.0, "{r} {x}: {got} vs {want}");
+        if shape.cap().is_some() {
+            self.force_cap(s, coupling, probe, probe_vel)
+        } else {
+            self.force_flat(s, coupling, probe, probe_vel)
         }
     }
 
-    /// `tan_small` against `std` over its whole domain.
-    #[test]
-    fn tan_small_matches_std() {
-        let mut worst = 0.0f64;
-        for i in 1..=70_000 {
-            let x = i as f64 * 1e-5;
-            let rel = (super::tan_small(x) - x.tan()).abs() / x.tan();
-            worst = worst.max(rel);
+    /// The proxy's centre on the current surface of a tissue of `frame`'s shape (Q24 mm,
+    /// patch frame), when in contact.
+    pub(crate) fn centre_in<Sh: Shape>(
+        &self,
+        s: &impl Surface,
+        frame: &Frame<'_, Sh>,
+    ) -> Option<V3> {
+        match frame.shape.cap() {
+            None => self.centre_at(s),
+            Some(&cap) => self.centre_cap_at(
+                s,
+                &CapFrame {
+                    cap,
+                    origin: frame.origin,
+                },
+            ),
         }
-        assert!(worst < 1e-15, "worst relative error {worst:e}");
-        assert_eq!(super::tan_small(0.0), 0.0);
     }
+}
+
+/// The tissue's shape as a proxy sees it in one tick: the shape, and the patch frame's
+/// origin in the tissue frame (Q24 mm, `x` and `y`; the frames share `z`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Frame<'a, Sh: Shape> {
+    /// The tissue's shape.
+    pub shape: &'a Sh,
+    /// The patch frame's origin.
+    pub origin: [i32; 2],
 }

@@ -1,25 +1,38 @@
-//! The solver driven through a [`Proxy`] on its surface (issue #19): the standard patch's
-//! surface nodes as the proxy sees them, and the tick.
+//! The solver driven through a [`Proxy`] on its surface: the standard patch's surface
+//! nodes as the proxy sees them (its ring at the rest heights of the tissue's shape), and
+//! the tick.
 
 use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
-use crate::proxy::{Proxy, ProxyConfig, ProxyError, Surface};
+use crate::proxy::{Frame, Proxy, ProxyConfig, ProxyError, Surface};
 use crate::q::{self, V3};
+use crate::shape::{Flat, Level, RestHeights, Shape};
 use crate::topology::surface_node;
 use crate::units::{from_f64, Force, Length, LEN_FRAC};
+use crate::window::Window;
 
 /// The standard patch's surface as a proxy reads it: node `(a, b)` of the `n × n` grid,
-/// the outer ring at rest.
-pub(super) struct View<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
+/// the outer ring at rest at the rest heights `H` of the tissue's shape (a flat tissue's:
+/// zero, a constant; the free nodes' rest positions are the topology's, moved with a
+/// window over a cap).
+pub(super) struct View<
+    'a,
+    const NODES: usize,
+    const EDGES: usize,
+    const S: usize,
+    A: Arith,
+    H: RestHeights = Level,
+> {
     solver: &'a Solver<NODES, EDGES, S, A>,
     n: usize,
     /// Spacing, Q24 mm.
     spacing: i32,
+    heights: H,
 }
 
-impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
-    View<'_, NODES, EDGES, S, A>
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, H: RestHeights>
+    View<'_, NODES, EDGES, S, A, H>
 {
     /// The node of surface point `(a, b)`, `None` on the ring.
     fn node(&self, a: usize, b: usize) -> Option<usize> {
@@ -39,42 +52,13 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
     }
 }
 
-/// A window's surface over a cap as the proxy reads it: the ring's rest heights from the
-/// window's (the free nodes' rest positions are the topology's, moved with the window).
-pub(super) struct CapView<'a, const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
-    view: View<'a, NODES, EDGES, S, A>,
-    heights: &'a [i32; EDGES],
-}
-
-impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
-    for CapView<'_, NODES, EDGES, S, A>
-{
-    fn position(&self, a: usize, b: usize) -> V3 {
-        match self.view.node(a, b) {
-            Some(_) => self.view.position(a, b),
-            None => {
-                let [x, y] = self.view.ring_xy(a, b);
-                [x, y, self.rest_z(a, b)]
-            }
-        }
-    }
-
-    fn velocity(&self, a: usize, b: usize) -> V3 {
-        self.view.velocity(a, b)
-    }
-
-    fn rest_z(&self, a: usize, b: usize) -> i32 {
-        self.heights.get(a * self.view.n + b).copied().unwrap_or(0)
-    }
-}
-
-impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
-    for View<'_, NODES, EDGES, S, A>
+impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, H: RestHeights> Surface
+    for View<'_, NODES, EDGES, S, A, H>
 {
     fn position(&self, a: usize, b: usize) -> V3 {
         let ring = || {
             let [x, y] = self.ring_xy(a, b);
-            [x, y, 0]
+            [x, y, self.rest_z(a, b)]
         };
         match self.node(a, b) {
             Some(i) => {
@@ -88,6 +72,11 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Surface
 
     fn velocity(&self, a: usize, b: usize) -> V3 {
         self.node(a, b).map_or([0; 3], |i| self.solver.node_vel(i))
+    }
+
+    #[inline(always)]
+    fn rest_z(&self, a: usize, b: usize) -> i32 {
+        self.heights.z(a * self.n + b)
     }
 }
 
@@ -108,24 +97,31 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         }
     }
 
+    /// The patch's surface, its ring flat.
+    #[inline(always)]
     pub(super) fn view(&self, proxy: &Proxy) -> View<'_, NODES, EDGES, S, A> {
         let (n, spacing) = proxy.grid();
         View {
             solver: self,
             n,
             spacing,
+            heights: Level,
         }
     }
 
-    /// A window's surface over a cap.
-    pub(super) fn cap_view<'a, const CAP: bool>(
+    /// A window's surface: its ring at the rest heights of the window's shape.
+    #[inline(always)]
+    pub(super) fn view_in<'a, Sh: Shape>(
         &'a self,
         proxy: &Proxy,
-        window: &'a crate::window::Window<EDGES, CAP>,
-    ) -> CapView<'a, NODES, EDGES, S, A> {
-        CapView {
-            view: self.view(proxy),
-            heights: &window.heights,
+        window: &'a Window<EDGES, Sh>,
+    ) -> View<'a, NODES, EDGES, S, A, Sh::Rest<'a>> {
+        let (n, spacing) = proxy.grid();
+        View {
+            solver: self,
+            n,
+            spacing,
+            heights: window.shape().rest(window.heights()),
         }
     }
 
@@ -136,19 +132,20 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             .map(|p| p.map(Length::from_bits))
     }
 
-    /// The proxy's centre (mm, patch frame) on a window's current surface (flat or a
-    /// cap), when in contact.
-    pub fn proxy_point_in<const CAP: bool>(
+    /// The proxy's centre (mm, patch frame) on a window's current surface, when in
+    /// contact.
+    pub fn proxy_point_in<Sh: Shape>(
         &self,
         proxy: &Proxy,
-        window: &crate::window::Window<EDGES, CAP>,
+        window: &Window<EDGES, Sh>,
     ) -> Option<[Length; 3]> {
-        match super::roaming::cap_frame(window) {
-            None => self.proxy_point(proxy),
-            Some(f) => proxy
-                .centre_cap_at(&self.cap_view(proxy, window), &f)
-                .map(|p| p.map(Length::from_bits)),
-        }
+        let frame = Frame {
+            shape: window.shape(),
+            origin: window.origin(),
+        };
+        proxy
+            .centre_in(&self.view_in(proxy, window), &frame)
+            .map(|p| p.map(Length::from_bits))
     }
 
     /// One haptic tick with the probe at `probe` (mm, patch frame) touching the surface
@@ -160,29 +157,35 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
         // Past the patch's edge, the goal is the point above the nearest point of it.
-        proxy.update(&self.view(proxy), q::held_to(proxy.patch_rect(), p));
-        self.proxy_substeps(p, probe_vel, proxy);
+        let flat = Frame {
+            shape: &Flat,
+            origin: [0; 2],
+        };
+        proxy.update(&self.view(proxy), &flat, p, proxy.patch_rect());
+        self.proxy_substeps(p, probe_vel, proxy, &Flat, Level);
         self.device_force()
     }
 
-    /// The tick's substeps with the probe at `p` (Q24 mm, patch frame) moving at
-    /// `probe_vel` (Q16 mm/s), coupled to `proxy`.
-    pub(super) fn proxy_substeps(&mut self, p: V3, probe_vel: V3, proxy: &Proxy) {
-        self.coupled_substeps(proxy, |s| {
-            proxy.force(&s.view(proxy), &s.c.coupling, p, probe_vel)
-        });
-    }
-
-    /// [`Self::proxy_substeps`] on a cap.
-    pub(super) fn proxy_substeps_cap<const CAP: bool>(
+    /// The tick's substeps on a tissue of `shape` with the rest heights `heights`, the
+    /// probe at `p` (Q24 mm, patch frame) moving at `probe_vel` (Q16 mm/s), coupled to
+    /// `proxy` (one function for a patch alone and a flat window).
+    pub(super) fn proxy_substeps<Sh: Shape, H: RestHeights + Copy>(
         &mut self,
         p: V3,
         probe_vel: V3,
         proxy: &Proxy,
-        window: &crate::window::Window<EDGES, CAP>,
+        shape: &Sh,
+        heights: H,
     ) {
+        let (n, spacing) = proxy.grid();
         self.coupled_substeps(proxy, |s| {
-            proxy.force_cap(&s.cap_view(proxy, window), &s.c.coupling, p, probe_vel)
+            let view = View {
+                solver: s,
+                n,
+                spacing,
+                heights,
+            };
+            proxy.force(&view, shape, &s.c.coupling, p, probe_vel)
         });
     }
 

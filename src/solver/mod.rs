@@ -43,6 +43,7 @@ pub mod stability;
 mod step;
 #[cfg(test)]
 mod test_patch;
+mod window;
 
 pub use config::{ConfigKey, SolverConfig};
 pub use error::SolverError;

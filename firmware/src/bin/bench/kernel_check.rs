@@ -1,4 +1,4 @@
-//! The M4F's spring loop and integrator are assembly (`mccs/src/arith/wide_dsp.rs`);
+//! The M4F's spring loop and integrator are assembly (`mccs/src/arith/wide_dsp/`);
 //! this checks them against the portable Rust loops they replace, bit for bit, on the
 //! core itself, before anything is measured, on two sets of states:
 //! - the standard N = 5 patch (61 springs, 25 of them between two free nodes) at random

@@ -30,6 +30,8 @@ mod kernel_check;
 mod report;
 #[cfg(target_os = "none")]
 mod rng;
+#[cfg(target_os = "none")]
+mod ticks;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -38,7 +40,7 @@ mod firmware {
     use super::report::{
         check_budgets, fits, largest_patch, substep_case, Figures, Steps, SPRING_PATH_SPREAD,
     };
-    use super::{cases, harness, hold_check, kernel_check, report};
+    use super::{cases, harness, hold_check, kernel_check, report, ticks};
     use cases::TablePath;
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -197,15 +199,15 @@ mod firmware {
             );
         }
         // One whole tick of this core's demo configuration, in contact.
-        figs.report("tick", cases::tick(&h, table, probe) - empty);
+        figs.report("tick", ticks::tick(&h, table, probe) - empty);
         // One tick of the demo's patch through a sliding proxy (issue #19).
-        figs.report("tick_proxy", cases::tick_proxy(&h, table) - empty);
+        figs.report("tick_proxy", ticks::tick_proxy(&h, table) - empty);
         // The solver's start-up for the demo's patch, once (millions of instructions).
         let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
-        report::startup(&mut figs, grid, cases::startup(&h, table));
+        report::startup(&mut figs, grid, ticks::startup(&h, table));
         // The demo's roaming: the longest tick without and with a window shift, and a
         // shift's own cost (the most a shift tick took over the tick before).
-        let roam = cases::roaming(&h, table, empty);
+        let roam = ticks::roaming(&h, table, empty);
         figs.report("tick_roaming", roam.steady);
         figs.report("tick_roaming_shift", roam.shift);
         figs.report("window_shift", roam.shift_extra);
@@ -217,7 +219,7 @@ mod firmware {
         );
         // The same over a spherical cap (R = 150 mm): the contact along its normals, and
         // a shift that also computes the entering rest heights and springs.
-        let cap = cases::roaming_cap(&h, table, empty);
+        let cap = ticks::roaming_cap(&h, table, empty);
         figs.report("tick_roaming_cap", cap.steady);
         figs.report("tick_roaming_cap_shift", cap.shift);
         figs.report("window_shift_cap", cap.shift_extra);
@@ -227,7 +229,7 @@ mod firmware {
         );
         // Issue #19's M4F configuration, N = 5, over the cap (the M4F's demo runs N = 8).
         if CORE == Core::M4F {
-            let cap5 = cases::roaming_cap_n5(&h, table, empty);
+            let cap5 = ticks::roaming_cap_n5(&h, table, empty);
             figs.report("tick_roaming_cap_n5", cap5.steady);
             figs.report("window_shift_cap_n5", cap5.shift_extra);
             figs.report(

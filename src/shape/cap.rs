@@ -1,4 +1,4 @@
-//! `Cap`: a tissue's rest surface shaped as a spherical cap (issue #19), in fixed point:
+//! `Cap`: a tissue's rest surface shaped as a spherical cap, in fixed point:
 //! node heights, the rest normal and the radial direction through a point, each by
 //! products and at most one reciprocal square root ([`crate::q::rsqrt`]): no division.
 //! The window's shifts and the proxy use them on the tick; the `f64` reference is
@@ -35,9 +35,10 @@ fn on_q15_grid(d: V3) -> V3 {
 /// Largest cap radius, mm (`R` in Q20 within `i32`).
 pub const MAX_CAP_RADIUS_MM: f64 = 2000.0;
 
-/// A spherical cap over a `W × H` tissue at spacing `s`.
+/// A spherical cap over a `W × H` tissue at spacing `s`: a window's [`crate::shape::Shape`]
+/// (built from a [`crate::shape::Sphere`] at start-up).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Cap {
+pub struct Cap {
     /// `R`, Q20 mm.
     r: i32,
     /// `1/R` per mm as `inv_r · 2^−(31 + inv_sh)`, `inv_r` normalised within `[2³⁰, 2³¹)`

@@ -1,31 +1,13 @@
-//! [`spring_forces`] and [`integrate`]: [`super::Wide`]'s spring loop and integrator in
-//! Armv7E-M assembly (the Cortex-M4F's DSP instructions: `smmla`, `smmulr`, `qadd`,
-//! `ssat`, …), bit for bit the portable loops ([`super::wide::spring_forces_portable`],
-//! [`super::wide::integrate_portable`]), which every other core runs and against which
-//! the bench firmware checks these on random states before it measures
-//! (`firmware/src/bin/bench/kernel_check.rs`).
-//!
-//! Why assembly: the compiler's loop spent about a fifth of each spring on moving
-//! values (spills of the edge vector around the table lookup, the warm-start pointer
-//! kept on the stack, masks rebuilt for every spring, node addresses from two
-//! multiplies each), and small source changes moved that cost unpredictably
-//! (`docs/performance.md`, "The M4F's loops in assembly"). Here every register is
-//! chosen: an edge is one `ldm`, a node's three components one `ldm`/`stm`, and the
-//! loop keeps the edge and warm-start pointers in registers.
-//!
-//! The arithmetic is [`super::wide`]'s `spring` and `integrate`, step for step; their
-//! comments give the formats and ranges. One precondition the portable loop does not
-//! have: no displacement or stored velocity is `i32::MIN` (a spring to the ground
-//! subtracts `u_a`'s and `v_a`'s products instead of negating them). Every writer of the
-//! nodes holds both within ±2³⁰ (the integrator, `Solver::set_state`, the held drive, a
-//! window's shift, which copies them), so the solver never holds one. Only for tables of
-//! a power-of-two segment count (the index is a bit field); others take the portable
-//! loop.
+//! The spring loop in Armv7E-M assembly: every spring's force, accumulated on its two
+//! nodes, bit for bit [`crate::arith::wide`]'s portable loop (`wide_dsp/mod.rs` gives the
+//! preconditions).
 
 use crate::q::V3;
 use crate::state::Node;
 use crate::table::{ForceTable, RawTable};
 use crate::topology::{Edge, Topology};
+
+use super::serves;
 
 /// What the loop reads at entry (`repr(C)`: one `ldm`). The first six words become its
 /// frame: `velocities` and `stride` one `ldrd` (node `i`'s velocity is at
@@ -86,7 +68,7 @@ const fn header<const S: usize>() -> [i32; 14] {
 /// The header as the assembly addresses it: `ldrd` pairs (`strain_lo, strain_hi`,
 /// `index_pre, index_scale` and `corner_anchor, corner_pre`) and `ldr`s, word-aligned
 /// within 255 bytes before the first segment.
-const fn header_fits<const S: usize>() -> bool {
+pub(super) const fn header_fits<const S: usize>() -> bool {
     let h = header::<S>();
     let mut i = 0;
     let mut ok = h[1] == h[0] + 4 && h[3] == h[2] + 4 && h[11] == h[10] + 4;
@@ -95,33 +77,6 @@ const fn header_fits<const S: usize>() -> bool {
         i += 1;
     }
     ok
-}
-
-/// Whether this loop serves tables of `S` segments and topologies of `NODES` node slots
-/// (the loop takes a node index as a signed halfword: below 2¹⁵).
-pub(super) const fn serves<const S: usize, const NODES: usize>() -> bool {
-    S.is_power_of_two() && S <= 1 << 16 && header_fits::<S>() && NODES <= 1 << 15
-}
-
-/// `asm!` with every register but r0, r6, r7, r13 and r15 declared written: the blocks
-/// below use them all (r0 is each block's input, r6 and r7 they save themselves).
-macro_rules! asm_writing_all {
-    ($($operands:tt)*) => {
-        core::arch::asm!(
-            $($operands)*
-            out("r1") _,
-            out("r2") _,
-            out("r3") _,
-            out("r4") _,
-            out("r5") _,
-            out("r8") _,
-            out("r9") _,
-            out("r10") _,
-            out("r11") _,
-            out("r12") _,
-            out("lr") _,
-        )
-    };
 }
 
 /// The lower line's product, `(slope_lo · d) >> 20` held to 32 bits, into r3 from
@@ -442,11 +397,11 @@ macro_rules! spring_loop {
     };
 }
 
-/// Every spring's force, accumulated on its two nodes: [`super::wide`]'s loop, in
+/// Every spring's force, accumulated on its two nodes: [`crate::arith::wide`]'s loop, in
 /// assembly. Only for tables it [`serves`] (the caller's choice, a constant).
 #[inline(always)]
 #[allow(unsafe_code)]
-pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usize>(
+pub(crate) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usize>(
     table: &ForceTable<S>,
     damping: i32,
     topo: &Topology<NODES, EDGES>,
@@ -485,108 +440,5 @@ pub(super) fn spring_forces<const S: usize, const NODES: usize, const EDGES: usi
         (false, false) => unsafe { spring_loop!(args, lower_any, no_lower_corner) },
         (true, true) => unsafe { spring_loop!(args, lower_gentle, lower_corner) },
         (false, true) => unsafe { spring_loop!(args, lower_any, lower_corner) },
-    }
-}
-
-/// What [`integrate`] reads at entry (`repr(C)`: one `ldm`).
-#[repr(C)]
-struct IntegrateArgs {
-    begin: *mut Node,
-    end: *mut Node,
-    keep: i32,
-    h_over_m: i32,
-    half_h: i32,
-}
-
-/// The integrator's loop over [`IntegrateArgs`] `$args`; `$x`, `$y` and `$z` put what the
-/// position step multiplies by `h/2` in r3, r4 and r5 (`v + v'` or `v' + v'`, from v in
-/// r3–r5 and v' in r6, r8, r9).
-macro_rules! integrate_loop {
-    ($args:ident, $x:literal, $y:literal, $z:literal) => {
-        asm_writing_all!(
-            "push {{r6, r7}}",
-            "ldm r0, {{r1, r2, r10, r11, r12}}",
-            "mov lr, r1",
-            "push {{r2}}",
-            "cmp lr, r2",
-            "beq 99f",
-            "70:",
-            "ldm lr, {{r0, r1, r2, r3, r4, r5}}",
-            // Per axis: v' = (v keep + f h/m) >> 24, held within ±2³⁰ through the high
-            // word; u' = u + hi((v + v') h/2) (or (v' + v') h/2), held within ±2³⁰. v0'
-            // in r6, v1' in r8, v2' in r9 (so that u and v' go back in one `stm`).
-            "ldr r7, [lr, #24]",
-            "smull r6, r8, r3, r10",
-            "smlal r6, r8, r7, r11",
-            "ssat r8, #23, r8",
-            "lsl r8, r8, #8",
-            "orr r6, r8, r6, lsr #24",
-            $x,
-            "smmla r0, r3, r12, r0",
-            "ssat r0, #31, r0",
-            "ldr r7, [lr, #28]",
-            "smull r8, r9, r4, r10",
-            "smlal r8, r9, r7, r11",
-            "ssat r9, #23, r9",
-            "lsl r9, r9, #8",
-            "orr r8, r9, r8, lsr #24",
-            $y,
-            "smmla r1, r4, r12, r1",
-            "ssat r1, #31, r1",
-            "ldr r3, [lr, #32]",
-            "smull r9, r7, r5, r10",
-            "smlal r9, r7, r3, r11",
-            "ssat r7, #23, r7",
-            "lsl r7, r7, #8",
-            "orr r9, r7, r9, lsr #24",
-            $z,
-            "smmla r2, r5, r12, r2",
-            "ssat r2, #31, r2",
-            "mov r3, #0",
-            "stm lr!, {{r0, r1, r2, r6, r8, r9}}",
-            "strd r3, r3, [lr]",
-            "str r3, [lr, #8]",
-            "add lr, lr, #12",
-            "ldr r7, [sp]",
-            "cmp lr, r7",
-            "bne 70b",
-            "99:",
-            "add sp, sp, #4",
-            "pop {{r6, r7}}",
-            inout("r0") core::ptr::addr_of!($args) => _,
-        )
-    };
-}
-
-/// The integrator on every node of `free` and its accumulator cleared:
-/// [`super::wide`]'s `integrate`, in assembly (one `ldm` of a node's displacement and
-/// velocity, one `stm` back). `keep`, `h_over_m` and `half_h` are [`super::WideCoeffs`]'
-/// (Q24, Q20, Q40); `symplectic` chooses, once per call, the loop whose position step
-/// adds `v' + v'` instead of `v + v'` (the one instruction per axis the two differ by).
-#[inline(always)]
-#[allow(unsafe_code)]
-pub(super) fn integrate(
-    keep: i32,
-    h_over_m: i32,
-    half_h: i32,
-    symplectic: bool,
-    free: &mut [Node],
-) {
-    let range = free.as_mut_ptr_range();
-    let args = IntegrateArgs {
-        begin: range.start,
-        end: range.end,
-        keep,
-        h_over_m,
-        half_h,
-    };
-    // SAFETY (both loops): reads and writes the nodes of `free` (from `begin` up to
-    // `end`) only, at the offsets asserted above. r6 and r7 are saved and restored by the
-    // block itself, every other register it writes is declared, and the stack is left as
-    // it was found.
-    if symplectic {
-        unsafe { integrate_loop!(args, "add r3, r6, r6", "add r4, r8, r8", "add r5, r9, r9") }
-    } else {
-        unsafe { integrate_loop!(args, "add r3, r3, r6", "add r4, r4, r8", "add r5, r5, r9") }
     }
 }

@@ -1,0 +1,240 @@
+//! The measured ticks: this core's demo configuration (its start-up, one tick glued and
+//! one through a sliding proxy), and the demo's roaming, flat and over a cap (the
+//! longest tick without and with a window shift).
+
+use super::fw_common::exit;
+use super::harness::Harness;
+use core::hint::black_box;
+use mccs::{Flat, ForceTable64, Length, ProxyConfig, ShapeSpec, Solver, Sphere, Topology};
+use mccs_firmware::demo::{self, DemoSpec};
+use mccs_firmware::entry as e;
+use mccs_firmware::target::CORE;
+
+/// This core's demo patch (`spec`'s grid at the demo's spacing); exits with failure if it
+/// cannot be built.
+fn demo_topology<const N: usize, const E: usize>(spec: &DemoSpec) -> Topology<N, E> {
+    match Topology::<N, E>::standard_patch(spec.grid, demo::SPACING) {
+        Ok(topo) => topo,
+        Err(_) => exit(false),
+    }
+}
+
+/// A solver of `table` on this core's demo patch with `spec`'s configuration; exits with
+/// failure if it cannot be built.
+fn demo_solver<const N: usize, const E: usize>(
+    spec: &DemoSpec,
+    table: &ForceTable64,
+) -> Solver<N, E, 64> {
+    match Solver::new(demo_topology(spec), *table, &spec.config()) {
+        Ok(s) => s,
+        Err(_) => exit(false),
+    }
+}
+
+/// The solver's start-up for this core's demo configuration (`Solver::new`: the patch's
+/// coefficients and its stability bound, whose estimate runs the linearised step about
+/// ten times 1,536 steps, in block fixed point), once, in instructions.
+#[inline(never)]
+pub fn startup(h: &Harness, table: &ForceTable64) -> u64 {
+    match demo::spec_for(CORE).grid {
+        8 => startup_in::<37, 214>(h, table),
+        5 => startup_in::<10, 61>(h, table),
+        _ => startup_in::<5, 30>(h, table),
+    }
+}
+
+#[inline(never)]
+fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u64 {
+    let spec = demo::spec_for(CORE);
+    let topo = demo_topology::<N, E>(&spec);
+    let mut ok = false;
+    let n = h.measure_long(|| {
+        ok = black_box(Solver::new(black_box(topo), *table, &spec.config())).is_ok();
+    });
+    if !ok {
+        exit(false)
+    }
+    n
+}
+
+/// One tick of this core's demo configuration, pressed in, averaged over 4.
+#[inline(never)]
+pub fn tick(h: &Harness, table: &ForceTable64, probe: [Length; 3]) -> u32 {
+    if demo::spec_for(CORE).grid > 5 {
+        tick_in::<37, 214>(h, table, probe)
+    } else {
+        tick_in::<10, 61>(h, table, probe)
+    }
+}
+
+#[inline(never)]
+fn tick_in<const N: usize, const E: usize>(
+    h: &Harness,
+    table: &ForceTable64,
+    probe: [Length; 3],
+) -> u32 {
+    let spec = demo::spec_for(CORE);
+    let mut s = demo_solver::<N, E>(&spec, table);
+    for _ in 0..200 {
+        e::tick(&mut s, probe);
+    }
+    h.measure(4, || {
+        black_box(e::tick(&mut s, black_box(probe)));
+    })
+}
+
+/// One tick of this core's demo patch (its grid and configuration, 2.5 mm) through a
+/// proxy with friction (μ_s 0.6, μ_k 0.4), 0.5 mm deep and sliding along x at 10 mm/s
+/// (the contact slipping), after 200 ticks of it; averaged over 4.
+#[inline(never)]
+pub fn tick_proxy(h: &Harness, table: &ForceTable64) -> u32 {
+    match demo::spec_for(CORE).grid {
+        8 => tick_proxy_in::<37, 214>(h, table),
+        5 => tick_proxy_in::<10, 61>(h, table),
+        _ => tick_proxy_in::<5, 30>(h, table),
+    }
+}
+
+#[inline(never)]
+fn tick_proxy_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u32 {
+    let spec = demo::spec_for(CORE);
+    let mut s = demo_solver::<N, E>(&spec, table);
+    let cfg = ProxyConfig {
+        grid: spec.grid,
+        spacing: 2.5,
+        mu_s: 0.6,
+        mu_k: 0.4,
+        probe_radius: 0.0,
+    };
+    let Ok(mut proxy) = s.proxy(&cfg) else {
+        exit(false)
+    };
+    let (step, z) = (Length::from_num(0.01), Length::from_num(-0.5));
+    let mut x = Length::from_num(-1.0);
+    for _ in 0..200 {
+        x += step;
+        e::tick_proxy(&mut s, [x, Length::ZERO, z], &mut proxy);
+    }
+    if !proxy.slipping() {
+        exit(false)
+    }
+    h.measure(4, || {
+        x += step;
+        black_box(e::tick_proxy(
+            &mut s,
+            black_box([x, Length::ZERO, z]),
+            &mut proxy,
+        ));
+    })
+}
+
+/// The demo's roaming ticks (`DemoSpec::roaming`: its patch as a window on the 64 × 64
+/// tissue, friction 0.6 / 0.4), flat or over a cap of radius 150 mm (`cap`): a press to
+/// `z = −1` mm at `x = −5` (200 ticks), then a slide along `x` at 10 mm/s for 1000 ticks
+/// (4 window shifts; over the cap 1 … 0.92 mm deep), each tick measured alone.
+#[derive(Clone, Copy)]
+pub struct RoamingTicks {
+    /// The longest tick of the slide without a shift.
+    pub steady: u32,
+    /// The longest tick with a shift.
+    pub shift: u32,
+    /// The most a shift tick took over the tick before it: the shift's own cost.
+    pub shift_extra: u32,
+}
+
+/// [`RoamingTicks`] for this core's demo patch; `empty` is the harness's own count.
+#[inline(never)]
+pub fn roaming(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    roaming_of(h, table, empty, &Flat)
+}
+
+/// The cap the bench roams: radius 150 mm.
+const CAP: Sphere = Sphere { radius_mm: 150.0 };
+
+/// [`roaming`] over a cap of radius 150 mm.
+#[inline(never)]
+pub fn roaming_cap(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    roaming_of(h, table, empty, &CAP)
+}
+
+/// [`roaming`] on a tissue of `shape`.
+fn roaming_of<Spec: ShapeSpec>(
+    h: &Harness,
+    table: &ForceTable64,
+    empty: u32,
+    shape: &Spec,
+) -> RoamingTicks {
+    let spec = demo::spec_for(CORE);
+    match spec.grid {
+        8 => roaming_in::<37, 214, Spec>(h, table, empty, &spec, shape),
+        5 => roaming_in::<10, 61, Spec>(h, table, empty, &spec, shape),
+        _ => roaming_in::<5, 30, Spec>(h, table, empty, &spec, shape),
+    }
+}
+
+/// [`roaming_cap`] with this core's demo configuration on an N = 5 patch: issue #19's
+/// configuration for the M4F.
+#[inline(never)]
+pub fn roaming_cap_n5(h: &Harness, table: &ForceTable64, empty: u32) -> RoamingTicks {
+    let spec = DemoSpec {
+        grid: 5,
+        ..demo::spec_for(CORE)
+    };
+    roaming_in::<10, 61, Sphere>(h, table, empty, &spec, &CAP)
+}
+
+#[inline(never)]
+fn roaming_in<const N: usize, const E: usize, Spec: ShapeSpec>(
+    h: &Harness,
+    table: &ForceTable64,
+    empty: u32,
+    spec: &DemoSpec,
+    shape: &Spec,
+) -> RoamingTicks {
+    let mut s = demo_solver::<N, E>(spec, table);
+    let (x0, y) = (Length::from_num(-5), Length::from_num(0.4));
+    let Ok(mut proxy) = s.proxy(&spec.proxy_config()) else {
+        exit(false)
+    };
+    let Ok(mut window) = s.window(&demo::WINDOW, shape, &proxy, -5.0, 0.4) else {
+        exit(false)
+    };
+    let depth = Length::from_num(-1);
+    for k in 0..200 {
+        let z = depth / 200 * k;
+        e::tick_roaming(&mut s, [x0, y, z], &mut proxy, &mut window);
+    }
+    let step = Length::from_num(0.01);
+    let mut x = x0;
+    let mut out = RoamingTicks {
+        steady: 0,
+        shift: 0,
+        shift_extra: 0,
+    };
+    let mut last = 0;
+    for _ in 0..1000 {
+        x += step;
+        let before = window.shifts();
+        let n = h
+            .measure(1, || {
+                black_box(e::tick_roaming(
+                    &mut s,
+                    black_box([x, y, depth]),
+                    &mut proxy,
+                    &mut window,
+                ));
+            })
+            .saturating_sub(empty);
+        if window.shifts() != before {
+            out.shift = out.shift.max(n);
+            out.shift_extra = out.shift_extra.max(n.saturating_sub(last));
+        } else {
+            out.steady = out.steady.max(n);
+        }
+        last = n;
+    }
+    if window.shifts() < 3 || !proxy.slipping() {
+        exit(false)
+    }
+    out
+}
