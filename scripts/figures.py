@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The figures quoted in README.md and docs/*.md, held to what the code prints.
+"""The figures quoted in README.md and docs/**/*.md, held to what the code prints.
 
 A figure in a doc is marked `<!-- fig:KEY -->VALUE<!-- /fig -->` (the markers do not
 render). KEY names a value printed by the test command: every line of its logs of the
@@ -108,7 +108,7 @@ def excerpts(doc: Path, text: str) -> int:
 
 
 def docs():
-    return [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
+    return [ROOT / "README.md"] + sorted((ROOT / "docs").rglob("*.md"))
 
 
 def main() -> int:

@@ -80,7 +80,7 @@ fn no_source_file_cites_a_document_outside_the_repository() {
         for cited in text.split("docs/").skip(1) {
             let name: String = cited
                 .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '-' || *c == '_' || *c == '.')
+                .take_while(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | '/'))
                 .collect();
             if let Some(name) = name.strip_suffix('.').or(Some(&name)) {
                 if name.ends_with(".md") {

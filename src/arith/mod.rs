@@ -43,7 +43,7 @@ pub const MAX_SUBSTEP: f64 = i32::MAX as f64 / (1u64 << 39) as f64;
 pub const MAX_H_OVER_M: f64 = 2000.0;
 
 /// Which one-step scheme advances the free nodes. Both cost the same per node (the same
-/// products with other coefficients); `docs/performance.md` ("Integrator variants")
+/// products with other coefficients); `docs/experiments/performance.md` ("Integrator variants")
 /// has their measured bounds and accuracy.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Integrator {

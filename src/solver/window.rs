@@ -61,7 +61,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// Apart from the checks, so that this function's large frame (where every spring's
     /// ends are: some 36 KiB on a host's N = 9 patch) is set up on entry, before a value
     /// of theirs is live: an x86-64 release build's stack probe of that frame clobbered
-    /// one otherwise (`docs/experiments.md`; `scripts/long.sh` checks a release build).
+    /// one otherwise (`docs/experiments/roaming.md`; `scripts/long.sh` checks a release build).
     #[inline(never)]
     fn build_window<Sh: Shape>(
         &mut self,

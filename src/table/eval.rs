@@ -88,7 +88,7 @@ impl<const S: usize> ForceTable<S> {
         let (sum, d) = (cubic_sum(c, t), slope(c, t));
         // (The header's shift and scales are read only here: loaded before the cubic, they
         // would hold registers across it, and the M4F's frame would save one more
-        // register on every path; docs/performance.md, "The evaluation's frame". A
+        // register on every path; docs/experiments/performance.md, "Before and after issue #17". A
         // compiler fence emits no instruction.)
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         let f = sum.wrapping_shr(r.shift);

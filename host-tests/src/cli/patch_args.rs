@@ -26,7 +26,7 @@ pub(super) struct PatchArgs {
     /// Tick rate, Hz (a whole number, 1 … 100000).
     #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     pub rate: f64,
-    /// Integrator of either backend (docs/performance.md, "Integrator variants").
+    /// Integrator of either backend (docs/performance.md, "The symplectic option").
     #[arg(long, value_enum, default_value_t = IntegratorArg::ImprovedEuler)]
     pub integrator: IntegratorArg,
 }
