@@ -66,6 +66,31 @@ fn committed_tables_are_what_the_cli_emits() {
     }
 }
 
+/// The board's tissue (`boards/f405/tissue.rs`) is what the command in its own first line
+/// emits today: the table the board flashes is the table `mccs table` shows.
+#[test]
+fn the_boards_tissue_is_what_its_command_emits() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let committed = std::fs::read_to_string(format!("{root}/boards/f405/tissue.rs")).unwrap();
+    let command = committed
+        .lines()
+        .next()
+        .and_then(|l| l.split('`').nth(1))
+        .expect("a `mccs table …` command in its first line");
+    let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+    assert_eq!(args.first(), Some(&"table"), "{command}");
+    let out = Command::new(env!("CARGO_BIN_EXE_mccs"))
+        .args(&args)
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{command}");
+    assert!(
+        String::from_utf8(out.stdout).unwrap() == committed,
+        "boards/f405/tissue.rs is stale: run `{command} --out boards/f405/tissue.rs`"
+    );
+}
+
 #[test]
 fn every_knot_count_renders_and_round_trips() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");

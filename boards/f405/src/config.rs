@@ -5,7 +5,7 @@
 //! parts' limits. The pin map is type-level (the HAL's pins are types): `src/pins.rs`,
 //! one table with this one in docs/firmware.md.
 
-use mccs::SolverConfig;
+use mccs::{Coupling, SolverConfig};
 use mccs_firmware::drivers::as5047p::EncoderConfig;
 use mccs_firmware::drivers::pwm_motor::{MotorConfig, MotorConfigError};
 
@@ -51,21 +51,32 @@ pub struct BoardConfig {
     pub diag_every: u16,
     /// Bad encoder frames in a row tolerated before the safe state.
     pub max_bad_frames: u32,
-    /// Force at the probe at 100 % duty, N (0.001 … 1024): `k_t · I_max · i / (r/1000)`.
+    /// Force at the probe at 100 % duty, N (0.001 … 1024): `k_t · I_max · i / (r/1000)`,
+    /// for a current-mode driver (duty ∝ current ∝ torque; a plain H-bridge's torque
+    /// also falls with the motor's speed: docs/firmware.md, "The motor driver").
     pub force_at_full_duty: f64,
-    /// The patch: N × N surface nodes (the standard patch, 2.5 mm spacing).
+    /// The patch: N × N surface nodes (the standard patch, 2.5 mm spacing): 3 … 8.
     pub grid: usize,
-    /// Haptic node mass, kg.
-    pub node_mass: f64,
-    /// Spring damping, N·s/m.
+    /// Haptic mass of each free node, g (> 0; `mccs patch`/`replay`'s `--node-mass`).
+    pub node_mass_g: f64,
+    /// Relative damping of each spring, N·s/m (`--spring-damping`).
     pub spring_damping: f64,
+    /// The probe coupling's stiffness, N/mm (> 0, ≤ 1000; `--coupling-stiffness`): with
+    /// the tissue, what a press feels like (docs/cli.md, "From a sample to what a hand
+    /// feels").
+    pub coupling_stiffness: f64,
+    /// The probe coupling's damping, N·s/m (0 … 1000; `--coupling-damping`).
+    pub coupling_damping: f64,
+    /// The largest force per axis the controller renders, N (> 0, at most
+    /// `force_at_full_duty`, which the motor saturates at; `--max-force`).
+    pub max_force: f64,
     /// Ticks a QEMU run (`--features qemu`) lasts before its SUMMARY.
     pub qemu_ticks: u32,
 }
 
 /// The STM32F405 board: 8 MHz crystal, 168 MHz, a 1 kHz tick, the AS5047P at 5.25 MHz,
-/// 20 kHz PWM, a 50 ms watchdog; a 75 mm lever on a 10:1 capstan, a 3 N motor; the
-/// N = 8 patch of the M4F demo.
+/// 20 kHz PWM, a 50 ms watchdog; a 75 mm lever on a 10:1 capstan, a 3 N motor, the
+/// force held to it; the N = 8 patch of the M4F demo, the solver's default coupling.
 pub const BOARD: BoardConfig = BoardConfig {
     hse_hz: 8_000_000,
     sysclk_hz: 168_000_000,
@@ -80,8 +91,11 @@ pub const BOARD: BoardConfig = BoardConfig {
     max_bad_frames: 8,
     force_at_full_duty: 3.0,
     grid: 8,
-    node_mass: 0.005,
+    node_mass_g: 5.0,
     spring_damping: 1.0,
+    coupling_stiffness: 1.0,
+    coupling_damping: 0.5,
+    max_force: 3.0,
     qemu_ticks: 1000,
 };
 
@@ -109,6 +123,11 @@ pub enum BoardConfigError {
     /// `grid` is not 3 … 8 (the controller's capacity), or the mass or damping is not
     /// a finite positive number.
     Patch,
+    /// The coupling's stiffness, damping or force clamp is out of the solver's range.
+    Coupling,
+    /// `max_force` is over `force_at_full_duty`: the motor would saturate below the
+    /// clamp, without a word.
+    ForceClamp,
 }
 
 impl BoardConfigError {
@@ -126,7 +145,9 @@ impl BoardConfigError {
             Self::Encoder => "encoder_zero ≤ 16383 and 0 < |mm_per_count| < 0.01",
             Self::Speed => "max_speed_mm_s: must be finite and positive",
             Self::Motor(_) => "force_at_full_duty: must be 0.001 … 1024 N",
-            Self::Patch => "grid 3 … 8, node_mass and spring_damping finite and positive",
+            Self::Patch => "grid 3 … 8, node_mass_g and spring_damping finite and positive",
+            Self::Coupling => "coupling_stiffness > 0 and ≤ 1000 N/mm, coupling_damping 0 … 1000 N·s/m, max_force > 0 N",
+            Self::ForceClamp => "max_force: must be at most force_at_full_duty (the motor saturates there)",
         }
     }
 }
@@ -267,10 +288,16 @@ impl BoardConfig {
         MotorConfig::check(self.force_at_full_duty).map_err(E::Motor)?;
         let positive = |x: f64| x.is_finite() && x > 0.0;
         if !(3..=8).contains(&self.grid)
-            || !positive(self.node_mass)
+            || !positive(self.node_mass_g)
             || !positive(self.spring_damping)
         {
             return Err(E::Patch);
+        }
+        if self.solver().validate().is_err() {
+            return Err(E::Coupling);
+        }
+        if self.max_force > self.force_at_full_duty {
+            return Err(E::ForceClamp);
         }
         Ok(())
     }
@@ -297,12 +324,18 @@ impl BoardConfig {
         }
     }
 
-    /// The solver's configuration.
+    /// The solver's configuration: the board's tick, patch and coupling (the node mass
+    /// in kg, as the solver takes it), the rest the solver's defaults.
     pub fn solver(&self) -> SolverConfig {
         SolverConfig {
             tick_hz: self.tick_hz as f64,
-            node_mass: self.node_mass,
+            node_mass: self.node_mass_g / 1000.0,
             spring_damping: self.spring_damping,
+            coupling: Coupling {
+                stiffness: self.coupling_stiffness,
+                damping: self.coupling_damping,
+                max_force: self.max_force,
+            },
             ..SolverConfig::default()
         }
     }

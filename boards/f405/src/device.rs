@@ -4,10 +4,11 @@
 //! the controller that ticks it.
 
 use crate::config::{BoardConfig, BoardConfigError};
+use crate::tissue::SEGMENTS;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
-use mccs::{ForceTable64, Solver, SolverError, Topology, TopologyError};
+use mccs::{ForceTable, Solver, SolverError, Topology, TopologyError};
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
 use mccs_firmware::one_dof::{OneDofDevice, OneDofError};
@@ -35,8 +36,9 @@ pub type BoardDeviceError<SPI, PWM, DIR, EN> = OneDofError<
     <DIR as embedded_hal::digital::ErrorType>::Error,
     <EN as embedded_hal::digital::ErrorType>::Error,
 >;
-/// The board's controller on a device.
-pub type BoardController<D> = Controller<D, NODES, EDGES, 64>;
+/// The board's controller on a device, for a force table of `S` segments (by default the
+/// board's tissue's, [`crate::tissue::TISSUE`]).
+pub type BoardController<D, const S: usize = SEGMENTS> = Controller<D, NODES, EDGES, S>;
 
 /// Why the board could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -167,11 +169,11 @@ where
 /// back with the error. Out of line: its stack frames are free again before the ticks.
 #[inline(never)]
 #[allow(clippy::type_complexity)]
-pub fn controller_into<SPI, PWM, DIR, EN>(
+pub fn controller_into<SPI, PWM, DIR, EN, const S: usize>(
     config: &BoardConfig,
-    table: ForceTable64,
+    table: ForceTable<S>,
     mut device: BoardDevice<SPI, PWM, DIR, EN>,
-    slot: &mut Option<BoardController<BoardDevice<SPI, PWM, DIR, EN>>>,
+    slot: &mut Option<BoardController<BoardDevice<SPI, PWM, DIR, EN>, S>>,
 ) -> Result<
     (),
     (

@@ -9,6 +9,7 @@
 //!   but the pins, held to the parts' limits, and the HAL's clock arithmetic;
 //! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
 //! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
+//! - [`tissue`]: the force table the firmware runs (`boards/f405/tissue.rs`);
 //! - `pins` (firmware builds only): the pin map.
 //!
 //! docs/firmware.md, "Bring-up on a board", is the firmware engineer's guide.
@@ -20,6 +21,7 @@ pub mod device;
 #[cfg(target_os = "none")]
 pub mod pins;
 pub mod telemetry;
+pub mod tissue;
 
 pub use config::{BoardConfig, BoardConfigError, BOARD};
 pub use telemetry::BoardTelemetry;

@@ -16,7 +16,7 @@ use haptic_f405::config::{
 use haptic_f405::device::{self, BoardController, SPI_MODE};
 use haptic_f405::telemetry::{qemu_verdict, zeros_fault_tick, BoardTelemetry, QemuMismatch};
 use haptic_f405::{BoardConfig, BOARD};
-use mccs::{Force, ForceTable64, Length, Params};
+use mccs::{Force, ForceTable, ForceTable64, Length, Params};
 use mccs_firmware::drivers::as5047p::{read_command, ANGLECOM, DIAAGC, DIAAGC_LF};
 use mccs_firmware::{Fault, HapticDevice};
 use std::cell::RefCell;
@@ -44,8 +44,9 @@ fn xfer(command: u16, response: u16) -> Vec<SpiTx<u8>> {
     ]
 }
 
-fn table2() -> ForceTable64 {
-    ForceTable64::new(&Params::TABLE2).unwrap()
+/// The board's tissue, the table its firmware runs.
+fn tissue() -> haptic_f405::tissue::TissueTable {
+    haptic_f405::tissue::TISSUE
 }
 
 #[test]
@@ -99,7 +100,7 @@ fn the_board_constants_hold_the_parts_limits() {
 #[test]
 fn every_constant_out_of_range_is_named() {
     use BoardConfigError as E;
-    let cases: [(BoardConfig, E); 14] = [
+    let cases: [(BoardConfig, E); 18] = [
         (
             BoardConfig {
                 hse_hz: 2_000_000,
@@ -187,10 +188,39 @@ fn every_constant_out_of_range_is_named() {
         (BoardConfig { grid: 9, ..BOARD }, E::Patch),
         (
             BoardConfig {
-                node_mass: -1.0,
+                node_mass_g: -1.0,
                 ..BOARD
             },
             E::Patch,
+        ),
+        (
+            BoardConfig {
+                coupling_stiffness: 0.0,
+                ..BOARD
+            },
+            E::Coupling,
+        ),
+        (
+            BoardConfig {
+                coupling_damping: -1.0,
+                ..BOARD
+            },
+            E::Coupling,
+        ),
+        (
+            BoardConfig {
+                max_force: f64::NAN,
+                ..BOARD
+            },
+            E::Coupling,
+        ),
+        // The clamp over what the motor gives at full duty: it would saturate unsaid.
+        (
+            BoardConfig {
+                max_force: 3.5,
+                ..BOARD
+            },
+            E::ForceClamp,
         ),
     ];
     for (config, expected) in cases {
@@ -228,7 +258,7 @@ fn start_up_is_the_safe_state_then_the_driver_is_enabled() {
     let mut spi = SpiMock::new(&[]);
     let dev = device::device(&BOARD, spi.clone(), pwm.clone(), dir.clone(), en.clone()).unwrap();
     let mut slot: Option<BoardController<_>> = None;
-    if device::controller_into(&BOARD, table2(), dev, &mut slot).is_err() {
+    if device::controller_into(&BOARD, tissue(), dev, &mut slot).is_err() {
         panic!("the board's controller did not build");
     }
     let ctl = slot.unwrap();
@@ -336,7 +366,7 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     let mut dir = PinMock::new(&[]);
     let dev = device::device(&BOARD, spi.clone(), pwm.clone(), dir.clone(), en.clone()).unwrap();
     let mut slot: Option<BoardController<_>> = None;
-    if device::controller_into(&BOARD, table2(), dev, &mut slot).is_err() {
+    if device::controller_into(&BOARD, tissue(), dev, &mut slot).is_err() {
         panic!("the board's controller did not build");
     }
     let mut ctl = slot.unwrap();
@@ -460,7 +490,7 @@ fn a_press_renders_an_upward_force() {
     )
     .unwrap();
     let mut slot: Option<BoardController<_>> = None;
-    if device::controller_into(&BOARD, table2(), dev, &mut slot).is_err() {
+    if device::controller_into(&BOARD, tissue(), dev, &mut slot).is_err() {
         panic!("the board's controller did not build");
     }
     let mut ctl = slot.unwrap();
@@ -557,5 +587,48 @@ fn a_start_up_failure_says_what_failed_with_its_values() {
     assert_eq!(
         config.fault().to_string(),
         format!("config: {}", BoardConfigError::Tick.message())
+    );
+}
+
+/// The board takes a table of any knot count `mccs table` emits: its controller is
+/// generic over the table's segments, and a 129-knot tissue builds and pushes back as the
+/// 65-knot one does.
+#[test]
+fn the_board_runs_a_table_of_any_knot_count() {
+    fn press<const S: usize>(table: ForceTable<S>) -> f64 {
+        let press = (1.0 / BOARD.mm_per_count) as i32;
+        let step = BOARD.encoder().max_step as i32 - 1;
+        let angle = move |f: usize| (-(f as i32 * step).min(press)).rem_euclid(16384) as u16;
+        let log = Log::default();
+        let dev = device::device(
+            &BOARD,
+            Sensor::new(angle),
+            Pwm(log.clone()),
+            Pin(log.clone(), "dir"),
+            Pin(log.clone(), "enable"),
+        )
+        .unwrap();
+        let mut slot: Option<BoardController<_, S>> = None;
+        if device::controller_into(&BOARD, table, dev, &mut slot).is_err() {
+            panic!("the board's controller did not build with {} knots", S + 1);
+        }
+        let mut ctl = slot.unwrap();
+        let mut last = [Force::ZERO; 3];
+        for _ in 0..500 {
+            last = ctl.tick(None);
+        }
+        last[2].to_num::<f64>()
+    }
+    let f65 = press(ForceTable::<64>::new(&Params::TABLE2).unwrap());
+    let f129 = press(ForceTable::<128>::new(&Params::TABLE2).unwrap());
+    let f17 = press(ForceTable::<16>::new(&Params::TABLE2).unwrap());
+    assert!(f65 > 0.05, "{f65}");
+    assert!((f129 - f65).abs() < 1e-3 * f65, "{f129} against {f65}");
+    assert!((f17 - f65).abs() < 1e-2 * f65, "{f17} against {f65}");
+    // The board's own tissue is Table 2's at 65 knots as shipped.
+    assert_eq!(haptic_f405::tissue::SEGMENTS, 64);
+    assert_eq!(
+        tissue().raw(),
+        ForceTable64::new(&Params::TABLE2).unwrap().raw()
     );
 }

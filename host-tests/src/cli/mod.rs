@@ -8,6 +8,7 @@ use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+mod check;
 mod curve;
 mod demo;
 mod fit;
@@ -168,10 +169,14 @@ enum Command {
     /// Indent the standard patch: ramp the contact node down to DEPTH over the first half
     /// of the run, hold it there, and print CSV `time_s,reaction_n` per tick.
     Patch(patch::Args),
-    /// Replay a recorded probe trajectory against the standard patch and print CSV
-    /// `time_s,fx_n,fy_n,fz_n,contact_dx_mm,contact_dy_mm,contact_dz_mm,max_disp_mm` per
-    /// tick.
+    /// Replay a recorded probe trajectory against the standard patch (or, with --tissue,
+    /// a tissue it roams) and print CSV per tick: `time_s,fx_n,fy_n,fz_n,max_disp_mm`,
+    /// then the mode's own columns (see --help).
     Replay(replay::Args),
+    /// Will a tissue run on a core? One line `substeps=<s> tick_instructions=<i>
+    /// budget=<b> fits=yes|no`: the core's stability bound's substeps, the tick estimated
+    /// from the bench's measured costs (exit 1 when it does not fit).
+    Check(check::Args),
 }
 
 /// Runs the parsed command, writing its output to `out`.
@@ -186,6 +191,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Demo(a) => demo::run(a, out),
         Command::Patch(a) => patch::run(a, out),
         Command::Replay(a) => replay::run(a, out),
+        Command::Check(a) => check::run(a, out),
     }
 }
 

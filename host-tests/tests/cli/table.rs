@@ -146,7 +146,7 @@ fn table_states_its_measured_bound_and_refuses_what_misses_it() {
     assert!(out.status.success());
     // Table 2 with its preload at 15 F_T (0.79 F_C), its slope kink Δ(P) on the cone's
     // steep rise toward its own solid point, far above Δ(F_T): no placement the builder
-    // knows meets the bound (docs/accuracy.md, "The grid below a preload's kink").
+    // knows meets the bound (docs/table.md, "The grid below a preload's kink near `F_C`").
     let kinked = TABLE2.replace(
         "shear_modulus = 4.9151e5",
         "shear_modulus = 4.9151e5\npreload = 8.1175",

@@ -39,7 +39,7 @@ mod firmware {
     use haptic_f405::device::{self, BoardController, BoardDevice, StartFault};
     use haptic_f405::pins::{EncoderCs, MotorDirection, MotorEnable, Pins};
     use haptic_f405::telemetry::BoardTelemetry;
-    use mccs::ForceTable64;
+    use haptic_f405::tissue::TISSUE;
     use mccs_firmware::{Mailbox, Shared};
     use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
     use stm32f4xx_hal::prelude::*;
@@ -51,9 +51,6 @@ mod firmware {
     type Motor = PwmChannel<pac::TIM1, 0>;
     type Device = BoardDevice<Encoder, Motor, MotorDirection, MotorEnable>;
     type Ctl = BoardController<Device>;
-
-    /// The tissue: Table 2's force table, emitted by `mccs table`.
-    static TABLE2: ForceTable64 = include!("../../../../tables/table2.rs");
 
     /// What `main` hands the tick.
     struct Hardware {
@@ -175,9 +172,10 @@ mod firmware {
         );
 
         // The table's own measured error against the f64 law (`mccs table` measured it).
-        if let Some(e) = TABLE2.max_error() {
+        if let Some(e) = TISSUE.max_error() {
             defmt::info!(
-                "force table: error {=f32} of F(0.95) in force, {=f32} in stiffness (measured when emitted)",
+                "force table: {=usize} knots, error {=f32} of F(to) in force, {=f32} in stiffness (measured when emitted)",
+                haptic_f405::tissue::SEGMENTS + 1,
                 e.force as f32,
                 e.stiffness as f32
             );
@@ -276,7 +274,7 @@ mod firmware {
         else {
             return;
         };
-        match device::controller_into(&BOARD, TABLE2, device, ctl) {
+        match device::controller_into(&BOARD, TISSUE, device, ctl) {
             Ok(()) => {
                 if let Some(c) = ctl {
                     START.set(Start::Running {

@@ -1,0 +1,212 @@
+//! `mccs check`: will a tissue run on a core before any firmware is built? The substeps
+//! the core's own stability bound asks for this tissue and configuration (computed here,
+//! in the core's arithmetic), and the tick's instructions estimated from the bench's
+//! measured costs on that core (`bench/baseline.txt`, compiled in), against half a tick
+//! at the core's clock.
+
+use super::patch_args::{config_error, topology_error, TuningArgs};
+use super::table::{build, with_knots, Domain, TableArgs};
+use super::{arg_error, io_error, CliError, IntegratorArg};
+use crate::paramfile;
+use crate::replay::{FIXED_EDGES, FIXED_NODES};
+use mccs::{Arith, ForceTable, Solver, SolverConfig, Topology};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// The bench's measured figures, as committed (`scripts/bench.sh --update` rewrites
+/// them): what the estimate is made of.
+const BASELINE: &str = include_str!("../../../bench/baseline.txt");
+
+/// A core the bench measures.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum CoreArg {
+    /// Cortex-M4F (STM32F405, 168 MHz; the board's).
+    M4f,
+    /// Cortex-M3 (LM3S6965, 50 MHz).
+    M3,
+    /// Cortex-M0 (48 MHz).
+    M0,
+}
+
+impl CoreArg {
+    fn name(self) -> &'static str {
+        match self {
+            Self::M4f => "m4f",
+            Self::M3 => "m3",
+            Self::M0 => "m0",
+        }
+    }
+
+    /// Its clock, MHz (the bench's yardstick: one instruction per cycle).
+    fn mhz(self) -> u64 {
+        match self {
+            Self::M4f => 168,
+            Self::M3 => 50,
+            Self::M0 => 48,
+        }
+    }
+
+    /// The patch its demo firmware (and the M4F's board) runs.
+    fn demo_grid(self) -> usize {
+        match self {
+            Self::M4f => 8,
+            Self::M3 => 5,
+            Self::M0 => 4,
+        }
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub(super) struct Args {
+    /// Parameter file (the TOML schema of docs/model.md).
+    #[arg(long)]
+    params: PathBuf,
+    /// The core it is to run on.
+    #[arg(long, value_enum, default_value_t = CoreArg::M4f)]
+    core: CoreArg,
+    /// Surface nodes per side, N (default: the core's demo patch, m4f 8, m3 5, m0 4).
+    #[arg(long)]
+    grid: Option<usize>,
+    /// Grid spacing, mm (the board's: 2.5).
+    #[arg(long, default_value_t = 2.5, allow_negative_numbers = true)]
+    spacing: f64,
+    /// Tick rate, Hz (a whole number, 1 … 100000).
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    rate: f64,
+    /// Integrator (docs/performance.md, "The symplectic option").
+    #[arg(long, value_enum, default_value_t = IntegratorArg::ImprovedEuler)]
+    integrator: IntegratorArg,
+    #[command(flatten)]
+    tuning: TuningArgs,
+    #[command(flatten)]
+    table: TableArgs,
+}
+
+/// One core's figures from the baseline, by case: `instructions`, or another field.
+fn figure(core: &str, case: &str, field: &str) -> Option<u64> {
+    BASELINE.lines().find_map(|l| {
+        let mut f = l.split_whitespace();
+        if f.next() != Some("BENCH") {
+            return None;
+        }
+        let kv: Vec<(&str, &str)> = f.filter_map(|x| x.split_once('=')).collect();
+        let get = |k: &str| kv.iter().find(|(a, _)| *a == k).map(|(_, v)| *v);
+        (get("core") == Some(core) && get("case") == Some(case))
+            .then(|| get(field)?.parse().ok())
+            .flatten()
+    })
+}
+
+pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
+    let core = a.core;
+    let n = a.grid.unwrap_or(core.demo_grid());
+    let rate = a.rate;
+    if !(rate.is_finite() && (1.0..=100_000.0).contains(&rate) && rate.fract() == 0.0) {
+        return Err(arg_error(
+            "--rate",
+            "must be a whole number of Hz, 1 … 100000",
+        ));
+    }
+    let symplectic = a.integrator == IntegratorArg::SymplecticDamped;
+    let suffix = if symplectic { "_symplectic" } else { "" };
+    let substep_case = format!("substep_n{n}{suffix}");
+    let Some(substep) = figure(core.name(), &substep_case, "instructions") else {
+        let measured: Vec<String> = (3..=12)
+            .filter(|k| {
+                figure(
+                    core.name(),
+                    &format!("substep_n{k}{suffix}"),
+                    "instructions",
+                )
+                .is_some()
+            })
+            .map(|k| k.to_string())
+            .collect();
+        return Err(arg_error(
+            "--grid",
+            &format!(
+                "the bench measures the {} substep{} for N = {} only, not {n}",
+                core.name(),
+                if symplectic {
+                    " of --integrator symplectic-damped"
+                } else {
+                    ""
+                },
+                measured.join(", ")
+            ),
+        ));
+    };
+    let cfg = SolverConfig {
+        integrator: a.integrator.into(),
+        ..a.tuning.config(rate)?
+    };
+    let p = paramfile::read(&a.params)?;
+    let substeps = with_knots!(a.table.knots(), |S| {
+        let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
+        match core {
+            CoreArg::M0 => substeps_of(t, n, a.spacing, &cfg, mccs::Narrow)?,
+            _ => substeps_of(t, n, a.spacing, &cfg, mccs::Wide)?,
+        }
+    });
+    // The bench's bound over every state of the patch's substeps, as its
+    // `largest_patch_1khz` takes it: each spring at the spread of its paths more.
+    let springs = mccs::topology::standard_capacity(n).1 as u64;
+    let spread = figure(core.name(), "spring_path_spread", "instructions").unwrap_or(0);
+    let tick = substeps as u64 * (substep + springs * spread);
+    let roaming = figure(core.name(), "tick_roaming_bound", "instructions").unwrap_or(0);
+    let budget = core.mhz() * 1_000_000 / (2 * rate as u64);
+    let fits = tick <= budget;
+    eprintln!(
+        "mccs check: tick_instructions estimated from the bench's measured costs on the {} (bench/baseline.txt): {substeps} substeps × ({substep} per substep + {springs} springs × {spread}, their spread over every state); the contact's own cost is not in it (a roaming tick's, window shift included, measured {roaming} on the demo's N = {} patch); budget: half a {} Hz tick at {} MHz, one instruction per cycle",
+        core.name(),
+        core.demo_grid(),
+        rate as u64,
+        core.mhz()
+    );
+    writeln!(
+        out,
+        "substeps={substeps} tick_instructions={tick} budget={budget} fits={}",
+        if fits { "yes" } else { "no" }
+    )
+    .map_err(io_error)?;
+    out.flush().map_err(io_error)?;
+    if fits {
+        Ok(())
+    } else {
+        Err(CliError::check_failed(format!(
+            "the tick would take {tick} instructions, over its budget of {budget}: a smaller --grid, a lower --rate or a heavier --node-mass"
+        )))
+    }
+}
+
+/// The substeps per tick the core's stability bound asks for on the standard `n × n`
+/// patch at `spacing` mm with `table` and `cfg`, in arithmetic `A`.
+fn substeps_of<const S: usize, A: Arith>(
+    table: ForceTable<S>,
+    n: usize,
+    spacing: f64,
+    cfg: &SolverConfig,
+    arith: A,
+) -> Result<u32, CliError> {
+    if !(3..=crate::replay::MAX_GRID_FIXED).contains(&n) {
+        return Err(arg_error("--grid", "must be 3 … 12"));
+    }
+    if !(spacing.is_finite() && spacing > 0.0 && spacing * n as f64 <= 100.0) {
+        return Err(arg_error(
+            "--spacing",
+            "must be > 0 mm, with grid × spacing ≤ 100 mm",
+        ));
+    }
+    let topo = Topology::<FIXED_NODES, FIXED_EDGES>::standard_patch(n, spacing).map_err(|e| {
+        if e == mccs::TopologyError::TooShort {
+            arg_error(
+                "--spacing",
+                "must be ≥ 1 mm (the fixed-point core's springs are 1 mm long at least)",
+            )
+        } else {
+            topology_error(e)
+        }
+    })?;
+    let s = Solver::with_arith(topo, table, cfg, arith).map_err(|e| config_error(e, cfg))?;
+    Ok(s.substeps())
+}

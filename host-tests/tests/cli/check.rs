@@ -1,0 +1,132 @@
+//! `mccs check`: will a tissue run on a core, before any firmware is built.
+
+use super::*;
+
+/// The line `check` prints, as `(substeps, tick_instructions, budget, fits)`.
+fn parse(line: &str) -> (u32, u64, u64, bool) {
+    let field = |k: &str| {
+        line.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
+            .unwrap_or_else(|| panic!("no {k} in {line:?}"))
+    };
+    (
+        field("substeps").parse().unwrap(),
+        field("tick_instructions").parse().unwrap(),
+        field("budget").parse().unwrap(),
+        field("fits") == "yes",
+    )
+}
+
+/// A bench figure of the committed baseline.
+fn baseline(core: &str, case: &str, key: &str) -> u64 {
+    let text = std::fs::read_to_string(root().join("bench/baseline.txt")).unwrap();
+    text.lines()
+        .find(|l| l.contains(&format!("core={core} ")) && l.contains(&format!("case={case} ")))
+        .and_then(|l| {
+            l.split_whitespace()
+                .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('=')?.parse().ok())
+        })
+        .unwrap_or_else(|| panic!("no {core} {case} {key}"))
+}
+
+/// On each core's demo patch, Table 2 at the default configuration: the substeps and the
+/// tick the bench itself takes for its largest patch (`largest_patch_1khz`: the same
+/// substeps, the same bound over every state), within half a 1 kHz tick at the core's
+/// clock: exit 0, `fits=yes`, and one stderr line saying how it is estimated.
+#[test]
+fn the_demo_patches_fit_as_the_bench_measures_them() {
+    for core in ["m4f", "m3", "m0"] {
+        let out = mccs_ok(&["check", "--params", "params/table2.toml", "--core", core]);
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        let (substeps, tick, budget, fits) = parse(text.trim());
+        assert_eq!(
+            substeps as u64,
+            baseline(core, "largest_patch_1khz", "substeps")
+        );
+        assert_eq!(
+            tick,
+            baseline(core, "largest_patch_1khz", "worst_instructions")
+        );
+        assert_eq!(
+            budget,
+            baseline(core, "largest_patch_1khz", "half_tick_instructions")
+        );
+        assert!(fits);
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains("estimated from the bench's measured costs"),
+            "{err}"
+        );
+    }
+}
+
+/// A patch over its budget says so and exits 1 (the M0's N = 5, the bench's
+/// `next_patch_1khz`); a configuration the core cannot run exits 2 with one line naming
+/// the cause: a patch the bench does not measure there, a tissue too stiff for the tick,
+/// a table over the bound (the table's own line), a spacing under the springs' 1 mm.
+#[test]
+fn what_does_not_fit_or_cannot_run_says_why() {
+    let out = mccs(&[
+        "check",
+        "--params",
+        "params/table2.toml",
+        "--core",
+        "m0",
+        "--grid",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let (_, tick, budget, fits) = parse(String::from_utf8_lossy(&out.stdout).trim());
+    assert!(!fits && tick > budget);
+    assert_eq!(
+        tick,
+        baseline("m0", "next_patch_1khz", "worst_instructions")
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.lines().last().unwrap().contains("over its budget"),
+        "{err}"
+    );
+    let t2 = "params/table2.toml";
+    let stiff = temp_file(
+        "stiff40.toml",
+        &TABLE2
+            .replace("shear_modulus = 1.8472e5", "shear_modulus = 7.3888e6")
+            .replace("shear_modulus = 4.9151e5", "shear_modulus = 1.96604e7"),
+    );
+    for (args, needles) in [
+        (
+            vec!["--params", t2, "--core", "m0", "--grid", "6"],
+            vec![
+                "--grid",
+                "the bench measures the m0 substep for N = 3, 4, 5 only, not 6",
+            ],
+        ),
+        (
+            vec!["--params", stiff.to_str().unwrap()],
+            vec!["--rate", "needs 80 substeps per tick"],
+        ),
+        (
+            vec!["--params", t2, "--spacing", "0.5"],
+            vec!["--spacing", "must be ≥ 1 mm"],
+        ),
+        (vec!["--params", t2, "--rate", "0"], vec!["--rate"]),
+    ] {
+        let out = mccs(&[&["check"][..], &args].concat());
+        assert_one_line_error(&out, &needles);
+    }
+    // A table over the bound: the same line as `mccs table`'s.
+    let kinked = temp_file(
+        "kinked-check.toml",
+        &TABLE2.replace(
+            "shear_modulus = 4.9151e5",
+            "shear_modulus = 4.9151e5\npreload = 8.1175",
+        ),
+    );
+    let out = mccs(&["check", "--params", kinked.to_str().unwrap()]);
+    let table = mccs(&["table", "--params", kinked.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.stderr, table.stderr);
+}
