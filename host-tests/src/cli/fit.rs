@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args, Debug)]
 pub(super) struct Args {
     /// Data file, CSV with the header `strain,force_n` (the loading branch: strain in
-    /// (0, 1) and force > 0, both strictly increasing; 5 … 1,000,000 rows).
+    /// (0, 1) and force > 0, both strictly increasing; 5 … 1,000,000 rows; a first row
+    /// at (0, 0), the unloaded sample, is dropped with a note).
     #[arg(long)]
     data: PathBuf,
     /// mccs, mcs, ms or all.
@@ -24,7 +25,7 @@ pub(super) struct Args {
     /// Write the fitted MCCS parameters here (the TOML schema of docs/model.md).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Draw the data and the fitted curves here (SVG).
+    /// Draw the data and the fitted curves here, as SVG (the file must end in .svg).
     #[arg(long)]
     plot: Option<PathBuf>,
 }
@@ -47,9 +48,22 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         check_writable("--out", p)?;
     }
     if let Some(p) = &a.plot {
+        let svg = p.extension().is_some_and(|x| x.eq_ignore_ascii_case("svg"));
+        if !svg {
+            return Err(arg_error(
+                "--plot",
+                &format!(
+                    "{}: the plot is drawn as SVG only: name it .svg (PNG would need a font built in)",
+                    p.display()
+                ),
+            ));
+        }
         check_writable("--plot", p)?;
     }
-    let points = fit::read_data(&a.data).map_err(|e| CliError::new(e.to_string()))?;
+    let (points, note) = fit::read_data_noted(&a.data).map_err(|e| CliError::new(e.to_string()))?;
+    if let Some(note) = note {
+        eprintln!("mccs: {note}");
+    }
     if points.len() > fit::FIT_ROWS {
         eprintln!(
             "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
@@ -94,6 +108,16 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             m.mse
         )
         .map_err(io_error)?;
+        let params: Vec<String> = f
+            .model
+            .fitted_params()
+            .iter()
+            .map(|(k, v)| format!("{k}={}", fmt_param(*v)))
+            .collect();
+        writeln!(out, "PARAMS model={} {}", kind.name(), params.join(" ")).map_err(io_error)?;
+        for warning in warnings(&f.model, &points) {
+            eprintln!("mccs: warning: the {} fit: {warning}", kind.name());
+        }
     }
     out.flush().map_err(io_error)?;
     let fits: Vec<fit::Fit> = fits.into_iter().map(|(_, f)| f).collect();
@@ -152,4 +176,53 @@ fn not_fitted(
         line.push_str(&format!("; {} fitted ({})", models(&ok), each.join(", ")));
     }
     CliError::new(line)
+}
+
+/// A fitted parameter: 7 significant digits, in scientific notation outside 1e-4 … 1e9.
+fn fmt_param(x: f64) -> String {
+    let v = format!("{x:.6e}").parse::<f64>().unwrap_or(x);
+    fmt_given(v)
+}
+
+/// What a fit's numbers do not say: a parameter on a bound the fit holds it within (the
+/// data want it past the bound: the model cannot place it there), and a degenerate fit
+/// (the data never leave the law's linear phase, or the cone closes at once), whose
+/// other parameters the data do not determine.
+fn warnings(model: &fit::Fitted, points: &[fit::Point]) -> Vec<String> {
+    let max_strain = points.iter().map(|p| p.0).fold(0.0, f64::max);
+    let mut out: Vec<String> = model
+        .on_bounds()
+        .into_iter()
+        .map(|(key, bound, side, range)| {
+            format!(
+                "{key} sits on its {side} bound ({}, of {range}): the data want it past what the model takes",
+                fmt_param(bound)
+            )
+        })
+        .collect();
+    let cone = match model {
+        fit::Fitted::Mccs(p) => Some((p.cone, crate::reference::Reference::new(p).ok())),
+        fit::Fitted::Mcs(c) => Some((*c, Some(crate::reference::Reference::cone_only(c)))),
+        fit::Fitted::Ms { .. } => None,
+    };
+    if let Some((c, Some(law))) = cone {
+        let linear_end = law.delta(law.f_t);
+        if c.compressible_height < 1e-3 * max_strain {
+            out.push(format!(
+                "degenerate: cone.compressible_height {} is under 1e-3 of the data's largest strain {}: the cone closes at once, and the data say nothing of its geometry",
+                fmt_param(c.compressible_height),
+                fmt_param(max_strain)
+            ));
+        } else {
+            let past = points.iter().filter(|p| p.0 > linear_end).count();
+            if past < 3 {
+                out.push(format!(
+                    "degenerate: {past} of the {} rows lie past the law's linear phase (which ends at strain {}): the data fix its stiffness and say little of the rest",
+                    points.len(),
+                    fmt_param(linear_end)
+                ));
+            }
+        }
+    }
+    out
 }

@@ -31,7 +31,10 @@ mod data;
 mod models;
 mod plot;
 
-pub use data::{demo_data, parse_data, read_data, synthesize, to_csv, DataError, Point, MAX_ROWS};
+pub use data::{
+    demo_data, parse_data, parse_data_noted, read_data, read_data_noted, synthesize, to_csv,
+    DataError, Point, MAX_ROWS,
+};
 pub use models::{ms_force, ms_strain, Fitted, ModelKind, SAMPLE_AREA_MM2};
 use models::{unbounded, D2, LN_C2, RATIO};
 pub use plot::plot;

@@ -116,6 +116,59 @@ impl Fitted {
         }
     }
 
+    /// The parameters the fit chooses (the others are held at Table 2's: the module
+    /// docs), by their parameter-file keys (`c1`, `c2`, `c3` for MS, MPa, 1, MPa).
+    pub fn fitted_params(&self) -> Vec<(&'static str, f64)> {
+        let cone = |c: &Cone| {
+            vec![
+                ("cone.small_diameter", c.small_diameter),
+                ("cone.compressible_height", c.compressible_height),
+                ("cone.shear_modulus", c.shear_modulus),
+            ]
+        };
+        match self {
+            Self::Mccs(p) => {
+                let mut v = cone(&p.cone);
+                v.push(("linear.shear_modulus", p.linear.shear_modulus));
+                v
+            }
+            Self::Mcs(c) => cone(c),
+            Self::Ms { c1, c2, c3 } => vec![("c1", *c1), ("c2", *c2), ("c3", *c3)],
+        }
+    }
+
+    /// The fitted parameters that sit on a bound the fit holds them within (within
+    /// 1e-3 of the bound's range): `(key, the bound, "lower" or "upper", what it is)`.
+    pub fn on_bounds(&self) -> Vec<(&'static str, f64, &'static str, &'static str)> {
+        let near = |x: f64, (lo, hi): (f64, f64)| {
+            let tol = 1e-3 * (hi - lo);
+            if x - lo <= tol {
+                Some((lo, "lower"))
+            } else if hi - x <= tol {
+                Some((hi, "upper"))
+            } else {
+                None
+            }
+        };
+        let mut out = Vec::new();
+        let cone = match self {
+            Self::Mccs(p) => Some(p.cone),
+            Self::Mcs(c) => Some(*c),
+            Self::Ms { .. } => None,
+        };
+        if let Some(c) = cone {
+            if let Some((b, side)) = near(c.small_diameter / D2, RATIO) {
+                out.push(("cone.small_diameter", b * D2, side, "0.05 … 0.95 of D2"));
+            }
+        }
+        if let Self::Ms { c2, .. } = self {
+            if let Some((b, side)) = near(c2.ln(), LN_C2) {
+                out.push(("c2", b.exp(), side, "1e-3 … 1e3"));
+            }
+        }
+        out
+    }
+
     /// Parameters in fit space: MCCS `[logit(D1/D2), ln H, ln s, ln k_p]`, MCS the first
     /// three, MS `[ln C1, ln C2, ln C3]`.
     pub fn theta(&self) -> Vec<f64> {
