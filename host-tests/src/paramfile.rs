@@ -2,7 +2,7 @@
 //! one-line errors that name the file and the key. The schema is the core's
 //! [`ParamKey`]: its sections, keys, which are required, and how each is stored.
 
-use mccs::{ParamError, ParamKey, Params};
+use mccs::{Derived, ParamError, ParamKey, Params};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -36,6 +36,8 @@ pub enum ParamFileError {
     NotNumber {
         /// The file.
         path: PathBuf,
+        /// The key's line (1-based), when found.
+        line: Option<usize>,
         /// The key.
         key: ParamKey,
     },
@@ -43,16 +45,33 @@ pub enum ParamFileError {
     Unknown {
         /// The file.
         path: PathBuf,
+        /// The key's line (1-based), when found.
+        line: Option<usize>,
         /// The dotted key as written.
         key: String,
+        /// The schema's nearest key or section, when one is close.
+        nearest: Option<String>,
     },
     /// The values are numbers but break the rules (finite, > 0, D2 > D1).
     Invalid {
         /// The file.
         path: PathBuf,
+        /// The line of the key at fault (1-based), when found.
+        line: Option<usize>,
         /// The rule broken.
         error: ParamError,
+        /// The values behind it, for the message (`F_C = 10.23 N`), when it is about a
+        /// derived quantity.
+        found: Option<String>,
     },
+}
+
+/// `FILE: ` or `FILE: line N: `.
+fn at(f: &mut fmt::Formatter<'_>, path: &Path, line: Option<usize>) -> fmt::Result {
+    match line {
+        Some(l) => write!(f, "{}: line {l}: ", path.display()),
+        None => write!(f, "{}: ", path.display()),
+    }
 }
 
 impl fmt::Display for ParamFileError {
@@ -63,18 +82,39 @@ impl fmt::Display for ParamFileError {
                 path,
                 line,
                 message,
-            } => match line {
-                Some(l) => write!(f, "{}: line {l}: invalid TOML: {message}", path.display()),
-                None => write!(f, "{}: invalid TOML: {message}", path.display()),
-            },
+            } => {
+                at(f, path, *line)?;
+                write!(f, "invalid TOML: {message}")
+            }
             Self::Missing { path, key } => write!(f, "{}: {key}: missing", path.display()),
-            Self::NotNumber { path, key } => {
-                write!(f, "{}: {key}: must be a number", path.display())
+            Self::NotNumber { path, line, key } => {
+                at(f, path, *line)?;
+                write!(f, "{key}: must be a number")
             }
-            Self::Unknown { path, key } => {
-                write!(f, "{}: {key}: unknown key", path.display())
+            Self::Unknown {
+                path,
+                line,
+                key,
+                nearest,
+            } => {
+                at(f, path, *line)?;
+                match nearest {
+                    Some(n) => write!(f, "{key}: unknown key; did you mean {n}?"),
+                    None => write!(f, "{key}: unknown key (docs/model.md lists the schema)"),
+                }
             }
-            Self::Invalid { path, error } => write!(f, "{}: {error}", path.display()),
+            Self::Invalid {
+                path,
+                line,
+                error,
+                found,
+            } => {
+                at(f, path, *line)?;
+                match found {
+                    Some(v) => write!(f, "{error} ({v})"),
+                    None => write!(f, "{error}"),
+                }
+            }
         }
     }
 }
@@ -102,8 +142,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
             message: e.message().lines().next().unwrap_or("").to_owned(),
         })?;
     for (name, value) in &table {
-        let unknown = |key: String| ParamFileError::Unknown {
+        let unknown = |key: String, line: Option<usize>| ParamFileError::Unknown {
             path: path.to_owned(),
+            line,
+            nearest: nearest(&key),
             key,
         };
         let known = |k: &str| {
@@ -114,10 +156,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
         match value.as_table() {
             Some(t) if ParamKey::ALL.iter().any(|p| p.section() == name.as_str()) => {
                 if let Some(k) = t.keys().find(|k| !known(k)) {
-                    return Err(unknown(format!("{name}.{k}")));
+                    return Err(unknown(format!("{name}.{k}"), key_line(text, name, k)));
                 }
             }
-            _ => return Err(unknown(name.clone())),
+            _ => return Err(unknown(name.clone(), section_line(text, name))),
         }
     }
     // Every key starts at its Table 2 value and is overwritten; a required key missing
@@ -131,6 +173,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
             Some(_) => {
                 return Err(ParamFileError::NotNumber {
                     path: path.to_owned(),
+                    line: key_line(text, key.section(), key.name()),
                     key,
                 })
             }
@@ -143,11 +186,124 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamFileError> {
             None => {}
         }
     }
-    params.validate().map_err(|error| ParamFileError::Invalid {
-        path: path.to_owned(),
-        error,
+    params.validate().map_err(|error| {
+        let key = error.key();
+        ParamFileError::Invalid {
+            path: path.to_owned(),
+            line: key_line(text, key.section(), key.name()),
+            found: found(&params, error),
+            error,
+        }
     })?;
     Ok(params)
+}
+
+/// The values behind a derived quantity's error: the quantity as computed, with the
+/// given preload against it.
+fn found(p: &Params, e: ParamError) -> Option<String> {
+    match e {
+        ParamError::PreloadNotBelowSolid => Some(format!(
+            "preload = {} N, F_C = {} N",
+            p.linear.preload.unwrap_or(f64::NAN),
+            sig(Derived::Fc.of(p))
+        )),
+        ParamError::OutOfFormat { quantity, .. } => {
+            let (name, unit) = match quantity {
+                Derived::K => ("k", " N"),
+                Derived::Kp => ("k_p", " N"),
+                Derived::Ft => ("F_T", " N"),
+                Derived::Fc => ("F_C", " N"),
+                Derived::H => ("H", ""),
+            };
+            Some(format!("{name} = {}{unit}", sig(quantity.of(p))))
+        }
+        _ => None,
+    }
+}
+
+/// `x` to 4 significant digits.
+fn sig(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        return format!("{x:.3e}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// The line (1-based) of `key = …` in the section `[section]` (or written `section.key`
+/// at the top level), if it is there.
+fn key_line(text: &str, section: &str, key: &str) -> Option<usize> {
+    let mut current = String::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if let Some(name) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
+            current = name.trim().to_string();
+            continue;
+        }
+        let Some((lhs, _)) = line.split_once('=') else {
+            continue;
+        };
+        let lhs: String = lhs.chars().filter(|c| !c.is_whitespace()).collect();
+        if (current == section && lhs == key)
+            || (current.is_empty() && lhs == format!("{section}.{key}"))
+        {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// The line (1-based) of the table `[section]` or of the first key `section.…`.
+fn section_line(text: &str, section: &str) -> Option<usize> {
+    text.lines()
+        .position(|raw| {
+            let line = raw.trim();
+            let header = line
+                .strip_prefix('[')
+                .and_then(|l| l.split(']').next())
+                .is_some_and(|n| n.trim() == section);
+            header
+                || line.starts_with(&format!("{section}."))
+                || line.starts_with(&format!("{section} "))
+        })
+        .map(|i| i + 1)
+}
+
+/// The schema's key (`section.name`) or section nearest `given`, if a few edits away.
+fn nearest(given: &str) -> Option<String> {
+    let mut names: Vec<String> = ParamKey::ALL
+        .iter()
+        .map(|k| format!("{}.{}", k.section(), k.name()))
+        .collect();
+    names.extend(["cone".to_string(), "linear".to_string()]);
+    let (d, best) = names
+        .into_iter()
+        .map(|n| (edits(given, &n), n))
+        .min_by_key(|(d, _)| *d)?;
+    (d <= 3.max(given.len() / 5)).then_some(best)
+}
+
+/// Levenshtein distance.
+fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for j in 0..b.len() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != b[j]))
+                .min(row[j] + 1)
+                .min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
 }
 
 /// Writes `params` in the schema (full precision, round-trips through [`parse`]).

@@ -36,6 +36,8 @@ pub enum Engine {
 pub struct Row {
     /// The probe sample's time, s.
     pub time: f64,
+    /// The probe sample's position, mm.
+    pub probe: [f64; 3],
     /// The device force, N.
     pub force: [f64; 3],
     /// The contact node's displacement from rest, mm.
@@ -129,6 +131,7 @@ impl Replay {
             let f = s.step(p.map(Length::saturating_from_num));
             row(Row {
                 time,
+                probe: p,
                 force: f.map(|c| c.to_num::<f64>()),
                 contact: s.displacement(contact).map(mm).unwrap_or([0.0; 3]),
                 max_disp: max_disp_fixed(&s, nodes),
@@ -154,6 +157,7 @@ impl Replay {
             };
             row(Row {
                 time,
+                probe: p,
                 force,
                 contact: disp(c),
                 max_disp: max_disp_twin(&twin),
@@ -164,6 +168,28 @@ impl Replay {
 }
 
 impl Replay {
+    /// The substeps per tick this replay's engine takes on its patch (the core's
+    /// stability bound, or the twin's rule), or why it cannot run: what a replay checks
+    /// before its first tick.
+    pub fn substeps<const S: usize>(
+        &self,
+        params: &Params,
+        table: Option<&ForceTable<S>>,
+    ) -> Result<u32, ReplayError> {
+        match self.engine {
+            Engine::Reference => {
+                let law = Reference::new(params).map_err(|e| ReplayError::Table(e.into()))?;
+                Ok(self.twin_dynamics(&law, self.spacing)?.substeps)
+            }
+            Engine::Wide => Ok(self
+                .solver(params, table, self.spacing, mccs::Wide)?
+                .substeps()),
+            Engine::Narrow => Ok(self
+                .solver(params, table, self.spacing, mccs::Narrow)?
+                .substeps()),
+        }
+    }
+
     /// The fixed-point solver of the standard patch at `spacing`, on `table` (`None`:
     /// [`ForceTable::new`]'s for `params`).
     fn solver<A: Arith, const S: usize>(
@@ -215,6 +241,8 @@ pub struct Roaming {
 pub struct RoamRow {
     /// The probe sample's time, s.
     pub time: f64,
+    /// The probe sample's position (tissue frame), mm.
+    pub probe: V,
     /// The device force, N.
     pub force: V,
     /// The proxy's centre, mm (the probe out of contact).
@@ -325,6 +353,7 @@ impl Replay {
             };
             row(RoamRow {
                 time,
+                probe: p,
                 force: force.map(|c| c.to_num::<f64>()),
                 proxy: proxy_at,
                 contact: proxy.grid_position().is_some(),
@@ -361,6 +390,7 @@ impl Replay {
             let contact = twin.contact();
             row(RoamRow {
                 time,
+                probe: p,
                 force: out.force,
                 proxy: out.proxy,
                 contact: contact.is_some(),

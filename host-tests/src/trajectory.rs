@@ -1,6 +1,7 @@
 //! Recorded probe trajectories: CSV `time_s,x_mm,y_mm,z_mm`, positions in the patch frame
 //! (surface at `z = 0`, `z` up) at strictly increasing times, sampled linearly at a tick
-//! rate. Every rejected file gets one line naming the file and the line.
+//! rate. Every rejected file gets one line naming the file and the row (the header is row 1,
+//! as in `mccs fit`'s data).
 
 use std::fmt;
 use std::path::Path;
@@ -14,21 +15,21 @@ pub const MAX_POSITION_MM: f64 = 100.0;
 /// The longest trajectory, s.
 pub const MAX_DURATION_S: f64 = 3600.0;
 
-/// Why a trajectory file was rejected. `Display` is one line naming the file and line.
+/// Why a trajectory file was rejected. `Display` is one line naming the file and row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrajectoryError {
     /// The file.
     pub file: String,
-    /// The line (1-based), when one is at fault.
-    pub line: Option<usize>,
+    /// The row (1-based, the header is row 1), when one is at fault.
+    pub row: Option<usize>,
     /// What is wrong.
     pub what: String,
 }
 
 impl fmt::Display for TrajectoryError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}: line {l}: {}", self.file, self.what),
+        match self.row {
+            Some(r) => write!(f, "{}: row {r}: {}", self.file, self.what),
             None => write!(f, "{}: {}", self.file, self.what),
         }
     }
@@ -84,12 +85,20 @@ impl Trajectory {
     }
 }
 
+/// What was read, for a message: at most 60 characters.
+fn shown(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
 /// Reads a trajectory file.
 pub fn read(path: &Path) -> Result<Trajectory, TrajectoryError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| TrajectoryError {
         file: file.clone(),
-        line: None,
+        row: None,
         what: format!("cannot read: {e}"),
     })?;
     parse(&text, &file)
@@ -97,15 +106,20 @@ pub fn read(path: &Path) -> Result<Trajectory, TrajectoryError> {
 
 /// Parses trajectory text; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<Trajectory, TrajectoryError> {
-    let err = |line: Option<usize>, what: String| TrajectoryError {
+    let err = |row: Option<usize>, what: String| TrajectoryError {
         file: file.to_string(),
-        line,
+        row,
         what,
     };
     let mut lines = text.lines().enumerate();
     match lines.next() {
         Some((_, h)) if h.trim().trim_start_matches('\u{feff}') == HEADER => {}
-        Some(_) => return Err(err(Some(1), format!("the header must be `{HEADER}`"))),
+        Some((_, h)) => {
+            return Err(err(
+                Some(1),
+                format!("the header must be `{HEADER}`, not `{}`", shown(h.trim())),
+            ))
+        }
         None => return Err(err(None, "empty file".into())),
     }
     let mut samples: Vec<(f64, [f64; 3])> = Vec::new();

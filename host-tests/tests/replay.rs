@@ -197,24 +197,27 @@ fn the_cli_prints_one_row_per_tick() {
 }
 
 #[test]
-fn bad_trajectories_name_the_file_and_line() {
+fn bad_trajectories_name_the_file_and_row() {
     for (text, needle) in [
         ("", "empty file"),
-        ("t,x,y,z\n0,0,0,0\n", "line 1"),
+        (
+            "t,x,y,z\n0,0,0,0\n",
+            "row 1: the header must be `time_s,x_mm,y_mm,z_mm`, not `t,x,y,z`",
+        ),
         ("time_s,x_mm,y_mm,z_mm\n", "no rows"),
-        ("time_s,x_mm,y_mm,z_mm\n0,0,0\n", "line 2"),
+        ("time_s,x_mm,y_mm,z_mm\n0,0,0\n", "row 2"),
         (
             "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n0,0,0,1\n",
-            "line 3: times must increase",
+            "row 3: times must increase",
         ),
-        ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,nan,0,0\n", "line 3"),
+        ("time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,nan,0,0\n", "row 3"),
         (
             "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1,0,0,500\n",
-            "line 3: a position beyond",
+            "row 3: a position beyond",
         ),
         (
             "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n1e9,0,0,0\n",
-            "line 3: longer than",
+            "row 3: longer than",
         ),
     ] {
         let p = temp("bad.csv", text);

@@ -79,10 +79,10 @@ impl ProxyError {
     /// The message: one source for `Display` and the `defmt` impl.
     pub const fn message(&self) -> &'static str {
         match self {
-            Self::Grid => "proxy: not this solver's standard patch (on a cap: its springs in its order), or a grid outside 3..=200 with a spacing of 1 … 100 mm within ±100 mm",
+            Self::Grid => "proxy: not this solver's standard patch (on a cap: its springs in its order), or a grid outside 3 to 200 nodes a side with a spacing of 1 to 100 mm within ±100 mm",
             Self::Friction => "proxy: mu_s and mu_k must be within [0, 2]",
             Self::ProbeRadius => "proxy: the probe radius must be within [0, spacing/2] mm",
-            Self::Window => "window: the tissue must be n..=64 nodes a side within ±100 mm, the hysteresis 0.05 … 0.45",
+            Self::Window => "window: the tissue must be the window's side to 64 nodes a side within ±100 mm, the hysteresis 0.05 to 0.45",
             Self::Cap => "cap: the radius must be 4/3 of the tissue's half-diagonal … 2000 mm, its base above -100 mm, its springs within the arithmetic's longest",
         }
     }

@@ -17,6 +17,7 @@ mod patch_args;
 mod progress;
 mod replay;
 mod table;
+mod watch;
 
 pub use demo::{parse_summary, FirmwareSummary};
 pub use patch::PatchRun;
@@ -172,6 +173,7 @@ enum Command {
     /// Replay a recorded probe trajectory against the standard patch (or, with --tissue,
     /// a tissue it roams) and print CSV per tick: `time_s,fx_n,fy_n,fz_n,max_disp_mm`,
     /// then the mode's own columns (see --help).
+    #[command(after_help = replay::COLUMNS_HELP)]
     Replay(replay::Args),
     /// Will a tissue run on a core? One line `substeps=<s> tick_instructions=<i>
     /// budget=<b> fits=yes|no`: the core's stability bound's substeps, the tick estimated

@@ -1,9 +1,10 @@
 //! `mccs patch`: the indentation test on the standard patch, in the `f64` twin or the
 //! fixed-point core.
 
-use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs};
+use super::patch_args::{config_error, topology_error, twin_limits, DynamicsArgs, PatchArgs};
 use super::progress::Simulated;
 use super::table::{build, with_knots, Domain, TableArgs};
+use super::watch::setup_line;
 use super::{arg_error, csv_error, file_error, fmt_given, fmt_strain, io_error, Backend, CliError};
 use crate::paramfile;
 use crate::patch::{max_stiffness, substeps, Mesh, Twin, TwinConfig, TWIN_MAX_SUBSTEPS};
@@ -27,11 +28,13 @@ pub(super) struct Args {
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     duration: f64,
     #[command(flatten)]
+    dynamics: DynamicsArgs,
+    #[command(flatten)]
     table: TableArgs,
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
-    let run = PatchRun::new(a.patch, a.indent, a.duration)?;
+    let run = PatchRun::new(a.patch, a.dynamics, a.indent, a.duration)?;
     if a.patch.backend == Backend::Reference {
         a.table.only_with_fixed()?;
     }
@@ -51,14 +54,24 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
 #[derive(Clone, Copy, Debug)]
 pub struct PatchRun {
     patch: PatchArgs,
+    cfg: SolverConfig,
     depth: f64,
     ticks: usize,
 }
 
 impl PatchRun {
     /// Checks the arguments; each error names its argument.
-    fn new(patch: PatchArgs, depth: f64, duration: f64) -> Result<Self, CliError> {
+    fn new(
+        patch: PatchArgs,
+        dynamics: DynamicsArgs,
+        depth: f64,
+        duration: f64,
+    ) -> Result<Self, CliError> {
         patch.check()?;
+        let cfg = SolverConfig {
+            integrator: patch.integrator.into(),
+            ..dynamics.config(patch.rate, mccs::Coupling::default())?
+        };
         if !(depth.is_finite() && (0.0..=patch.spacing).contains(&depth)) {
             let what = format!(
                 "must be 0 … {} mm (the --spacing)",
@@ -75,6 +88,7 @@ impl PatchRun {
         }
         Ok(Self {
             patch,
+            cfg,
             depth,
             ticks,
         })
@@ -125,6 +139,7 @@ impl PatchRun {
         .map_err(topology_error)?;
         let mut s =
             Solver::with_arith(topo, table, cfg, arith).map_err(|e| config_error(e, cfg))?;
+        self.announce(s.substeps());
         let mut progress = self.progress();
         Ok((0..self.ticks)
             .map(|i| {
@@ -156,6 +171,7 @@ impl PatchRun {
             ));
         }
         tc.substeps = n;
+        self.announce(n);
         let mut twin = Twin::new(mesh, law, tc);
         let mut progress = self.progress();
         Ok((0..self.ticks)
@@ -169,6 +185,14 @@ impl PatchRun {
             .collect())
     }
 
+    /// The line on stderr that says what the run simulates.
+    fn announce(&self, substeps: u32) {
+        eprintln!(
+            "{}",
+            setup_line("patch", &self.patch, None, &self.cfg, substeps, false)
+        );
+    }
+
     /// `(time_s, reaction_n)` per tick; the fixed-point core's table as `table` asks.
     pub(crate) fn reactions(
         &self,
@@ -176,11 +200,7 @@ impl PatchRun {
         file: &Path,
         table: &TableArgs,
     ) -> Result<Vec<(f64, f64)>, CliError> {
-        let cfg = SolverConfig {
-            tick_hz: self.patch.rate,
-            integrator: self.patch.integrator.into(),
-            ..SolverConfig::default()
-        };
+        let cfg = self.cfg;
         match self.patch.engine() {
             Engine::Reference => self.twin(p, file, &cfg),
             Engine::Wide => self.fixed(p, file, table, &cfg, mccs::Wide),

@@ -76,8 +76,36 @@ impl PatchArgs {
     }
 }
 
-/// The solver's configuration beyond the patch: the probe coupling, the node mass and
-/// the spring damping (the defaults are `SolverConfig::default()`'s).
+/// The patch's dynamics beyond its geometry: the node mass and the spring damping (the
+/// defaults are `SolverConfig::default()`'s). `patch`, `replay` and `check` take them.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub(super) struct DynamicsArgs {
+    /// Haptic mass of each free node, g (> 0).
+    #[arg(long, default_value_t = SolverConfig::default().node_mass * 1000.0, allow_negative_numbers = true)]
+    pub node_mass: f64,
+    /// Relative damping of each spring, N·s/m (0 … 30).
+    #[arg(long, default_value_t = SolverConfig::default().spring_damping, allow_negative_numbers = true)]
+    pub spring_damping: f64,
+}
+
+impl DynamicsArgs {
+    /// The configuration at `rate` with `coupling`; each value out of range names its
+    /// argument.
+    pub fn config(&self, rate: f64, coupling: Coupling) -> Result<SolverConfig, CliError> {
+        let cfg = SolverConfig {
+            tick_hz: rate,
+            node_mass: self.node_mass / 1000.0,
+            spring_damping: self.spring_damping,
+            coupling,
+            ..SolverConfig::default()
+        };
+        cfg.validate().map_err(|e| config_error(e, &cfg))?;
+        Ok(cfg)
+    }
+}
+
+/// The dynamics and the probe's coupling: what a run with a probe takes (`replay`,
+/// `check`). `patch` holds its contact node, so it has no coupling.
 #[derive(clap::Args, Debug, Clone, Copy)]
 pub(super) struct TuningArgs {
     /// Coupling stiffness, N/mm (> 0, ≤ 1000).
@@ -89,30 +117,21 @@ pub(super) struct TuningArgs {
     /// Largest force per axis the device renders, N (> 0, < 2000).
     #[arg(long, default_value_t = Coupling::default().max_force, allow_negative_numbers = true)]
     pub max_force: f64,
-    /// Haptic mass of each free node, g (> 0).
-    #[arg(long, default_value_t = SolverConfig::default().node_mass * 1000.0, allow_negative_numbers = true)]
-    pub node_mass: f64,
-    /// Relative damping of each spring, N·s/m (0 … 30).
-    #[arg(long, default_value_t = SolverConfig::default().spring_damping, allow_negative_numbers = true)]
-    pub spring_damping: f64,
+    #[command(flatten)]
+    pub dynamics: DynamicsArgs,
 }
 
 impl TuningArgs {
     /// The configuration at `rate`; each value out of range names its argument.
     pub fn config(&self, rate: f64) -> Result<SolverConfig, CliError> {
-        let cfg = SolverConfig {
-            tick_hz: rate,
-            node_mass: self.node_mass / 1000.0,
-            spring_damping: self.spring_damping,
-            coupling: Coupling {
+        self.dynamics.config(
+            rate,
+            Coupling {
                 stiffness: self.coupling_stiffness,
                 damping: self.coupling_damping,
                 max_force: self.max_force,
             },
-            ..SolverConfig::default()
-        };
-        cfg.validate().map_err(|e| config_error(e, &cfg))?;
-        Ok(cfg)
+        )
     }
 }
 

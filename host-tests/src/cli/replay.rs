@@ -4,9 +4,11 @@
 use super::patch_args::{config_error, topology_error, twin_limits, PatchArgs, TuningArgs};
 use super::progress::Simulated;
 use super::table::{build, with_knots, Domain, TableArgs};
-use super::{arg_error, file_error, io_error, Backend, CliError, OUTPUT_CLOSED};
+use super::watch::{setup_line, Watch};
+use super::{arg_error, file_error, fmt_given, io_error, Backend, CliError, OUTPUT_CLOSED};
 use crate::paramfile;
 use crate::replay::{Engine, Replay, ReplayError, RoamRow, Roaming};
+use crate::roam::tissue::{MAX_CAP_RADIUS_MM, MAX_EXTENT_MM, MAX_SIDE};
 use crate::roam::{Friction, RoamError, Shape, Tissue};
 use crate::trajectory;
 use mccs::{ProxyError, SolverConfig};
@@ -85,20 +87,9 @@ impl Args {
             Some(radius) => Shape::Cap { radius },
             None => Shape::Flat,
         };
-        let named = |e: RoamError| {
-            let arg = match e {
-                RoamError::TissueSize => "--tissue",
-                RoamError::Spacing | RoamError::TissueExtent => "--spacing",
-                RoamError::CapRadius => "--cap-radius",
-                RoamError::Window => "--grid",
-                RoamError::Friction => "--friction",
-                RoamError::ProbeRadius => "--probe-radius",
-                RoamError::Hysteresis => "--tissue",
-            };
-            arg_error(arg, &e.to_string())
-        };
-        let tissue = Tissue::new(w, h, self.patch.spacing, shape).map_err(named)?;
-        let friction = Friction::new(mu_s, mu_k).map_err(named)?;
+        let named = |e: RoamError| self.roaming_error(e, (w, h), (mu_s, mu_k));
+        let tissue = Tissue::new(w, h, self.patch.spacing, shape).map_err(&named)?;
+        let friction = Friction::new(mu_s, mu_k).map_err(&named)?;
         let probe_radius = self.probe_radius.unwrap_or(0.0);
         if !(probe_radius.is_finite() && (0.0..=tissue.spacing / 2.0).contains(&probe_radius)) {
             return Err(named(RoamError::ProbeRadius));
@@ -111,6 +102,70 @@ impl Args {
             friction,
             probe_radius,
         }))
+    }
+
+    /// A refused roaming configuration as one line: the argument at fault, the rule, and
+    /// what was given or computed from it.
+    fn roaming_error(&self, e: RoamError, (w, h): (usize, usize), mu: (f64, f64)) -> CliError {
+        let s = self.patch.spacing;
+        let extent = |n: usize| (n.saturating_sub(1)) as f64 * s;
+        match e {
+            RoamError::TissueSize => arg_error(
+                "--tissue",
+                &format!("each side must be 3 to {MAX_SIDE} nodes (got {w},{h})"),
+            ),
+            RoamError::Spacing => arg_error(
+                "--spacing",
+                &format!("must be a finite number of mm, 1 or more, with --tissue (got {})", fmt_given(s)),
+            ),
+            RoamError::TissueExtent => arg_error(
+                "--spacing",
+                &format!(
+                    "the tissue {w} × {h} nodes at {} mm spans {} × {} mm, more than the {} mm a side the core holds (±{} mm): lower --spacing or --tissue",
+                    fmt_given(s),
+                    fmt_given(extent(w)),
+                    fmt_given(extent(h)),
+                    2.0 * MAX_EXTENT_MM,
+                    MAX_EXTENT_MM,
+                ),
+            ),
+            RoamError::CapRadius => {
+                let (hx, hy) = (extent(w) / 2.0, extent(h) / 2.0);
+                let least = 4.0 / 3.0 * (hx * hx + hy * hy).sqrt();
+                arg_error(
+                    "--cap-radius",
+                    &format!(
+                        "must be {:.1} to {MAX_CAP_RADIUS_MM} mm for this tissue (4/3 of its half-diagonal at least; got {})",
+                        least,
+                        fmt_given(self.cap_radius.unwrap_or(f64::NAN)),
+                    ),
+                )
+            }
+            RoamError::Window => arg_error(
+                "--grid",
+                &format!(
+                    "the window ({} nodes a side) must fit in the tissue ({w} × {h} nodes)",
+                    self.patch.grid
+                ),
+            ),
+            RoamError::Friction => arg_error(
+                "--friction",
+                &format!(
+                    "MU_S and MU_K must each be 0 to 2 (got {},{})",
+                    fmt_given(mu.0),
+                    fmt_given(mu.1)
+                ),
+            ),
+            RoamError::ProbeRadius => arg_error(
+                "--probe-radius",
+                &format!(
+                    "must be 0 to {} mm, half the spacing (got {})",
+                    fmt_given(s / 2.0),
+                    fmt_given(self.probe_radius.unwrap_or(f64::NAN)),
+                ),
+            ),
+            RoamError::Hysteresis => arg_error("--tissue", &e.to_string()),
+        }
     }
 }
 
@@ -134,6 +189,20 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         }),
     }
 }
+
+/// The columns of each mode, for `--help` (the tests hold it to the headers printed).
+pub(super) const COLUMNS_HELP: &str = "\
+Columns (one row per tick, stdout):
+  every mode:  time_s,fx_n,fy_n,fz_n,max_disp_mm
+               the tick's time (s), the device force (N), the largest node displacement (mm)
+  glued:       then contact_dx_mm,contact_dy_mm,contact_dz_mm
+               the contact node's displacement from rest (mm)
+  --tissue:    then proxy_x_mm,proxy_y_mm,proxy_z_mm,contact,slipping,window_shifts
+               the proxy (mm, the tissue's frame; the probe out of contact), 1 in contact,
+               1 slipping, the window's shifts so far
+stderr: one line with what the run simulates, then one counted line for each way the
+probe left what the model represents (below the patch's depth, pressing off its side or
+the tissue's edge, at the force clamp).";
 
 /// The columns every mode prints first, in this order; each mode's own follow
 /// ([`GLUED_COLUMNS`], [`ROAMING_COLUMNS`]).
@@ -175,13 +244,36 @@ fn replay<const S: usize>(
         ReplayError::Topology(e) => topology_error(e),
         other => file_error(&a.params, other),
     };
-    match roaming {
+    let substeps = replay.substeps(p, table).map_err(fail)?;
+    let tissue = roaming.as_ref().map(|r| r.tissue);
+    // Said with the first row: a configuration the core refuses when the run starts (a
+    // cap's window) gets its one error line alone.
+    let mut setup = Some(setup_line(
+        "replay",
+        &a.patch,
+        tissue.as_ref(),
+        &cfg,
+        substeps,
+        true,
+    ));
+    let mut watch = Watch::new(
+        "replay",
+        a.patch.grid,
+        a.patch.spacing,
+        tissue,
+        cfg.coupling.max_force,
+    );
+    let done = match roaming {
         Some(roaming) => csv(
             w,
             &format!("{LEADING_COLUMNS},{ROAMING_COLUMNS}"),
             |row| {
                 replay.roam_with(p, table, &traj, &roaming, |r: RoamRow| {
+                    if let Some(line) = setup.take() {
+                        eprintln!("{line}");
+                    }
                     progress.at(r.time);
+                    watch.see(r.time, r.probe, r.force);
                     row(format!(
                         "{},{},{},{},{},{},{},{},{},{},{}",
                         fmt_time(r.time),
@@ -205,7 +297,11 @@ fn replay<const S: usize>(
             &format!("{LEADING_COLUMNS},{GLUED_COLUMNS}"),
             |row| {
                 replay.run_with(p, table, &traj, |r| {
+                    if let Some(line) = setup.take() {
+                        eprintln!("{line}");
+                    }
                     progress.at(r.time);
+                    watch.see(r.time, r.probe, r.force);
                     row(format!(
                         "{},{},{},{},{},{},{},{}",
                         fmt_time(r.time),
@@ -221,7 +317,11 @@ fn replay<const S: usize>(
             },
             fail,
         ),
+    };
+    for line in watch.warnings() {
+        eprintln!("{line}");
     }
+    done
 }
 
 /// Writes `header`, then each line `run` hands its row function; stops writing at the

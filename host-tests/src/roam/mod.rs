@@ -64,14 +64,14 @@ pub enum RoamError {
 impl core::fmt::Display for RoamError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
-            Self::TissueSize => "tissue: each side must be 3..=64 nodes",
+            Self::TissueSize => "tissue: each side must be 3 to 64 nodes",
             Self::Spacing => "tissue: the spacing must be a finite number of mm >= 1",
             Self::TissueExtent => "tissue: it must lie within ±100 mm of its centre",
-            Self::CapRadius => "tissue: the cap radius must be 4/3 of the half-diagonal … 2000 mm",
+            Self::CapRadius => "tissue: the cap radius must be 4/3 of the half-diagonal to 2000 mm",
             Self::Window => "window: its side must be 3 or more and fit in the tissue",
-            Self::Friction => "friction: mu_s and mu_k must be within [0, 2]",
-            Self::ProbeRadius => "probe radius: must be within [0, spacing/2] mm",
-            Self::Hysteresis => "window hysteresis: must be within [0.05, 0.45] spacings",
+            Self::Friction => "friction: mu_s and mu_k must each be 0 to 2",
+            Self::ProbeRadius => "probe radius: must be 0 to half the spacing, mm",
+            Self::Hysteresis => "window hysteresis: must be 0.05 to 0.45 spacings",
         })
     }
 }

@@ -133,7 +133,7 @@ fn negative_numbers_with_signed_exponents_are_values() {
     // `unexpected argument '-1'`).
     assert_one_line_error(
         &mccs(&[&PALPATION[..7], &["--friction", "-1e-3,0"]].concat()),
-        &["--friction: friction: mu_s and mu_k must be within [0, 2]"],
+        &["--friction: MU_S and MU_K must each be 0 to 2 (got -0.001,0)"],
     );
     // In the other subcommands' numbers too: a negative indentation, named.
     assert_one_line_error(

@@ -222,3 +222,47 @@ fn tiny_spacings_name_the_spacing() {
     let out = patch(&["--spacing", "0.5", "--indent", "0.1", "--duration", "0.01"]);
     assert!(out.status.success(), "{out:?}");
 }
+
+/// `patch` takes the patch's dynamics as `replay` does (its substeps message names
+/// `--node-mass`), and they change the run: a heavier node lags the ramp.
+#[test]
+fn patch_takes_the_dynamics_options_replay_takes() {
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "0.5",
+            "--duration",
+            "0.01",
+            "--backend",
+            "fixed",
+        ];
+        a.extend_from_slice(extra);
+        let out = mccs(&a);
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let light = run(&[]);
+    let heavy = run(&["--node-mass", "20"]);
+    let third = |s: &str| s.lines().nth(3).unwrap().to_string();
+    assert_ne!(third(&light), third(&heavy), "--node-mass changed nothing");
+    assert_ne!(
+        run(&["--spring-damping", "5"]),
+        light,
+        "--spring-damping changed nothing"
+    );
+    assert_one_line_error(
+        &mccs(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "0.5",
+            "--node-mass",
+            "0",
+        ]),
+        &["--node-mass: must be > 0 g"],
+    );
+}

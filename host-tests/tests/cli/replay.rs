@@ -124,7 +124,10 @@ fn replay_roaming_errors_name_the_argument() {
             ][..],
             &["--cap-radius", "the arithmetic's longest"][..],
         ),
-        (&["--tissue", "2,64"], &["--tissue", "3..=64"]),
+        (
+            &["--tissue", "2,64"],
+            &["--tissue: each side must be 3 to 64 nodes (got 2,64)"],
+        ),
         (&["--tissue", "64"], &["--tissue", "W,H"]),
         (&["--tissue", "64,x"], &["--tissue", "W,H"]),
         (
@@ -133,7 +136,7 @@ fn replay_roaming_errors_name_the_argument() {
         ),
         (
             &["--tissue", "64,64", "--friction", "3,1"],
-            &["--friction", "[0, 2]"],
+            &["--friction: MU_S and MU_K must each be 0 to 2 (got 3,1)"],
         ),
         (
             &["--friction", "0.3,0.2"],
@@ -145,7 +148,7 @@ fn replay_roaming_errors_name_the_argument() {
         ),
         (
             &["--tissue", "64,64", "--probe-radius", "2"],
-            &["--probe-radius"],
+            &["--probe-radius: must be 0 to 1.25 mm, half the spacing (got 2)"],
         ),
         (
             &["--tissue", "64,64", "--probe-radius", "NaN"],
@@ -153,12 +156,18 @@ fn replay_roaming_errors_name_the_argument() {
         ),
         (
             &["--tissue", "64,64", "--cap-radius", "10"],
-            &["--cap-radius"],
+            &[
+                "--cap-radius: must be 148.5 to 2000 mm for this tissue",
+                "got 10",
+            ],
         ),
         (&["--tissue", "8,8", "--grid", "9"], &["--grid"]),
         (
             &["--tissue", "64,64", "--spacing", "4"],
-            &["--spacing", "100 mm"],
+            &[
+                "--spacing: the tissue 64 × 64 nodes at 4 mm spans 252 × 252 mm",
+                "lower --spacing or --tissue",
+            ],
         ),
     ] {
         let args: Vec<&str> = base.iter().chain(extra).copied().collect();
@@ -498,5 +507,152 @@ fn over_a_caps_edge_the_core_and_the_reference_agree() {
         }
         assert!(slips <= 1, "{friction}: {slips} ticks slip apart");
         assert!(reference.iter().any(|r| r[0] > 3.0 && r[CONTACT] == 0.0));
+    }
+}
+
+/// The stderr of a successful replay: its setup line, then its warnings.
+fn replay_said(extra: &[&str], probe: &Path) -> Vec<String> {
+    let mut a = vec![
+        "replay",
+        "--params",
+        "params/table2.toml",
+        "--probe",
+        probe.to_str().unwrap(),
+    ];
+    a.extend_from_slice(extra);
+    let out = mccs(&a);
+    assert!(out.status.success(), "{out:?}");
+    String::from_utf8(out.stderr)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+/// A replay says what it simulates in one line on stderr, and each way the probe left
+/// what the model represents in one counted line: past the patch's depth, off its side
+/// or the tissue's edge while pressing, at the force clamp.
+#[test]
+fn replays_say_what_they_simulate_and_where_the_model_ends() {
+    // Down to 3 mm on the 2.5 mm-deep patch: below it from t = 0.15 s (z = −2.5 mm) to
+    // the end, 150 ticks at 1 kHz.
+    let deep = temp_file(
+        "deep.csv",
+        "time_s,x_mm,y_mm,z_mm\n0,0,0,1\n0.1,0,0,-2\n0.2,0,0,-3\n0.3,0,0,-3\n",
+    );
+    let said = replay_said(&["--max-force", "100"], &deep);
+    assert_eq!(
+        said[0],
+        "mccs replay: patch 5 × 5 nodes (10 × 10 mm, 2.5 mm deep) at 2.5 mm; the f64 twin, \
+         1000 Hz × 6 substeps, node mass 5 g, spring damping 1 N·s/m; coupling 1 N/mm and \
+         0.5 N·s/m, force clamp 100 N"
+    );
+    assert_eq!(said.len(), 2, "{said:#?}");
+    assert!(
+        said[1].starts_with(
+            "mccs replay: warning: the probe was below the patch's depth (2.5 mm under the rest \
+             surface, where its base is fixed) on 150 ticks, first at t = 0.151 s: "
+        ),
+        "{}",
+        said[1]
+    );
+    // Slid off a 21 × 21 tissue's edge (±25 mm) at 1 mm deep, pulled back at a 3 N clamp.
+    let edge = temp_file(
+        "edge.csv",
+        "time_s,x_mm,y_mm,z_mm\n0,20,0,1\n0.2,20,0,-1\n0.7,30,0,-1\n",
+    );
+    let said = replay_said(
+        &[
+            "--backend",
+            "fixed",
+            "--tissue",
+            "21,21",
+            "--max-force",
+            "3",
+        ],
+        &edge,
+    );
+    assert!(
+        said[0].starts_with(
+            "mccs replay: tissue 21 × 21 nodes at 2.5 mm (50 × 50 mm, flat), window 5 × 5 nodes"
+        ),
+        "{}",
+        said[0]
+    );
+    assert!(
+        said[0].contains("the fixed-point core (wide)"),
+        "{}",
+        said[0]
+    );
+    let warned = |what: &str| {
+        said.iter()
+            .any(|l| l.contains(what) && l.contains(" ticks, first at t = "))
+    };
+    assert!(
+        warned("the probe pressed off the tissue's edge (x within ±25 mm, y within ±25 mm) on 250 ticks, first at t = 0.451 s"),
+        "{said:#?}"
+    );
+    assert!(warned("the force was at the clamp (3 N)"), "{said:#?}");
+    // A press within the tissue, under the clamp: the setup line alone.
+    let said = replay_said(
+        &["--tissue", "21,21"],
+        &temp_file(
+            "gentle.csv",
+            "time_s,x_mm,y_mm,z_mm\n0,0,0,1\n0.2,0,0,-1\n0.4,0,0,-1\n",
+        ),
+    );
+    assert_eq!(said.len(), 1, "{said:#?}");
+}
+
+/// `patch` says what it simulates too: the held contact node, no coupling.
+#[test]
+fn patch_says_what_it_simulates() {
+    let out = mccs(&[
+        "patch",
+        "--params",
+        "params/table2.toml",
+        "--indent",
+        "1",
+        "--duration",
+        "0.01",
+        "--node-mass",
+        "2",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "mccs patch: patch 5 × 5 nodes (10 × 10 mm, 2.5 mm deep) at 2.5 mm; the f64 twin, \
+         1000 Hz × 9 substeps, node mass 2 g, spring damping 1 N·s/m; the contact node held \
+         at the indentation (no coupling)\n"
+    );
+}
+
+/// `replay --help` names the columns of every mode as the runs print them.
+#[test]
+fn replay_help_names_every_modes_columns() {
+    let help = String::from_utf8(mccs(&["replay", "--help"]).stdout).unwrap();
+    let header = |extra: &[&str]| {
+        let mut a = vec![
+            "replay",
+            "--params",
+            "params/table2.toml",
+            "--probe",
+            "params/palpation.csv",
+        ];
+        a.extend_from_slice(extra);
+        let out = mccs(&a);
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    let (glued, roaming) = (header(&[]), header(&["--tissue", "64,64"]));
+    let (lead, glued_own) = glued.split_at(glued.match_indices(',').nth(4).unwrap().0);
+    let roaming_own = roaming.strip_prefix(lead).unwrap();
+    for columns in [lead, &glued_own[1..], &roaming_own[1..]] {
+        assert!(help.contains(columns), "--help lacks {columns:?}:\n{help}");
     }
 }
