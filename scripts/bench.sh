@@ -41,7 +41,7 @@ run_bin() {
   set +e
   timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$t" --bin "$2" \
       < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
-    | "$DECODER" "target/$t/release/$2" > "$3"
+    | "$DECODER" "$TARGET_DIR/$t/release/$2" > "$3"
   echo "${PIPESTATUS[0]}" > "$3.rc"
 }
 for core in m4f m3 m0; do
@@ -59,7 +59,7 @@ for core in m4f m3 m0; do
     echo "bench: the $core table_new firmware failed (see $log)" >&2
     status=1
   fi
-  python3 scripts/code_size.py "target/$(core_target "$core")/release/table_new" "$core" \
+  python3 scripts/code_size.py "$TARGET_DIR/$(core_target "$core")/release/table_new" "$core" \
     'mccs_firmware::entry::table_new' table_new >> target/qemu/code-size.txt || status=1
 done
 cat target/qemu/code-size.txt

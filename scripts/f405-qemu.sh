@@ -10,7 +10,7 @@ source scripts/lib.sh  # build_decoder, $DECODER
 echo "f405-qemu: building the board firmware (--features qemu) and the log decoder" >&2
 build_decoder --quiet
 cargo build --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 --features qemu
-elf=target/thumbv7em-none-eabihf/release/haptic-f405
+elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
 echo "f405-qemu: running it in QEMU (netduinoplus2, a second of ticks)" >&2
 timeout --foreground 300 cargo run --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf \
     --bin haptic-f405 --features qemu < /dev/null 2> >(grep -v "Timer with period zero" >&2) \

@@ -10,7 +10,7 @@ shift || true
 target=$(core_target "$core")
 build_decoder --quiet
 cargo build --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@"
-elf="target/$target/release/haptic"
+elf="$TARGET_DIR/$target/release/haptic"
 # The runner from .cargo/config.toml (QEMU with -icount, off the terminal), output
 # decoded. A hung firmware fails after 5 minutes instead of stalling the caller.
 timeout --foreground 300 cargo run --quiet --release -p mccs-firmware --target "$target" --bin haptic "$@" \

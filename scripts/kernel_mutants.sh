@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 T=thumbv7em-none-eabihf
 root=$(pwd)
 source scripts/lib.sh  # build_decoder, $DECODER
-DECODER="$root/$DECODER"
+[[ $DECODER = /* ]] || DECODER="$root/$DECODER"
 work=$(mktemp -d)
 trap 'git worktree remove --force "$work" >/dev/null 2>&1 || rm -rf "$work"' EXIT
 git worktree add --detach "$work" HEAD >/dev/null

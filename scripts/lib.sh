@@ -6,6 +6,7 @@
 #                               "ok   NAME (34 s)" or "FAIL NAME (34 s): see LOG";
 #                               returns COMMAND's status.
 #   say TEXT                    one line on stderr.
+#   $TARGET_DIR                 cargo's target folder ($CARGO_TARGET_DIR, else target).
 #   build_decoder [ARGS]        builds the defmt log decoder, $DECODER (its own cargo
 #                               profile, `tool`: unoptimised, it builds in half the time),
 #                               linted as it builds (clippy's driver as the workspace's
@@ -16,7 +17,9 @@ LOG_DIR=${LOG_DIR:-target/logs}
 mkdir -p "$LOG_DIR"
 STAGES=()
 
-DECODER=target/tool/defmt-log
+# Where cargo builds: $CARGO_TARGET_DIR when it is set, as cargo does.
+TARGET_DIR=${CARGO_TARGET_DIR:-target}
+DECODER=$TARGET_DIR/tool/defmt-log
 build_decoder() {
   RUSTFLAGS=-Dwarnings RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver)" \
     cargo build -p defmt-log --profile tool "$@"

@@ -29,9 +29,9 @@ start=$SECONDS
 exec 3>&2
 
 stack_probes() {
-  rm -f target/release/deps/mccs-*.s
+  rm -f "$TARGET_DIR"/release/deps/mccs-*.s
   cargo rustc --release -p mccs-host --bin mccs -- --emit asm -C llvm-args=-x86-asm-syntax=intel
-  python3 scripts/check_stack_probes.py target/release/deps/mccs-*.s
+  python3 scripts/check_stack_probes.py "$TARGET_DIR"/release/deps/mccs-*.s
 }
 say "long.sh: the host tests in a release build (several minutes from scratch), then its stack probes"
 run_stage release-host-tests cargo test --release -p mccs-host

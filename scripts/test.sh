@@ -79,7 +79,7 @@ demo_core() {
 
 tick_path() {
   for t in "${THUMB[@]}"; do
-    python3 scripts/check_tick_path.py "target/$t/release/haptic" | tail -n 1 || return 1
+    python3 scripts/check_tick_path.py "$TARGET_DIR/$t/release/haptic" | tail -n 1 || return 1
   done
 }
 
@@ -90,7 +90,7 @@ panic_test() {
     return 1
   fi
   grep "panic: " target/qemu/panic.log || return 1
-  if python3 scripts/check_tick_path.py target/thumbv7em-none-eabihf/release/haptic > /dev/null; then
+  if python3 scripts/check_tick_path.py "$TARGET_DIR"/thumbv7em-none-eabihf/release/haptic > /dev/null; then
     echo "the tick-path check missed the injected panic"
     return 1
   fi
@@ -104,7 +104,7 @@ panic_test() {
 # code can meet.
 budget_test() {
   local t=thumbv7em-none-eabihf runner
-  local elf=target/$t/release/bench
+  local elf=$TARGET_DIR/$t/release/bench
   runner=$(sed -n "/^\[target\.$t\]/,/^runner/s/^runner = \"\(.*\)\"$/\1/p" .cargo/config.toml)
   case $runner in
     *"-semihosting-config enable=on,target=native "*) ;;
@@ -145,7 +145,7 @@ bench_truncated() {
 # microbit has 16 KiB in all).
 sizes() {
   for t in "${THUMB[@]}"; do
-    python3 scripts/size.py "target/$t/release/haptic" "$t" haptic 98304 16384 || return 1
+    python3 scripts/size.py "$TARGET_DIR/$t/release/haptic" "$t" haptic 98304 16384 || return 1
   done | tee target/qemu/sizes.txt
 }
 
@@ -154,7 +154,7 @@ sizes() {
 # its tick path checked too, run in QEMU, where its SUMMARY verdict must be ok (the fault
 # rules, for an encoder that reads zeros).
 board_f405() {
-  local t=thumbv7em-none-eabihf elf=target/thumbv7em-none-eabihf/release/haptic-f405
+  local t=thumbv7em-none-eabihf elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
   local init='haptic_f405::firmware::init'
   cargo build --release -p haptic-f405 --target "$t" --bin haptic-f405 || return 1
   python3 scripts/size.py "$elf" "$t" haptic-f405 98304 16384 | tee target/qemu/sizes-f405.txt

@@ -94,3 +94,106 @@ fn no_source_file_cites_a_document_outside_the_repository() {
         }
     }
 }
+
+/// GitHub's anchor for a heading: lower case, punctuation but `-` and `_` dropped,
+/// spaces as `-`.
+fn anchor_of(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// A page's text without its fenced blocks and code spans (links there are code).
+fn prose(text: &str) -> String {
+    let mut out = String::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut in_code = false;
+        for c in line.chars() {
+            if c == '`' {
+                in_code = !in_code;
+            } else if !in_code {
+                out.push(c);
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The anchors of a page's headings.
+fn anchors(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    text.lines()
+        .filter(|l| {
+            if l.trim_start().starts_with("```") {
+                fenced = !fenced;
+            }
+            !fenced && l.starts_with('#')
+        })
+        .map(|l| anchor_of(l.trim_start_matches('#')))
+        .collect()
+}
+
+/// Every relative link of README.md and docs/ (`[text](path)`, `[text](path#anchor)`,
+/// `[text](#anchor)`) names a file that exists and, with an anchor, a heading of it.
+#[test]
+fn every_relative_link_in_the_docs_resolves() {
+    let link = |s: &str| -> Vec<String> {
+        let mut out = Vec::new();
+        let mut rest = s;
+        while let Some(i) = rest.find("](") {
+            rest = &rest[i + 2..];
+            if let Some(end) = rest.find(')') {
+                out.push(rest[..end].trim().to_string());
+            }
+        }
+        out
+    };
+    let mut checked = 0;
+    for page in super::doc_snippets::doc_pages() {
+        let text = std::fs::read_to_string(&page).unwrap();
+        for target in link(&prose(&text)) {
+            if target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            checked += 1;
+            let (path, anchor) = match target.split_once('#') {
+                Some((p, a)) => (p, Some(a)),
+                None => (target.as_str(), None),
+            };
+            let file = if path.is_empty() {
+                page.clone()
+            } else {
+                page.parent().unwrap().join(path)
+            };
+            assert!(
+                file.exists(),
+                "{}: the link ({target}) names {}, which does not exist",
+                page.display(),
+                file.display()
+            );
+            if let Some(a) = anchor {
+                let heads = anchors(&std::fs::read_to_string(&file).unwrap());
+                assert!(
+                    heads.iter().any(|h| h == a),
+                    "{}: the link ({target}) names no heading of {}",
+                    page.display(),
+                    file.display()
+                );
+            }
+        }
+    }
+    assert!(checked > 20, "{checked} links checked: the scan is broken");
+}

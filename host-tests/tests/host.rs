@@ -18,6 +18,8 @@ mod contact;
 mod demo;
 #[path = "device.rs"]
 mod device;
+#[path = "doc_snippets.rs"]
+mod doc_snippets;
 #[path = "docs.rs"]
 mod docs;
 #[path = "fit.rs"]

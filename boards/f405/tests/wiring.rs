@@ -625,10 +625,6 @@ fn the_board_runs_a_table_of_any_knot_count() {
     assert!(f65 > 0.05, "{f65}");
     assert!((f129 - f65).abs() < 1e-3 * f65, "{f129} against {f65}");
     assert!((f17 - f65).abs() < 1e-2 * f65, "{f17} against {f65}");
-    // The board's own tissue is Table 2's at 65 knots as shipped.
-    assert_eq!(haptic_f405::tissue::SEGMENTS, 64);
-    assert_eq!(
-        tissue().raw(),
-        ForceTable64::new(&Params::TABLE2).unwrap().raw()
-    );
+    // (Which tissue the board holds is the user's: `table_source.rs` holds it to the
+    // command in its header, whatever the tissue.)
 }

@@ -190,16 +190,58 @@ fn fmt_param(x: f64) -> String {
 /// other parameters the data do not determine.
 fn warnings(model: &fit::Fitted, points: &[fit::Point]) -> Vec<String> {
     let max_strain = points.iter().map(|p| p.0).fold(0.0, f64::max);
+    let max_force = points.iter().map(|p| p.1).fold(0.0, f64::max);
+    let solid = match model {
+        fit::Fitted::Mccs(p) => Some(mccs::Derived::Fc.of(p)),
+        // F_C is the cone's alone.
+        fit::Fitted::Mcs(c) => Some(mccs::Derived::Fc.of(&mccs::Params {
+            cone: *c,
+            ..mccs::Params::TABLE2
+        })),
+        fit::Fitted::Ms { .. } => None,
+    };
     let mut out: Vec<String> = model
         .on_bounds()
         .into_iter()
         .map(|(key, bound, side, range)| {
+            let why = match solid {
+                // D1 shapes the law only near the solid force, where the smallest coils close.
+                Some(f_c) if key == "cone.small_diameter" && max_force < 0.5 * f_c => format!(
+                    "the data stop at {} N, well below the cone's solid force F_C = {} N, and say little of D1",
+                    fmt_param(max_force),
+                    fmt_param(f_c)
+                ),
+                _ => "the data want it past what the model takes, or do not decide it".to_string(),
+            };
             format!(
-                "{key} sits on its {side} bound ({}, of {range}): the data want it past what the model takes",
+                "{key} sits on its {side} bound ({}, of {range}): {why}; treat its value as unknown",
                 fmt_param(bound)
             )
         })
         .collect();
+    if let fit::Fitted::Ms { c1, c2, c3 } = *model {
+        // Eq. 27's two terms at each row: one that never reaches 1e-6 of the other is a
+        // parameter the fit dropped.
+        let terms = |e: f64| {
+            let l = 1.0 - e;
+            (
+                c1 * c2 * (c2 * (l * l * l - 3.0 * l + 2.0) / l).exp(),
+                c3 / l,
+            )
+        };
+        let (most1, most3) = points.iter().fold((0.0f64, 0.0f64), |(a, b), p| {
+            let (t1, t3) = terms(p.0);
+            (a.max(t1 / t3), b.max(t3 / t1))
+        });
+        for (key, value, most) in [("c3", c3, most3), ("c1", c1, most1)] {
+            if most < 1e-6 {
+                out.push(format!(
+                    "degenerate: {key} = {} scales a term under 1e-6 of the other's at every row: the fit dropped it",
+                    fmt_param(value)
+                ));
+            }
+        }
+    }
     let cone = match model {
         fit::Fitted::Mccs(p) => Some((p.cone, crate::reference::Reference::new(p).ok())),
         fit::Fitted::Mcs(c) => Some((*c, Some(crate::reference::Reference::cone_only(c)))),

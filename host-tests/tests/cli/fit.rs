@@ -72,8 +72,10 @@ fn fit_warns_of_a_bound_and_of_a_degenerate_fit() {
     let out = mccs_ok(&["fit", "--data", "params/demo-data.csv"]);
     let err = String::from_utf8_lossy(&out.stderr);
     for needle in [
-        "mccs: warning: the mccs fit: cone.small_diameter sits on its lower bound (0.04, of 0.05 … 0.95 of D2)",
+        "mccs: warning: the mccs fit: cone.small_diameter sits on its lower bound (0.04, of 0.05 … 0.95 of D2): the data stop at 1 N, well below the cone's solid force F_C = ",
         "mccs: warning: the ms fit: c2 sits on its lower bound (0.001, of 1e-3 … 1e3)",
+        "mccs: warning: the ms fit: degenerate: c3 = ",
+        "scales a term under 1e-6 of the other's at every row: the fit dropped it",
     ] {
         assert!(err.contains(needle), "{err}");
     }

@@ -9,6 +9,7 @@ mod one_table;
 mod patch;
 mod replay;
 mod table;
+mod walks;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

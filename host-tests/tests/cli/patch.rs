@@ -266,3 +266,29 @@ fn patch_takes_the_dynamics_options_replay_takes() {
         &["--node-mass: must be > 0 g"],
     );
 }
+
+/// The example of docs/accuracy.md: a 0.8 mm indentation of the default patch, in both
+/// backends, its last reaction printed for the doc (`PATCHRUN`) and the two within 1e-6.
+#[test]
+fn the_docs_indentation_example() {
+    let last = |backend: &str| -> f64 {
+        let out = mccs_ok(&[
+            "patch",
+            "--params",
+            "params/table2.toml",
+            "--indent",
+            "0.8",
+            "--backend",
+            backend,
+        ]);
+        let text = String::from_utf8(out.stdout).unwrap();
+        let f = text.lines().last().unwrap().split(',').nth(1).unwrap();
+        println!("PATCHRUN backend={backend} final_n={f}");
+        f.parse().unwrap()
+    };
+    let (fixed, reference) = (last("fixed"), last("reference"));
+    assert!(
+        (fixed - reference).abs() < 1e-6 * reference,
+        "{fixed} against {reference}"
+    );
+}
