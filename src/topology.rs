@@ -74,7 +74,9 @@ impl TopologyError {
         match self {
             Self::NodeCapacity => "topology: more free nodes than the node capacity",
             Self::EdgeCapacity => "topology: more springs than the edge capacity",
-            Self::BadGrid => "topology: the grid must be 3 to 200 nodes a side with a finite spacing > 0",
+            Self::BadGrid => {
+                "topology: the grid must be 3 to 200 nodes a side with a finite spacing > 0"
+            }
             Self::OutOfRange => "topology: a node lies beyond ±100 mm of the contact node",
             Self::TooShort => "topology: a spring is shorter than 1 mm",
             Self::BadEnd => "topology: a spring refers to a missing node or joins two fixed points",

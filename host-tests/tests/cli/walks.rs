@@ -57,7 +57,7 @@ fn the_walk_from_a_fit_to_the_board() {
     let table2 =
         String::from_utf8(mccs_ok(&["check", "--params", "params/table2.toml"]).stdout).unwrap();
     println!(
-        "WALK board substeps={} tick_instructions={} budget={} table2_substeps={}",
+        "WALK walk=board substeps={} tick_instructions={} budget={} table2_substeps={}",
         field(&check, "substeps"),
         field(&check, "tick_instructions"),
         field(&check, "budget"),
@@ -100,7 +100,7 @@ fn the_walk_from_data_to_a_replay() {
         .fold(0.0, f64::max);
     assert!(most > 0.5 && diff < 0.02 * most, "{diff} N of {most} N");
     println!(
-        "WALK replay rows={} max_fz_n={most:.4} max_fz_diff_mn={:.2}",
+        "WALK walk=replay rows={} max_fz_n={most:.4} max_fz_diff_mn={:.2}",
         fit.len(),
         diff * 1000.0
     );
