@@ -124,18 +124,9 @@ impl Replay {
         row: &mut dyn FnMut(Row),
     ) -> Result<(), ReplayError> {
         let mut s = self.solver(params, table, self.spacing, arith)?;
-        let nodes = s.topology().node_count() as u16;
-        let contact = s.topology().contact();
-        let mm = |x: [Length; 3]| x.map(|c| c.to_num::<f64>());
-        for (time, p) in traj.ticks(self.config.tick_hz) {
-            let f = s.step(p.map(Length::saturating_from_num));
-            row(Row {
-                time,
-                probe: p,
-                force: f.map(|c| c.to_num::<f64>()),
-                contact: s.displacement(contact).map(mm).unwrap_or([0.0; 3]),
-                max_disp: max_disp_fixed(&s, nodes),
-            });
+        for (tick, (time, p)) in traj.ticks(self.config.tick_hz).enumerate() {
+            let raw = mccs_link::replay::glued(&mut s, tick as u32, probe_bits(p));
+            row(Row::of_raw(time, p, &raw));
         }
         Ok(())
     }
@@ -335,32 +326,14 @@ impl Replay {
         replay: &Replay,
         row: &mut dyn FnMut(RoamRow),
     ) -> Result<(), ReplayError> {
-        let nodes = s.topology().node_count() as u16;
         let mut ticks = traj.ticks(replay.config.tick_hz).peekable();
         let start = ticks.peek().map_or([0.0; 3], |(_, p)| *p);
         let mut window = s
             .window(window_config, shape, proxy, start[0], start[1])
             .map_err(ReplayError::Proxy)?;
-        for (time, p) in ticks {
-            let force = s.step_roaming(p.map(Length::saturating_from_num), proxy, &mut window);
-            let o = window.origin_mm().map(|c| c.to_num::<f64>());
-            let proxy_at = match s.proxy_point_in(proxy, &window) {
-                Some(q) => {
-                    let q = q.map(|c| c.to_num::<f64>());
-                    [q[0] + o[0], q[1] + o[1], q[2]]
-                }
-                None => p,
-            };
-            row(RoamRow {
-                time,
-                probe: p,
-                force: force.map(|c| c.to_num::<f64>()),
-                proxy: proxy_at,
-                contact: proxy.grid_position().is_some(),
-                slipping: proxy.slipping(),
-                window_shifts: window.shifts(),
-                max_disp: max_disp_fixed(s, nodes),
-            });
+        for (tick, (time, p)) in ticks.enumerate() {
+            let raw = mccs_link::replay::roaming(s, proxy, &mut window, tick as u32, probe_bits(p));
+            row(RoamRow::of_raw(time, p, &raw));
         }
         Ok(())
     }
@@ -403,15 +376,54 @@ impl Replay {
     }
 }
 
-/// The largest |displacement| from rest of the core's free nodes `1 … nodes − 1`, mm.
-fn max_disp_fixed<const N: usize, const E: usize, const S: usize, A: Arith>(
-    s: &Solver<N, E, S, A>,
-    nodes: u16,
-) -> f64 {
-    (1..nodes)
-        .filter_map(|i| s.displacement(i))
-        .map(|d| norm(d.map(|c| c.to_num::<f64>())))
-        .fold(0.0, f64::max)
+/// A probe sample as the core's lengths (saturated at ±128 mm): what the fixed-point
+/// engines step on, here and on a device over the link.
+pub fn probe_bits(p: [f64; 3]) -> [Length; 3] {
+    p.map(Length::saturating_from_num)
+}
+
+/// Q24 mm bits as mm.
+fn mm(bits: [i32; 3]) -> [f64; 3] {
+    bits.map(|b| Length::from_bits(b).to_num::<f64>())
+}
+
+impl Row {
+    /// A glued tick's row from the core's raw outputs (here or from a device), at the
+    /// sample's `time` and position `probe`.
+    pub fn of_raw(time: f64, probe: [f64; 3], raw: &mccs_link::ReplayRow) -> Row {
+        Row {
+            time,
+            probe,
+            force: raw.force.map(|b| mccs::Force::from_bits(b).to_num::<f64>()),
+            contact: mm(raw.point),
+            max_disp: norm(mm(raw.max_disp)),
+        }
+    }
+}
+
+impl RoamRow {
+    /// A roaming tick's row from the core's raw outputs, as [`Row::of_raw`]: the proxy
+    /// in the tissue's frame (the probe out of contact).
+    pub fn of_raw(time: f64, probe: [f64; 3], raw: &mccs_link::ReplayRow) -> RoamRow {
+        use mccs_link::replay::{CONTACT, PROXY, SLIPPING};
+        let proxy = if raw.flags & PROXY != 0 {
+            let q = mm(raw.point);
+            let o = raw.origin.map(|b| Length::from_bits(b).to_num::<f64>());
+            [q[0] + o[0], q[1] + o[1], q[2]]
+        } else {
+            probe
+        };
+        RoamRow {
+            time,
+            probe,
+            force: raw.force.map(|b| mccs::Force::from_bits(b).to_num::<f64>()),
+            proxy,
+            contact: raw.flags & CONTACT != 0,
+            slipping: raw.flags & SLIPPING != 0,
+            window_shifts: raw.shifts,
+            max_disp: norm(mm(raw.max_disp)),
+        }
+    }
 }
 
 /// The largest |displacement| from rest of the twin's nodes, mm.

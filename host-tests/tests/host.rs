@@ -26,6 +26,8 @@ mod docs;
 mod fit;
 #[path = "float_patch.rs"]
 mod float_patch;
+#[path = "link/mod.rs"]
+mod link;
 #[path = "patch.rs"]
 mod patch;
 #[path = "proxy.rs"]
