@@ -10,6 +10,7 @@
 //!   [`one_dof`], a 1-DOF device made of the two;
 //! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
 //!   buffer between the main loop and the tick interrupt;
+//! - [`link`]: the device's side of the host link (`mccs-link`);
 //! - [`demo`]: the demo run shared by the QEMU firmware and the host (`mccs demo`);
 //! - [`entry`], [`float_patch`]: what the instruction-count bench calls.
 //!
@@ -25,6 +26,7 @@ pub mod device;
 pub mod drivers;
 pub mod entry;
 pub mod float_patch;
+pub mod link;
 pub mod mailbox;
 pub mod one_dof;
 pub mod probe_path;

@@ -56,7 +56,10 @@ impl core::fmt::Display for FrameError {
 }
 
 /// Encodes `msg` as one frame into `out`; returns the frame (delimiter included).
-pub fn encode<'o, T: Serialize>(msg: &T, out: &'o mut [u8; MAX_FRAME]) -> Result<&'o [u8], FrameError> {
+pub fn encode<'o, T: Serialize>(
+    msg: &T,
+    out: &'o mut [u8; MAX_FRAME],
+) -> Result<&'o [u8], FrameError> {
     let mut raw = [0u8; MAX_PAYLOAD + 4];
     let n = postcard::to_slice(msg, &mut raw[..MAX_PAYLOAD])
         .map_err(|_| FrameError::TooLarge)?

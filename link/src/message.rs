@@ -202,6 +202,8 @@ pub enum SpecOption {
     Arith,
     /// `--tissue`.
     Tissue,
+    /// `--cap-radius`.
+    CapRadius,
     /// The path's length.
     Samples,
     /// The solver's configuration as a whole (its substeps).
@@ -218,6 +220,7 @@ impl SpecOption {
             Self::NodeMass => "--node-mass",
             Self::Arith => "--arith",
             Self::Tissue => "--tissue",
+            Self::CapRadius => "--cap-radius",
             Self::Samples => "--probe",
             Self::Config => "--rate",
         }
@@ -307,6 +310,9 @@ pub struct ReplaySpec {
     pub narrow: bool,
     /// Path samples (ticks) to come.
     pub samples: u32,
+    /// The first sample's `x, y`, mm, as the host read it: where a roaming window
+    /// starts (the host's own replay starts it there, before any rounding).
+    pub start: [f64; 2],
     /// `--tissue` and its options.
     pub roaming: Option<RoamSpec>,
 }

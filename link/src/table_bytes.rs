@@ -66,37 +66,39 @@ pub fn read<const S: usize>(bytes: &[u8]) -> Option<RawTable<S>> {
         let b = &bytes[4 * i..4 * i + 4];
         i32::from_le_bytes([b[0], b[1], b[2], b[3]])
     };
-    let mut segments = [[0i32; 4]; S];
-    for (k, seg) in segments.iter_mut().enumerate() {
-        for (j, v) in seg.iter_mut().enumerate() {
-            *v = word(HEADER_WORDS + 4 * k + j);
-        }
-    }
-    Some(RawTable {
-        strain_lo: word(0),
-        strain_hi: word(1),
-        index_pre: word(2) as u32,
-        index_scale: word(3) as u32,
-        anchor_lo: word(4),
-        force_lo: word(5),
-        stiffness_lo: word(6),
-        slope_lo: word(7),
-        force_hi: word(8),
-        stiffness_hi: word(9),
-        slope_hi: word(10),
-        shift: word(11) as u32,
-        stiff_scale: word(12),
-        stiff_post: word(13),
-        corner_hi: word(14),
-        corner_anchor: word(15),
-        corner_pre: word(16) as u32,
-        corner_base: word(17) as u32,
-        corner_scale: word(18),
-        corner_post: word(19),
-        err_force_ppb: word(20) as u32,
-        err_stiffness_ppb: word(21) as u32,
+    let header: [i32; HEADER_WORDS] = core::array::from_fn(word);
+    let segments =
+        core::array::from_fn(|k| core::array::from_fn(|j| word(HEADER_WORDS + 4 * k + j)));
+    Some(from_words(&header, segments))
+}
+
+/// The table of these words: the header's fields in order, and the segments.
+pub fn from_words<const S: usize>(h: &[i32; HEADER_WORDS], segments: [[i32; 4]; S]) -> RawTable<S> {
+    RawTable {
+        strain_lo: h[0],
+        strain_hi: h[1],
+        index_pre: h[2] as u32,
+        index_scale: h[3] as u32,
+        anchor_lo: h[4],
+        force_lo: h[5],
+        stiffness_lo: h[6],
+        slope_lo: h[7],
+        force_hi: h[8],
+        stiffness_hi: h[9],
+        slope_hi: h[10],
+        shift: h[11] as u32,
+        stiff_scale: h[12],
+        stiff_post: h[13],
+        corner_hi: h[14],
+        corner_anchor: h[15],
+        corner_pre: h[16] as u32,
+        corner_base: h[17] as u32,
+        corner_scale: h[18],
+        corner_post: h[19],
+        err_force_ppb: h[20] as u32,
+        err_stiffness_ppb: h[21] as u32,
         segments,
-    })
+    }
 }
 
 /// A table's hash: FNV-1a over its bytes, fed in 4-byte words (no buffer).

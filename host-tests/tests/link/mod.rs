@@ -2,3 +2,4 @@
 //! `device.rs`; the firmware in QEMU behind `mccs link` in `qemu.rs`.
 
 mod codec;
+mod device;
