@@ -6,6 +6,7 @@
 
 pub mod cli;
 pub mod fit;
+pub mod link;
 pub mod paramfile;
 pub mod patch;
 pub mod reference;

@@ -12,6 +12,7 @@ mod check;
 mod curve;
 mod demo;
 mod fit;
+mod link;
 mod patch;
 mod patch_args;
 mod progress;
@@ -179,6 +180,9 @@ enum Command {
     /// budget=<b> fits=yes|no`: the core's stability bound's substeps, the tick estimated
     /// from the bench's measured costs (exit 1 when it does not fit).
     Check(check::Args),
+    /// Talk to a device over the host link (docs/link.md): hello, status, load a tissue,
+    /// replay a trajectory on the device, watch its live telemetry, pose, arm, disarm.
+    Link(link::Args),
 }
 
 /// Runs the parsed command, writing its output to `out`.
@@ -194,6 +198,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Patch(a) => patch::run(a, out),
         Command::Replay(a) => replay::run(a, out),
         Command::Check(a) => check::run(a, out),
+        Command::Link(a) => link::run(a, out),
     }
 }
 

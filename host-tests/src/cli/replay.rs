@@ -30,6 +30,13 @@ pub(super) struct Args {
     tuning: TuningArgs,
     #[command(flatten)]
     table: TableArgs,
+    #[command(flatten)]
+    roam: RoamArgs,
+}
+
+/// The roaming options of `replay` and `link replay`.
+#[derive(clap::Args, Debug)]
+pub(super) struct RoamArgs {
     /// Roam a tissue of W,H nodes (3 … 64 each, at --spacing; --grid is the window) with
     /// a proxy that slides on its surface; the trajectory is then in the tissue's frame
     /// (origin at its centre, top at z = 0).
@@ -59,9 +66,10 @@ fn pair<T: std::str::FromStr>(arg: &str, text: &str, what: &str) -> Result<(T, T
     }
 }
 
-impl Args {
-    /// The roaming arguments, if `--tissue` is given; each error names its argument.
-    fn roaming(&self) -> Result<Option<Roaming>, CliError> {
+impl RoamArgs {
+    /// The roaming arguments on `patch`, if `--tissue` is given; each error names its
+    /// argument.
+    pub(super) fn roaming(&self, patch: &PatchArgs) -> Result<Option<Roaming>, CliError> {
         let Some(tissue) = &self.tissue else {
             for (given, arg) in [
                 (self.friction.is_some(), "--friction"),
@@ -87,14 +95,14 @@ impl Args {
             Some(radius) => Shape::Cap { radius },
             None => Shape::Flat,
         };
-        let named = |e: RoamError| self.roaming_error(e, (w, h), (mu_s, mu_k));
-        let tissue = Tissue::new(w, h, self.patch.spacing, shape).map_err(&named)?;
+        let named = |e: RoamError| self.roaming_error(patch, e, (w, h), (mu_s, mu_k));
+        let tissue = Tissue::new(w, h, patch.spacing, shape).map_err(&named)?;
         let friction = Friction::new(mu_s, mu_k).map_err(&named)?;
         let probe_radius = self.probe_radius.unwrap_or(0.0);
         if !(probe_radius.is_finite() && (0.0..=tissue.spacing / 2.0).contains(&probe_radius)) {
             return Err(named(RoamError::ProbeRadius));
         }
-        if self.patch.grid > w.min(h) {
+        if patch.grid > w.min(h) {
             return Err(named(RoamError::Window));
         }
         Ok(Some(Roaming {
@@ -106,8 +114,14 @@ impl Args {
 
     /// A refused roaming configuration as one line: the argument at fault, the rule, and
     /// what was given or computed from it.
-    fn roaming_error(&self, e: RoamError, (w, h): (usize, usize), mu: (f64, f64)) -> CliError {
-        let s = self.patch.spacing;
+    fn roaming_error(
+        &self,
+        patch: &PatchArgs,
+        e: RoamError,
+        (w, h): (usize, usize),
+        mu: (f64, f64),
+    ) -> CliError {
+        let s = patch.spacing;
         let extent = |n: usize| (n.saturating_sub(1)) as f64 * s;
         match e {
             RoamError::TissueSize => arg_error(
@@ -145,7 +159,7 @@ impl Args {
                 "--grid",
                 &format!(
                     "the window ({} nodes a side) must fit in the tissue ({w} × {h} nodes)",
-                    self.patch.grid
+                    patch.grid
                 ),
             ),
             RoamError::Friction => arg_error(
@@ -175,7 +189,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         integrator: a.patch.integrator.into(),
         ..a.tuning.config(a.patch.rate)?
     };
-    let roaming = a.roaming()?;
+    let roaming = a.roam.roaming(&a.patch)?;
     let p = paramfile::read(&a.params)?;
     match a.patch.backend {
         Backend::Reference => {
@@ -266,7 +280,7 @@ fn replay<const S: usize>(
     let done = match roaming {
         Some(roaming) => csv(
             w,
-            &format!("{LEADING_COLUMNS},{ROAMING_COLUMNS}"),
+            &header(true),
             |row| {
                 replay.roam_with(p, table, &traj, &roaming, |r: RoamRow| {
                     if let Some(line) = setup.take() {
@@ -274,27 +288,14 @@ fn replay<const S: usize>(
                     }
                     progress.at(r.time);
                     watch.see(r.time, r.probe, r.force);
-                    row(format!(
-                        "{},{},{},{},{},{},{},{},{},{},{}",
-                        fmt_time(r.time),
-                        r.force[0],
-                        r.force[1],
-                        r.force[2],
-                        r.max_disp,
-                        r.proxy[0],
-                        r.proxy[1],
-                        r.proxy[2],
-                        r.contact as u8,
-                        r.slipping as u8,
-                        r.window_shifts
-                    ))
+                    row(roam_line(&r))
                 })
             },
             fail,
         ),
         None => csv(
             w,
-            &format!("{LEADING_COLUMNS},{GLUED_COLUMNS}"),
+            &header(false),
             |row| {
                 replay.run_with(p, table, &traj, |r| {
                     if let Some(line) = setup.take() {
@@ -302,17 +303,7 @@ fn replay<const S: usize>(
                     }
                     progress.at(r.time);
                     watch.see(r.time, r.probe, r.force);
-                    row(format!(
-                        "{},{},{},{},{},{},{},{}",
-                        fmt_time(r.time),
-                        r.force[0],
-                        r.force[1],
-                        r.force[2],
-                        r.max_disp,
-                        r.contact[0],
-                        r.contact[1],
-                        r.contact[2],
-                    ))
+                    row(glued_line(&r))
                 })
             },
             fail,
@@ -322,6 +313,48 @@ fn replay<const S: usize>(
         eprintln!("{line}");
     }
     done
+}
+
+/// A glued tick's CSV line.
+pub(super) fn glued_line(r: &crate::replay::Row) -> String {
+    format!(
+        "{},{},{},{},{},{},{},{}",
+        fmt_time(r.time),
+        r.force[0],
+        r.force[1],
+        r.force[2],
+        r.max_disp,
+        r.contact[0],
+        r.contact[1],
+        r.contact[2],
+    )
+}
+
+/// A roaming tick's CSV line.
+pub(super) fn roam_line(r: &RoamRow) -> String {
+    format!(
+        "{},{},{},{},{},{},{},{},{},{},{}",
+        fmt_time(r.time),
+        r.force[0],
+        r.force[1],
+        r.force[2],
+        r.max_disp,
+        r.proxy[0],
+        r.proxy[1],
+        r.proxy[2],
+        r.contact as u8,
+        r.slipping as u8,
+        r.window_shifts
+    )
+}
+
+/// The CSV header of a mode.
+pub(super) fn header(roaming: bool) -> String {
+    if roaming {
+        format!("{LEADING_COLUMNS},{ROAMING_COLUMNS}")
+    } else {
+        format!("{LEADING_COLUMNS},{GLUED_COLUMNS}")
+    }
 }
 
 /// Writes `header`, then each line `run` hands its row function; stops writing at the

@@ -68,7 +68,7 @@ fn assert_usage_error(out: &Output, needles: &[&str]) {
 
 /// Asserts exit 2, empty stdout, and exactly one stderr line containing every `needle` —
 /// for a mistake found past the argument parser (no usage hint).
-fn assert_one_line_error(out: &Output, needles: &[&str]) {
+pub(crate) fn assert_one_line_error(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
     assert!(out.stdout.is_empty(), "stdout not empty");
