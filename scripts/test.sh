@@ -157,7 +157,7 @@ board_f405() {
   local t=thumbv7em-none-eabihf elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
   local init='haptic_f405::firmware::init'
   cargo build --release -p haptic-f405 --target "$t" --bin haptic-f405 || return 1
-  python3 scripts/size.py "$elf" "$t" haptic-f405 98304 16384 | tee target/qemu/sizes-f405.txt
+  python3 scripts/size.py "$elf" "$t" haptic-f405 98304 32768 | tee target/qemu/sizes-f405.txt
   [ "${PIPESTATUS[0]}" = 0 ] || return 1
   python3 scripts/check_tick_path.py "$elf" TIM2 "$init" | tail -n 1 || return 1
   bash scripts/f405-qemu.sh > target/qemu/f405.log || { tail -n 5 target/qemu/f405.log; return 1; }
@@ -169,7 +169,18 @@ board_f405() {
 # The property tests on a fixed seed, so that a run is reproducible (`cargo test` alone
 # draws a new one each time, and so does scripts/long.sh: they explore).
 host_tests() {
-  PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-2026} cargo test --workspace --no-fail-fast -- --show-output
+  PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-2026} cargo test --workspace --no-fail-fast -- --show-output \
+    --skip link::qemu::
+}
+
+# The host link against the board firmware in QEMU (scripts/qemu-link.sh, which builds it
+# with the link's QEMU feature): one test, its figures in target/qemu/link.log.
+link_qemu() {
+  MCCS_LINK_QEMU=1 cargo test -p mccs-host --test host link::qemu:: -- --show-output \
+    > target/qemu/link.log 2>&1
+  local status=$?
+  grep -E '^LINK |test result' target/qemu/link.log
+  return $status
 }
 
 # The host tests need only the host build, and they run beside the firmware stages (a
@@ -221,6 +232,7 @@ run_stage budget-breach-fails budget_test
 run_stage bench-truncated-fails bench_truncated
 run_stage firmware-size sizes
 run_stage board-f405 board_f405
+run_stage link-qemu link_qemu
 run_stage host-tests wait_host_tests
 run_stage docs-figures python3 scripts/figures.py check
 

@@ -267,6 +267,11 @@ impl<
         &self.device
     }
 
+    /// The device, to set what it holds between ticks (a link's pose and gain).
+    pub fn device_mut(&mut self) -> &mut D {
+        &mut self.device
+    }
+
     /// The solver and the device back.
     pub fn into_parts(self) -> (Solver<NODES, EDGES, S, A>, D) {
         (self.solver, self.device)

@@ -5,13 +5,22 @@
 //! switches to it between two ticks. The value moves whole inside a critical section, so
 //! a tick sees the old value or the new one, never a mix. No `RefCell`: no borrow panic.
 
-use core::cell::Cell;
+use core::cell::{Cell, UnsafeCell};
+use core::mem::MaybeUninit;
 use critical_section::Mutex;
 
-/// A one-slot mailbox shared between contexts.
+/// A one-slot mailbox shared between contexts. Empty, it is all zero bytes, so that a
+/// `static` mailbox lies in `.bss` and costs no flash for its image (an `Option<T>`
+/// whose `None` is a niche value put a parameter set's 1.1 KB in `.data`).
 pub struct Mailbox<T> {
-    slot: Mutex<Cell<Option<T>>>,
+    full: Mutex<Cell<bool>>,
+    value: UnsafeCell<MaybeUninit<T>>,
 }
+
+// SAFETY: `value` is only read or written inside a critical section, and only as `full`
+// says (written when empty, read once when full), so the value moves between contexts
+// whole, as with `Mutex<Cell<Option<T>>>`.
+unsafe impl<T: Send> Sync for Mailbox<T> {}
 
 impl<T> Default for Mailbox<T> {
     fn default() -> Self {
@@ -23,18 +32,44 @@ impl<T> Mailbox<T> {
     /// Empty.
     pub const fn new() -> Self {
         Self {
-            slot: Mutex::new(Cell::new(None)),
+            full: Mutex::new(Cell::new(false)),
+            value: UnsafeCell::new(MaybeUninit::uninit()),
         }
     }
 
     /// Puts `value` in the slot; returns the value it replaces if that was never taken.
     pub fn post(&self, value: T) -> Option<T> {
-        critical_section::with(|cs| self.slot.borrow(cs).replace(Some(value)))
+        critical_section::with(|cs| {
+            let full = self.full.borrow(cs);
+            // SAFETY: inside the critical section; the value is read only when full.
+            let slot = unsafe { &mut *self.value.get() };
+            let old = full.get().then(|| unsafe { slot.assume_init_read() });
+            slot.write(value);
+            full.set(true);
+            old
+        })
     }
 
     /// Takes the value, if any.
     pub fn take(&self) -> Option<T> {
-        critical_section::with(|cs| self.slot.borrow(cs).take())
+        critical_section::with(|cs| {
+            let full = self.full.borrow(cs);
+            if !full.get() {
+                return None;
+            }
+            full.set(false);
+            // SAFETY: inside the critical section, and full: written by `post`, read once.
+            Some(unsafe { (*self.value.get()).assume_init_read() })
+        })
+    }
+}
+
+impl<T> Drop for Mailbox<T> {
+    fn drop(&mut self) {
+        if *self.full.get_mut().get_mut() {
+            // SAFETY: full: the value was written and not taken.
+            unsafe { self.value.get_mut().assume_init_drop() };
+        }
     }
 }
 
@@ -59,5 +94,17 @@ impl<T: Copy> Shared<T> {
     /// The value.
     pub fn get(&self) -> T {
         critical_section::with(|cs| self.cell.borrow(cs).get())
+    }
+
+    /// Reads, changes and writes the value in one critical section (no update between
+    /// the read and the write is lost); returns what `f` returns.
+    pub fn update<R>(&self, f: impl FnOnce(&mut T) -> R) -> R {
+        critical_section::with(|cs| {
+            let cell = self.cell.borrow(cs);
+            let mut v = cell.get();
+            let r = f(&mut v);
+            cell.set(v);
+            r
+        })
     }
 }

@@ -244,6 +244,8 @@ pub struct StatusInfo {
     pub fault: bool,
     /// Whether a replay runs.
     pub replaying: bool,
+    /// The tissue's origin the host last set (Q24 mm; the tick moves toward it).
+    pub pose: [i32; 3],
 }
 
 /// A live tick.

@@ -25,7 +25,7 @@ HelloInfo{protocol:u16,schema:u32,core:Core,tick_hz:u32,grid:u8,max_grid:u8,tiss
 tissue_h:u8,knots:u16,tissue:u32,path_capacity:u32}Core{M0;M3;M4f}\
 NakReason{Busy;Order;Length;Hash;Segments;Table;Bound;Solver;NoTissue;Option{option:SpecOption,limit:i32}}\
 SpecOption{Grid;Spacing;Rate;NodeMass;Arith;Tissue;CapRadius;Samples;Config}\
-StatusInfo{ticks:u32,overruns:u32,bad_frames:u32,dropped_telemetry:u32,armed:bool,fault:bool,replaying:bool}\
+StatusInfo{ticks:u32,overruns:u32,bad_frames:u32,dropped_telemetry:u32,armed:bool,fault:bool,replaying:bool,pose:[i32;3]}\
 Telemetry{seq:u32,tick:u32,probe:[i32;3],force:[i32;3],gain:u16,flags:u8,dropped:u32}\
 ReplayRow{tick:u32,force:[i32;3],point:[i32;3],origin:[i32;2],max_disp:[i32;3],flags:u8,shifts:u32}";
 

@@ -11,6 +11,7 @@ use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
 use mccs::{ForceTable, Solver, SolverError, Topology, TopologyError};
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
+use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::one_dof::{OneDofDevice, OneDofError};
 use mccs_firmware::{Controller, HapticDevice};
 
@@ -36,6 +37,12 @@ pub type BoardDeviceError<SPI, PWM, DIR, EN> = OneDofError<
     <DIR as embedded_hal::digital::ErrorType>::Error,
     <EN as embedded_hal::digital::ErrorType>::Error,
 >;
+/// The board's device as the tick drives it: with the host link's pose and force gain
+/// ([`LinkedDevice`]; standalone, it is the device as wired).
+pub type Linked<SPI, PWM, DIR, EN> = LinkedDevice<BoardDevice<SPI, PWM, DIR, EN>>;
+/// The largest step of the tissue's pose per tick, mm (10 mm/s at 1 kHz: a moved organ,
+/// breathing), whatever the host asks.
+pub const MAX_POSE_STEP_MM: f64 = 0.01;
 /// The board's controller on a device, for a force table of `S` segments (by default the
 /// board's tissue's, [`crate::tissue::TISSUE`]).
 pub type BoardController<D, const S: usize = SEGMENTS> = Controller<D, NODES, EDGES, S>;
@@ -173,7 +180,7 @@ pub fn controller_into<SPI, PWM, DIR, EN, const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
     mut device: BoardDevice<SPI, PWM, DIR, EN>,
-    slot: &mut Option<BoardController<BoardDevice<SPI, PWM, DIR, EN>, S>>,
+    slot: &mut Option<BoardController<Linked<SPI, PWM, DIR, EN>, S>>,
 ) -> Result<
     (),
     (
@@ -201,6 +208,10 @@ where
         let _ = device.safe_state();
         return Err((StartError::SafeState(OneDofError::Motor(e)), device));
     }
-    *slot = Some(Controller::new(solver, device, u32::MAX));
+    *slot = Some(Controller::new(
+        solver,
+        LinkedDevice::new(device, MAX_POSE_STEP_MM),
+        u32::MAX,
+    ));
     Ok(())
 }

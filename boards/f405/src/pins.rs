@@ -11,13 +11,15 @@
 //! | Motor PWM         | PA8 | TIM1 CH1 AF1, 20 kHz          | input, floating           |
 //! | Motor direction   | PB0 | push-pull output, low = −z    | input, floating           |
 //! | Motor enable      | PB1 | push-pull output, high = on   | input, floating           |
+//! | Host link TX      | PA2 | USART2 AF7, 115200 8N1        | input, floating           |
+//! | Host link RX      | PA3 | USART2 AF7                    | input, floating           |
 //!
 //! Every pin is a floating input from reset until the firmware drives it: the motor
 //! driver's enable and PWM inputs need pull-downs on the board (most driver boards have
 //! them), so that a reset — the watchdog's included — leaves the driver off.
 
 use stm32f4xx_hal::gpio::{
-    gpioa, gpiob, Output, PinState, PushPull, PA4, PA5, PA6, PA7, PA8, PB0, PB1,
+    gpioa, gpiob, Output, PinState, PushPull, PA2, PA3, PA4, PA5, PA6, PA7, PA8, PB0, PB1,
 };
 
 /// The encoder's chip select.
@@ -43,6 +45,10 @@ pub struct Pins {
     pub direction: MotorDirection,
     /// Motor enable, low (driver off).
     pub enable: MotorEnable,
+    /// The host link's USART2 TX.
+    pub link_tx: PA2,
+    /// The host link's USART2 RX.
+    pub link_rx: PA3,
 }
 
 impl Pins {
@@ -57,6 +63,8 @@ impl Pins {
             pwm: a.pa8,
             direction: b.pb0.into_push_pull_output_in_state(PinState::Low),
             enable: b.pb1.into_push_pull_output_in_state(PinState::Low),
+            link_tx: a.pa2,
+            link_rx: a.pa3,
         }
     }
 }

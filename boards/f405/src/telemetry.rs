@@ -22,6 +22,10 @@ pub struct BoardTelemetry {
     pub encoder: EncoderErrors,
     /// The tick (0-based) on which the safe state was entered.
     pub fault_tick: Option<u32>,
+    /// The probe as the last tick read it, in the tissue's frame (Q24 mm).
+    pub probe: [i32; 3],
+    /// The host link's force gain on the last tick (Q15).
+    pub gain: u16,
 }
 
 impl BoardTelemetry {
@@ -39,6 +43,8 @@ impl BoardTelemetry {
                 consecutive: 0,
             },
             fault_tick: None,
+            probe: [0; 3],
+            gain: mccs_firmware::link::guard::FULL,
         }
     }
 

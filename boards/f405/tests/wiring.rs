@@ -373,7 +373,7 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     let mut t = BoardTelemetry::new();
     for _ in 0..ticks {
         ctl.tick(None);
-        t.record(ctl.telemetry(), 0, 0, ctl.device().encoder.errors());
+        t.record(ctl.telemetry(), 0, 0, ctl.device().inner().encoder.errors());
     }
     assert_eq!(t.run.fault, Some(Fault::Read));
     assert_eq!(t.fault_tick, Some(fault_tick));
@@ -499,7 +499,7 @@ fn a_press_renders_an_upward_force() {
         last = ctl.tick(None);
     }
     assert_eq!(ctl.telemetry().fault, None);
-    assert_eq!(ctl.device().encoder.errors().implausible, 0);
+    assert_eq!(ctl.device().inner().encoder.errors().implausible, 0);
     let f = last[2].to_num::<f64>();
     assert!(
         f > 0.05 && f < BOARD.force_at_full_duty,

@@ -61,7 +61,9 @@ impl<D: HapticDevice> HapticDevice for LinkedDevice<D> {
     fn read_position(&mut self) -> Result<[Length; 3], Self::Error> {
         for k in 0..3 {
             let d = self.target[k].saturating_sub(self.origin[k]);
-            self.origin[k] = self.origin[k].saturating_add(d.clamp(-self.max_step, self.max_step));
+            // (Not `clamp`, which asserts its bounds: a panic path in the tick.)
+            self.origin[k] =
+                self.origin[k].saturating_add(d.max(-self.max_step).min(self.max_step));
         }
         let p = self.device.read_position()?;
         self.probe =

@@ -38,6 +38,8 @@ pub struct Now {
     pub fault: bool,
     /// A host holds the device armed.
     pub armed: bool,
+    /// The tissue's origin the host last set (Q24 mm).
+    pub pose: [i32; 3],
 }
 
 /// What the firmware applies after a message.
@@ -119,6 +121,7 @@ impl<const S: usize> Session<S> {
             armed: now.armed,
             fault: now.fault,
             replaying,
+            pose: now.pose,
         }
     }
 

@@ -231,8 +231,16 @@ fn status_line(link: &mut Link, addr: &str, out: &mut dyn Write) -> Result<(), C
     };
     writeln!(
         out,
-        "ticks={} overruns={} bad_frames={} dropped_telemetry={} armed={} fault={}",
-        s.ticks, s.overruns, s.bad_frames, s.dropped_telemetry, s.armed as u8, s.fault as u8
+        "ticks={} overruns={} bad_frames={} dropped_telemetry={} armed={} fault={} pose={},{},{}",
+        s.ticks,
+        s.overruns,
+        s.bad_frames,
+        s.dropped_telemetry,
+        s.armed as u8,
+        s.fault as u8,
+        mccs::Length::from_bits(s.pose[0]).to_num::<f64>(),
+        mccs::Length::from_bits(s.pose[1]).to_num::<f64>(),
+        mccs::Length::from_bits(s.pose[2]).to_num::<f64>(),
     )
     .map_err(io_error)
 }
@@ -270,12 +278,16 @@ fn load(
         hash,
     })
     .map_err(gone)?;
+    // One chunk at a time: the status after each says the device has taken it (its
+    // receive queue is not overrun while it works).
     for (i, c) in bytes.chunks(200).enumerate() {
         link.send(&ToDevice::TissueChunk {
             offset: (i * 200) as u32,
             bytes: c,
         })
         .map_err(gone)?;
+        link.send(&ToDevice::Status).map_err(gone)?;
+        expect(link, addr, |m| matches!(m, ToHost::Status(_)))?;
     }
     link.send(&ToDevice::TissueCommit).map_err(gone)?;
     match expect(link, addr, |m| matches!(m, ToHost::Ack { .. }))? {

@@ -36,6 +36,7 @@ pub fn serve(socket: &Path, table: ForceTable64) -> std::io::Result<std::thread:
             session: Session::<64>::new(live, table),
             replayer: Box::new(Replayer::new(false)),
             guard: Guard::at_rate(1000),
+            pose: [0; 3],
             start: Instant::now(),
         };
         for stream in listener.incoming() {
@@ -52,6 +53,7 @@ struct Device {
     session: Session<64>,
     replayer: Box<Replayer<NODES, EDGES, 64, Wide, PATH>>,
     guard: Guard,
+    pose: [i32; 3],
     start: Instant,
 }
 
@@ -60,6 +62,7 @@ fn run(mut stream: UnixStream, d: &mut Device) {
         session,
         replayer,
         guard,
+        pose,
         start,
     } = d;
     let mut decoder = Decoder::new();
@@ -98,6 +101,7 @@ fn run(mut stream: UnixStream, d: &mut Device) {
                             overruns: 0,
                             fault: false,
                             armed: guard.armed(),
+                            pose: *pose,
                         };
                         match session.handle(msg, now, replayer, &mut send) {
                             Effect::Arm => guard.arm(tick),
@@ -105,7 +109,8 @@ fn run(mut stream: UnixStream, d: &mut Device) {
                             Effect::Swap { set, tissue } => {
                                 session.swapped(*set.table(), tissue, &mut send)
                             }
-                            Effect::Pose(_) | Effect::None => {}
+                            Effect::Pose(p) => *pose = p,
+                            Effect::None => {}
                         }
                     }
                     Err(_) => session.bad_frame(),

@@ -37,7 +37,7 @@ fn hello_status_arm_pose_and_load() {
     );
     let status = line(&mccs_ok(&["link", "--connect", &addr, "status"]));
     assert!(
-        status.starts_with("ticks=") && status.ends_with("armed=0 fault=0"),
+        status.starts_with("ticks=") && status.ends_with("armed=0 fault=0 pose=0,0,0"),
         "{status}"
     );
     assert!(line(&mccs_ok(&["link", "--connect", &addr, "arm"])).contains("armed=1"));
@@ -53,6 +53,7 @@ fn hello_status_arm_pose_and_load() {
         ])),
         "pose origin=1,-2.5,0"
     );
+    assert!(line(&mccs_ok(&["link", "--connect", &addr, "status"])).ends_with("pose=1,-2.5,0"));
     // A load: the device acknowledges the tissue by its hash, and says it after.
     let ack = line(&mccs_ok(&[
         "link",
@@ -181,4 +182,51 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
         dev.extend_from_slice(extra);
         crate::cli::assert_one_line_error(&mccs(&dev), &[needle]);
     }
+}
+
+/// A device of another schema is refused by the host, in one line naming both.
+#[test]
+fn a_device_of_another_schema_is_refused() {
+    use mccs_link::message::{Core, HelloInfo, ToHost};
+    use std::io::{Read, Write};
+    let dir = std::env::temp_dir().join(format!("mccs-link-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let socket = dir.join("foreign.sock");
+    let _ = std::fs::remove_file(&socket);
+    let listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    std::thread::spawn(move || {
+        let (mut s, _) = listener.accept().unwrap();
+        let mut b = [0u8; 64];
+        let _ = s.read(&mut b);
+        let hello = ToHost::Hello(HelloInfo {
+            protocol: 1,
+            schema: 0x1234_5678,
+            core: Core::M4f,
+            tick_hz: 1000,
+            grid: 5,
+            max_grid: 8,
+            tissue_w: 5,
+            tissue_h: 5,
+            knots: 65,
+            tissue: 0,
+            path_capacity: 64,
+        });
+        let mut f = [0u8; mccs_link::MAX_FRAME];
+        let frame = mccs_link::encode(&hello, &mut f).unwrap();
+        s.write_all(frame).unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(500));
+    });
+    let out = mccs(&[
+        "link",
+        "--connect",
+        &format!("unix:{}", socket.display()),
+        "status",
+    ]);
+    crate::cli::assert_one_line_error(
+        &out,
+        &[&format!(
+            "the device speaks protocol 1 schema 12345678, this mccs protocol 1 schema {:08x}",
+            mccs_link::SCHEMA
+        )],
+    );
 }

@@ -90,6 +90,7 @@ fn every_message() -> (Vec<ToDevice<'static>>, Vec<ToHost>) {
             armed: true,
             fault: true,
             replaying: true,
+            pose: [1, -2, 3],
         }),
         ToHost::Telemetry(Telemetry {
             seq: 1,
@@ -164,7 +165,7 @@ fn the_schema_moves_with_the_encoding() {
     let golden = mccs_link::schema::fnv1a(&all);
     assert_eq!(
         (SCHEMA, golden),
-        (0x110f_fbd3, 0xcf96_799b),
+        (0xa28e_f31a, 0x7f07_592d),
         "schema {SCHEMA:#010x}, encoding {golden:#010x}"
     );
 }

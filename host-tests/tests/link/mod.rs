@@ -4,3 +4,4 @@
 mod cli;
 mod codec;
 mod device;
+mod qemu;

@@ -10,7 +10,12 @@
 //! - Each tick: clear the update, one controller tick (read, solve, write; a device error
 //!   latches the safe state, re-asserted every tick after), feed the watchdog, time it.
 //!   A tick that ends with the next update already pending is an overrun.
-//! - The main loop logs the tick statistics every second.
+//! - The main loop logs the tick statistics every second, and runs the host link
+//!   (docs/link.md): USART2's receive interrupt queues the bytes; the main loop decodes
+//!   them, answers (transmit polled: QEMU 7.2 models no TXE interrupt), runs replays on
+//!   its own solver, and hands the tick what it must see — the guard's arm and disarm,
+//!   the pose, a checked tissue — through shared state and a mailbox. The tick never
+//!   waits on the link.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -36,21 +41,48 @@ mod firmware {
     use cortex_m_rt::entry;
     use embedded_hal_bus::spi::{ExclusiveDevice, NoDelay};
     use haptic_f405::config::{self, spi_clock_hz, tick_timer, AS5047P_MAX_SPI_HZ, BOARD};
-    use haptic_f405::device::{self, BoardController, BoardDevice, StartFault};
+    use haptic_f405::device::{
+        self, BoardController, Linked, StartFault, EDGES, NODES, SPACING_MM,
+    };
     use haptic_f405::pins::{EncoderCs, MotorDirection, MotorEnable, Pins};
     use haptic_f405::telemetry::BoardTelemetry;
     use haptic_f405::tissue::TISSUE;
+    use heapless::spsc::{Consumer, Producer, Queue};
+    use mccs::{ForceTable, ParamSet, Wide};
+    use mccs_firmware::link::{Effect, Guard, Live, Now, Replayer, Session};
     use mccs_firmware::{Mailbox, Shared};
+    use mccs_link::{frame::parse, Core, Decoder, ToDevice, ToHost, MAX_FRAME};
     use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
     use stm32f4xx_hal::prelude::*;
+    use stm32f4xx_hal::serial::{Rx, Tx};
     use stm32f4xx_hal::spi::Spi;
     use stm32f4xx_hal::timer::{PwmChannel, Timer};
     use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
     type Encoder = ExclusiveDevice<Spi<pac::SPI1>, EncoderCs, NoDelay>;
     type Motor = PwmChannel<pac::TIM1, 0>;
-    type Device = BoardDevice<Encoder, Motor, MotorDirection, MotorEnable>;
-    type Ctl = BoardController<Device>;
+    type Device = haptic_f405::device::BoardDevice<Encoder, Motor, MotorDirection, MotorEnable>;
+    type Ctl = BoardController<Linked<Encoder, Motor, MotorDirection, MotorEnable>>;
+    type Segments = ParamSet<{ haptic_f405::tissue::SEGMENTS }, Wide>;
+
+    /// Path samples a replay buffers.
+    const PATH: usize = 128;
+    /// Bytes the receive interrupt queues for the main loop: more than a replay's credit
+    /// of path samples in frames (128 × 12 B and their framing), and more than a tissue
+    /// chunk while the main loop checks a tissue (the host waits for each chunk's status).
+    const RX_QUEUE: usize = 2048;
+
+    /// The link's guard, read and stepped by the tick, armed by the main loop.
+    static GUARD: Shared<Guard> = Shared::new(Guard::at_rate(BOARD.tick_hz));
+    /// The tissue's origin the host asked for (Q24 mm).
+    static POSE: Shared<[i32; 3]> = Shared::new([0; 3]);
+    /// A checked tissue for the tick to swap in; the flag spares the tick the copy.
+    static SWAP: Mailbox<Segments> = Mailbox::new();
+    static SWAP_READY: Shared<bool> = Shared::new(false);
+    /// USART2's receiver and the queue's producer, for its interrupt.
+    static LINK_RX: Mailbox<(Rx<pac::USART2>, Producer<'static, u8>)> = Mailbox::new();
+    /// Bytes the queue could not take.
+    static RX_DROPPED: Shared<u32> = Shared::new(0);
 
     /// What `main` hands the tick.
     struct Hardware {
@@ -103,6 +135,23 @@ mod firmware {
         }
 
         let pins = Pins::take(dp.GPIOA.split(), dp.GPIOB.split());
+        // The host link: USART2 at 115200 8N1, its receive interrupt feeding a queue.
+        let Ok(serial) = dp.USART2.serial(
+            (pins.link_tx, pins.link_rx),
+            stm32f4xx_hal::serial::Config::default().baudrate(115_200.bps()),
+            &clocks,
+        ) else {
+            fail("USART2: the clock cannot make 115200 baud")
+        };
+        let (link_tx, mut link_rx) = serial.split();
+        link_rx.listen();
+        let queue: &'static mut Queue<u8, RX_QUEUE> = {
+            static mut QUEUE: Queue<u8, RX_QUEUE> = Queue::new();
+            // SAFETY: the one reference to QUEUE, taken once before any interrupt runs.
+            unsafe { &mut *core::ptr::addr_of_mut!(QUEUE) }
+        };
+        let (producer, consumer) = queue.split();
+        let _ = LINK_RX.post((link_rx, producer));
         let spi_hz = spi_clock_hz(clocks.pclk2().raw(), BOARD.spi_request_hz);
         if spi_hz == 0 || spi_hz > AS5047P_MAX_SPI_HZ {
             fail_with(StartFault::Config(config::BoardConfigError::SpiTooFast));
@@ -150,8 +199,12 @@ mod firmware {
         }
         // The tick's first run builds the controller and starts the timer.
         NVIC::pend(Interrupt::TIM2);
-        // SAFETY: the handler shares state only through `Mailbox` and `Shared`.
-        unsafe { NVIC::unmask(Interrupt::TIM2) };
+        // SAFETY: the handlers share state only through `Mailbox`, `Shared` and the
+        // queue's two ends.
+        unsafe {
+            NVIC::unmask(Interrupt::TIM2);
+            NVIC::unmask(Interrupt::USART2);
+        }
         cortex_m::asm::isb();
         let (springs, substeps) = match START.get() {
             Start::Running { springs, substeps } => (springs, substeps),
@@ -180,17 +233,161 @@ mod firmware {
                 e.stiffness as f32
             );
         }
+        let mut link = HostLink::new(link_tx, consumer);
         let mut next_log = BOARD.tick_hz;
         loop {
-            cortex_m::asm::wfi();
+            let busy = link.poll();
+            if !busy {
+                cortex_m::asm::wfi();
+            }
             let t = TELEMETRY.get();
             if t.run.ticks >= next_log {
                 next_log = next_log.saturating_add(BOARD.tick_hz);
                 log_second(&t);
             }
-            #[cfg(feature = "qemu")]
+            // A QEMU run ends after its ticks, unless it serves a host link.
+            #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
             if t.run.ticks >= BOARD.qemu_ticks {
                 qemu_end(&t);
+            }
+        }
+    }
+
+    /// The main loop's end of the host link.
+    struct HostLink {
+        tx: Tx<pac::USART2>,
+        rx: Consumer<'static, u8>,
+        decoder: Decoder,
+        session: Session<{ haptic_f405::tissue::SEGMENTS }>,
+        replayer:
+            &'static mut Replayer<NODES, EDGES, { haptic_f405::tissue::SEGMENTS }, Wide, PATH>,
+        /// A swap posted: its table, hash and the tick's swap count before it.
+        pending: Option<(ForceTable<{ haptic_f405::tissue::SEGMENTS }>, u32, u32, u32)>,
+    }
+
+    impl HostLink {
+        fn new(tx: Tx<pac::USART2>, rx: Consumer<'static, u8>) -> Self {
+            // In `.bss` (an initialised 13 KB static would take its image in flash), and
+            // written once here.
+            static mut REPLAYER: core::mem::MaybeUninit<
+                Replayer<NODES, EDGES, { haptic_f405::tissue::SEGMENTS }, Wide, PATH>,
+            > = core::mem::MaybeUninit::uninit();
+            let live = Live {
+                core: Core::M4f,
+                grid: BOARD.grid,
+                spacing: SPACING_MM,
+                config: BOARD.solver(),
+            };
+            Self {
+                tx,
+                rx,
+                decoder: Decoder::new(),
+                session: Session::new(live, TISSUE),
+                // SAFETY: the one reference to REPLAYER, taken once in the main loop, and
+                // initialised before it is read.
+                replayer: unsafe {
+                    (*core::ptr::addr_of_mut!(REPLAYER)).write(Replayer::new(false))
+                },
+                pending: None,
+            }
+        }
+
+        /// Everything the link has to do now; whether there is more.
+        fn poll(&mut self) -> bool {
+            let t = TELEMETRY.get();
+            let mut now = Now {
+                ticks: t.run.ticks,
+                overruns: t.run.overruns,
+                fault: t.run.fault.is_some(),
+                armed: GUARD.get().armed(),
+                pose: POSE.get(),
+            };
+            let tx = &mut self.tx;
+            let mut send = |m: &ToHost| {
+                let mut buf = [0u8; MAX_FRAME];
+                if let Ok(frame) = mccs_link::encode(m, &mut buf) {
+                    for &b in frame {
+                        let _ = nb::block!(embedded_hal_nb::serial::Write::write(tx, b));
+                    }
+                }
+            };
+            let mut bytes = 0;
+            while let Some(b) = self.rx.dequeue() {
+                bytes += 1;
+                let Some(frame) = self.decoder.push(b) else {
+                    continue;
+                };
+                let msg = match frame.and_then(parse::<ToDevice>) {
+                    Ok(m) => m,
+                    Err(_) => {
+                        self.session.bad_frame();
+                        continue;
+                    }
+                };
+                GUARD.update(|g| g.frame(now.ticks));
+                match self.session.handle(msg, now, self.replayer, &mut send) {
+                    Effect::None => {}
+                    Effect::Arm => GUARD.update(|g| g.arm(now.ticks)),
+                    Effect::Disarm => GUARD.update(|g| g.disarm()),
+                    Effect::Pose(origin) => {
+                        POSE.set(origin);
+                        now.pose = origin;
+                    }
+                    Effect::Swap { set, tissue } => {
+                        self.pending =
+                            Some((*set.table(), tissue, t.run.swaps, t.run.rejected_swaps));
+                        let _ = SWAP.post(set);
+                        SWAP_READY.set(true);
+                    }
+                }
+                if bytes >= 512 {
+                    break;
+                }
+            }
+            if let Some((table, tissue, swaps, rejected)) = self.pending {
+                let t = TELEMETRY.get();
+                if t.run.swaps > swaps {
+                    self.session.swapped(table, tissue, &mut send);
+                    self.pending = None;
+                } else if t.run.rejected_swaps > rejected {
+                    send(&ToHost::Nak(mccs_link::NakReason::Solver));
+                    self.pending = None;
+                }
+            }
+            let mut stepped = 0;
+            while stepped < 4 && self.replayer.step(&mut send) {
+                stepped += 1;
+            }
+            let flags = (t.run.force != [mccs::Force::ZERO; 3]) as u8
+                | ((now.armed as u8) << 2)
+                | ((now.fault as u8) << 3);
+            self.session.telemetry(
+                t.run.ticks,
+                t.probe,
+                t.run.force.map(|f| f.to_bits()),
+                t.gain,
+                flags,
+                &mut |m| {
+                    send(m);
+                    true
+                },
+            );
+            bytes > 0 || stepped > 0 || self.rx.ready()
+        }
+    }
+
+    #[interrupt]
+    fn USART2() {
+        static mut RX: Option<(Rx<pac::USART2>, Producer<'static, u8>)> = None;
+        if RX.is_none() {
+            *RX = LINK_RX.take();
+        }
+        let Some((rx, producer)) = RX.as_mut() else {
+            return;
+        };
+        while let Ok(b) = embedded_hal_nb::serial::Read::read(rx) {
+            if producer.enqueue(b).is_err() {
+                RX_DROPPED.update(|n| *n = n.saturating_add(1));
             }
         }
     }
@@ -217,20 +414,40 @@ mod firmware {
 
     #[interrupt]
     fn TIM2() {
-        static mut CTL: Option<Ctl> = None;
+        // The controller in `.bss`: an `Option<Ctl>` static is initialised data (its
+        // `None` is a niche value), 8 KB of flash for its image. Written `None` once.
+        static mut CTL: core::mem::MaybeUninit<Option<Ctl>> = core::mem::MaybeUninit::uninit();
+        static mut CTL_WRITTEN: bool = false;
         static mut HW: Option<(TickTimer, IndependentWatchdog)> = None;
-        let (Some(ctl), Some((tick, watchdog))) = (CTL.as_mut(), HW.as_mut()) else {
-            init(CTL, HW);
+        if !*CTL_WRITTEN {
+            CTL.write(None);
+            *CTL_WRITTEN = true;
+        }
+        // SAFETY: written above before its first read.
+        let slot = unsafe { CTL.assume_init_mut() };
+        let (Some(ctl), Some((tick, watchdog))) = (slot.as_mut(), HW.as_mut()) else {
+            init(slot, HW);
             return;
         };
         let start = cycles();
         tick.clear();
-        #[cfg(feature = "qemu")]
+        #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
         if ctl.telemetry().ticks >= BOARD.qemu_ticks {
             tick.stop();
             return;
         }
-        ctl.tick(None);
+        let ticks = ctl.telemetry().ticks;
+        let gain = GUARD.update(|g| g.gain(ticks));
+        let d = ctl.device_mut();
+        d.set_gain(gain);
+        d.set_target(POSE.get());
+        let swap = if SWAP_READY.get() {
+            SWAP_READY.set(false);
+            SWAP.take()
+        } else {
+            None
+        };
+        ctl.tick(swap);
         watchdog.feed();
         let us = tick.count();
         let cycles = elapsed(start, cycles());
@@ -238,7 +455,14 @@ mod firmware {
             ctl.note_overrun();
         }
         let mut t = TELEMETRY.get();
-        t.record(ctl.telemetry(), us, cycles, ctl.device().encoder.errors());
+        t.record(
+            ctl.telemetry(),
+            us,
+            cycles,
+            ctl.device().inner().encoder.errors(),
+        );
+        t.probe = ctl.device().probe().map(|c| c.to_bits());
+        t.gain = gain;
         TELEMETRY.set(t);
     }
 
@@ -312,7 +536,7 @@ mod firmware {
             self.0.cr1().modify(|_, w| w.cen().set_bit());
             self.0.cnt().write(|w| w.cnt().set(0));
         }
-        #[cfg(feature = "qemu")]
+        #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
         fn stop(&mut self) {
             self.0.dier().modify(|_, w| w.uie().clear_bit());
         }
@@ -336,7 +560,7 @@ mod firmware {
 
     /// The end of a QEMU run: the SUMMARY, held to the fault rules (the encoder reads
     /// zeros in QEMU), and the exit through semihosting.
-    #[cfg(feature = "qemu")]
+    #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
     fn qemu_end(t: &BoardTelemetry) -> ! {
         use haptic_f405::telemetry::qemu_verdict;
         let verdict = qemu_verdict(&BOARD, t);

@@ -202,6 +202,8 @@ mod firmware {
         figs.report("tick", ticks::tick(&h, table, probe) - empty);
         // One tick of the demo's patch through a sliding proxy (issue #19).
         figs.report("tick_proxy", ticks::tick_proxy(&h, table) - empty);
+        // What the host link adds to a tick (the board's TIM2).
+        figs.report("tick_link", ticks::tick_link(&h, table));
         // The solver's start-up for the demo's patch, once (millions of instructions).
         let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
         report::startup(&mut figs, grid, ticks::startup(&h, table));

@@ -238,3 +238,65 @@ fn roaming_in<const N: usize, const E: usize, Spec: ShapeSpec>(
     }
     out
 }
+
+/// What the host link adds to a tick (the board's TIM2, docs/link.md): the guard's gain
+/// stepped in a critical section, the pose and the swap flag read, the device's pose
+/// step and force scaling ([`mccs_firmware::link::LinkedDevice`]). Two controllers on
+/// the 3 × 3 patch (the cost does not depend on the patch) follow the same indentation,
+/// one through the link's device; the difference of their ticks, averaged over 4.
+#[inline(never)]
+pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
+    use mccs_firmware::link::{Guard, LinkedDevice};
+    use mccs_firmware::{Controller, Shared, SimulatedDevice};
+    const N: usize = mccs::topology::standard_capacity(3).0;
+    const E: usize = mccs::topology::standard_capacity(3).1;
+    static GUARD: Shared<Guard> = Shared::new(Guard::at_rate(1000));
+    static POSE: Shared<[i32; 3]> = Shared::new([0; 3]);
+    static SWAP_READY: Shared<bool> = Shared::new(false);
+    static SWAP: mccs_firmware::Mailbox<mccs::ParamSet<64>> = mccs_firmware::Mailbox::new();
+    let solver = || {
+        let Ok(topo) = Topology::<N, E>::standard_patch(3, 2.5) else {
+            exit(false)
+        };
+        let Ok(s) = Solver::new(topo, *table, &mccs::SolverConfig::default()) else {
+            exit(false)
+        };
+        s
+    };
+    let Ok(path) = mccs_firmware::indentation_path(1000) else {
+        exit(false)
+    };
+    let mut bare = Controller::new(solver(), SimulatedDevice::new(path), u32::MAX);
+    let mut linked = Controller::new(
+        solver(),
+        LinkedDevice::new(SimulatedDevice::new(path), 0.01),
+        u32::MAX,
+    );
+    let link_tick = |ctl: &mut Controller<LinkedDevice<SimulatedDevice<7>>, N, E, 64>| {
+        let ticks = ctl.telemetry().ticks;
+        let gain = GUARD.update(|g| g.gain(ticks));
+        let d = ctl.device_mut();
+        d.set_gain(gain);
+        d.set_target(POSE.get());
+        let swap = if SWAP_READY.get() {
+            SWAP_READY.set(false);
+            SWAP.take()
+        } else {
+            None
+        };
+        let f = ctl.tick(swap);
+        black_box(ctl.device().probe());
+        f
+    };
+    for _ in 0..400 {
+        bare.tick(None);
+        link_tick(&mut linked);
+    }
+    let plain = h.measure(4, || {
+        black_box(bare.tick(None));
+    });
+    let with_link = h.measure(4, || {
+        black_box(link_tick(&mut linked));
+    });
+    with_link.saturating_sub(plain)
+}
