@@ -16,10 +16,11 @@ if [ $# -ne 1 ] || [ -z "$1" ]; then
   exit 2
 fi
 socket=$1
-source scripts/lib.sh  # build_decoder, $DECODER, $TARGET_DIR
-echo "qemu-link: building the board firmware (--features qemu-link) and the log decoder" >&2
-build_decoder --quiet
-cargo build --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 --features qemu-link
+LOG_DIR=target/logs/qemu-link
+source scripts/lib.sh  # run_stage, build_decoder, $DECODER, $TARGET_DIR
+run_stage build-decoder build_decoder
+run_stage build-firmware cargo build --release -p haptic-f405 --target thumbv7em-none-eabihf \
+  --bin haptic-f405 --features qemu-link
 elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
 rm -f "$socket"
 echo "qemu-link: running it in QEMU (netduinoplus2), its link on unix:$socket" >&2

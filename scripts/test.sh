@@ -36,11 +36,12 @@ THUMB=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf)
 THUMB_ARGS=()
 for t in "${THUMB[@]}"; do THUMB_ARGS+=(--target "$t"); done
 clippy_thumb() {
-  cargo clippy --release -p mccs --target thumbv6m-none-eabi -- -D warnings || return 1
+  cargo clippy --release -p mccs -p mccs-link --target thumbv6m-none-eabi -- -D warnings || return 1
   cargo clippy --release -p mccs-firmware --target thumbv6m-none-eabi --target thumbv7em-none-eabihf \
     --lib --bins -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins -- -D warnings || return 1
-  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu -- -D warnings
+  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu -- -D warnings || return 1
+  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu-link -- -D warnings
 }
 
 # Without warnings, which fails the stage: rustc's on the M3 are checked here, as the

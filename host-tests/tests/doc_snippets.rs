@@ -48,6 +48,33 @@ fn firmware_md_a_roaming_controller() -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
+/// docs/link.md, "A scene in Rust", against the device in software.
+#[test]
+#[rustfmt::skip]
+fn link_md_a_scene() -> Result<(), Box<dyn Error>> {
+    let socket = std::env::temp_dir().join(format!("mccs-doc-scene-{}.sock", std::process::id()));
+    mccs_host::link::soft::serve(&socket, ForceTable64::new(&Params::TABLE2)?)?;
+    let addr = &format!("unix:{}", socket.display());
+use mccs_host::link::{Addr, Link};
+use mccs_link::{ToDevice, ToHost};
+use std::time::{Duration, Instant};
+let mut link = Link::connect(&Addr::parse(addr)?)?;
+link.send(&ToDevice::Watch { every: 16 })?; // about 60 Hz at 1 kHz
+link.send(&ToDevice::Arm)?;
+let start = Instant::now();
+while start.elapsed() < Duration::from_secs(1) {
+    let breath = 2.0 * (start.elapsed().as_secs_f64() * 1.5).sin(); // mm
+    let z = mccs::Length::from_num(breath).to_bits();
+    link.send(&ToDevice::Pose { origin: [0, 0, z] })?; // also keeps the link armed
+    if let Some(ToHost::Telemetry(t)) = link.recv(Instant::now() + Duration::from_millis(16))? {
+        let fz = mccs::Force::from_bits(t.force[2]).to_num::<f64>();
+        println!("tick {} force {fz:.3} N", t.tick);
+    }
+}
+link.send(&ToDevice::Disarm)?;
+    Ok(())
+}
+
 /// README.md and every page under docs/.
 pub fn doc_pages() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");

@@ -7,7 +7,7 @@ use std::process::Command;
 #[test]
 fn scripts_refuse_a_bad_argument_in_one_line() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let cases: [(&str, &[&str], &str); 9] = [
+    let cases: [(&str, &[&str], &str); 10] = [
         (
             "bash",
             &["scripts/bench.sh", "--frob"],
@@ -19,6 +19,7 @@ fn scripts_refuse_a_bad_argument_in_one_line() {
             "usage: scripts/long.sh",
         ),
         ("bash", &["scripts/fuzz.sh", "0"], "usage: scripts/fuzz.sh"),
+        ("bash", &["scripts/qemu-link.sh"], "usage: scripts/qemu-link.sh"),
         (
             "bash",
             &["scripts/firmware.sh", "m7"],
