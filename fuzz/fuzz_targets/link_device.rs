@@ -13,7 +13,8 @@ const N: usize = mccs::topology::standard_capacity(5).0;
 const E: usize = mccs::topology::standard_capacity(5).1;
 
 fuzz_target!(|bytes: &[u8]| {
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
+    static TABLE: std::sync::OnceLock<ForceTable64> = std::sync::OnceLock::new();
+    let table = *TABLE.get_or_init(|| ForceTable64::new(&Params::TABLE2).unwrap());
     let live = Live { core: Core::M4f, grid: 3, spacing: 2.5, config: SolverConfig::default() };
     let mut session = Session::<64>::new(live, table);
     let mut replayer = Box::new(Replayer::<N, E, 64, Wide, 16>::new(false));
