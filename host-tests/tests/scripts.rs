@@ -19,7 +19,11 @@ fn scripts_refuse_a_bad_argument_in_one_line() {
             "usage: scripts/long.sh",
         ),
         ("bash", &["scripts/fuzz.sh", "0"], "usage: scripts/fuzz.sh"),
-        ("bash", &["scripts/qemu-link.sh"], "usage: scripts/qemu-link.sh"),
+        (
+            "bash",
+            &["scripts/qemu-link.sh"],
+            "usage: scripts/qemu-link.sh",
+        ),
         (
             "bash",
             &["scripts/firmware.sh", "m7"],
