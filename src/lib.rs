@@ -23,6 +23,7 @@
 extern crate self as mccs;
 
 pub mod arith;
+pub mod arm;
 pub mod coupling;
 pub mod law;
 pub mod params;
@@ -40,6 +41,7 @@ pub mod window;
 mod defmt;
 
 pub use arith::{Arith, DefaultArith, Integrator, Narrow, Wide};
+pub use arm::{Arm, ArmError, ArmPose, ArmSpec, Drive, GravitySpec, JointSpec};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};

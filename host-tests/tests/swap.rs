@@ -27,9 +27,9 @@ fn a_tick_runs_on_one_whole_parameter_set() {
     let poster = std::thread::spawn(move || {
         let mut posts = 0u32;
         while !DONE.load(Ordering::Relaxed) {
-            let _ = SWAP.post(if posts % 2 == 0 { a } else { b });
+            let _ = SWAP.post(if posts.is_multiple_of(2) { a } else { b });
             posts += 1;
-            if posts % 7 == 0 {
+            if posts.is_multiple_of(7) {
                 std::thread::yield_now();
             }
         }
@@ -42,7 +42,7 @@ fn a_tick_runs_on_one_whole_parameter_set() {
     // Tick until 50 swaps have happened (the threads interleave as the OS pleases).
     while swaps_seen < 50 && ticks < 200_000 {
         ticks += 1;
-        if ticks % 5 == 0 {
+        if ticks.is_multiple_of(5) {
             std::thread::yield_now();
         }
         // What the tick could produce: the active set, A, or B — each wholly.

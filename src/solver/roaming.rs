@@ -143,7 +143,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
                 geometry.set(e, dir, inv_len);
             }
         };
-        if dir % 2 == 0 {
+        if dir.is_multiple_of(2) {
             (0..count).for_each(&mut step);
         } else {
             (0..count).rev().for_each(&mut step);

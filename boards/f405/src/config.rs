@@ -194,9 +194,9 @@ pub const fn pwm_max_duty(timer_clock_hz: u32, pwm_hz: u32) -> u32 {
 /// whole number of MHz (≤ 65.536 GHz) or the tick does not divide 1 MHz.
 pub const fn tick_timer(timer_clock_hz: u32, tick_hz: u32) -> Option<(u16, u32)> {
     if tick_hz == 0
-        || timer_clock_hz % TICK_COUNTER_HZ != 0
+        || !timer_clock_hz.is_multiple_of(TICK_COUNTER_HZ)
         || timer_clock_hz < TICK_COUNTER_HZ
-        || TICK_COUNTER_HZ % tick_hz != 0
+        || !TICK_COUNTER_HZ.is_multiple_of(tick_hz)
     {
         return None;
     }
@@ -260,7 +260,8 @@ impl BoardConfig {
         if !(24_000_000..=168_000_000).contains(&self.sysclk_hz) {
             return Err(E::Sysclk);
         }
-        if !(100..=10_000).contains(&self.tick_hz) || TICK_COUNTER_HZ % self.tick_hz != 0 {
+        if !(100..=10_000).contains(&self.tick_hz) || !TICK_COUNTER_HZ.is_multiple_of(self.tick_hz)
+        {
             return Err(E::Tick);
         }
         let clocks = Clocks::for_sysclk(self.sysclk_hz);

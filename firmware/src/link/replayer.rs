@@ -139,7 +139,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
         let n = (points.len() / 12) as u32;
         if self.run.is_none()
             || first != self.received
-            || points.len() % 12 != 0
+            || !points.len().is_multiple_of(12)
             || self.received.saturating_add(n) > self.credit()
         {
             self.run = None;
@@ -175,7 +175,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
         if self.done == self.samples {
             out(&ToHost::ReplayEnd { ticks: self.done });
             self.run = None;
-        } else if self.done % (P as u32 / 2).max(1) == 0 {
+        } else if self.done.is_multiple_of((P as u32 / 2).max(1)) {
             out(&ToHost::ReplayCredit {
                 until: self.credit(),
             });

@@ -89,7 +89,7 @@ fn stir<const N: usize, const E: usize>(
         n.v = core::array::from_fn(|_| rng.within(vel_bits));
         n.f = core::array::from_fn(|_| rng.next() as i32);
     }
-    if state % 4 != 0 {
+    if !state.is_multiple_of(4) {
         for w in warm.iter_mut() {
             *w = (rng.next() >> 2) as i32;
         }

@@ -1,0 +1,122 @@
+//! A serial RRR arm (WoodenHaptics, Phantom Premium and their clones) as the haptic
+//! device: joint counts to the probe in the tissue's frame, and the tissue's force to the
+//! motors' duties, in fixed point, per tick, constant time (docs/arm.md draws the
+//! convention).
+//!
+//! # The convention
+//! - Joint angles from counts: `θᵢ = home_angleᵢ + signᵢ · 2π (countᵢ − home_countᵢ) /
+//!   (counts_per_revᵢ · ratioᵢ)` (`counts_per_rev` per motor turn after ×4 quadrature,
+//!   `ratio` motor turns per joint turn).
+//! - A is the base's yaw; B the upper arm from vertical up; C the forearm from vertical
+//!   down; both forward-positive.
+//! - Forward kinematics, device frame, mm (origin on the base's axis, `z` up):
+//!   `r = Lb sin B + Lc sin C`, `x = r cos A`, `y = r sin A`, `z = Ln + Lb cos B − Lc cos C`.
+//! - The tissue's frame is the device frame translated by `tissue_origin_mm`.
+//! - Torques `τ = Jᵀ F` (F in N in the tissue's frame) plus gravity compensation
+//!   `∂U/∂θ`, `U` the potential of the upper arm's and forearm's masses at their
+//!   centres of mass: `∂U/∂B = −g sin B (m_b c_b + m_c Lb)`, `∂U/∂C = g m_c c_c sin C`.
+//! - Motor: `current = sign · τ / (ratio · Kt)`, `duty = current / max_current`; when any
+//!   `|duty|` would pass 1, all three are scaled by the same factor, so that the force
+//!   keeps its direction.
+//!
+//! # Fixed point
+//! Angles are full-turn phases (`u32`, 2³² a turn); `cos`/`sin` come from quartiq's
+//! `idsp::cossin` (Q31, 9e-6 at most from the true values); lengths are Q16 mm, the
+//! device-frame position Q24 mm in `i64`, the tissue-frame probe the core's `Length`
+//! (Q24 mm, ±128 mm, saturated), torques Q20 N·mm, duties Q16 (65,536 = 100 %). Every
+//! constant that divides is folded into a gain when the arm is made ([`Arm::new`]); the
+//! tick ([`Arm::pose`], [`Arm::drive`]) multiplies and shifts, and scales the duties by a
+//! reciprocal found by Newton's iteration ([`recip`]).
+
+mod drive;
+mod pose;
+pub mod recip;
+mod spec;
+
+pub use drive::Drive;
+pub use pose::{ArmPose, LIMIT_A, LIMIT_B, LIMIT_C, OUTSIDE};
+pub use spec::{ArmError, ArmSpec, GravitySpec, JointSpec};
+
+/// A full turn in phase units (2³²), as `f64`.
+const TURN: f64 = 4_294_967_296.0;
+
+/// One joint's gains, from its [`JointSpec`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Joint {
+    /// The angle at the home count, full-turn phase.
+    home_phase: u32,
+    /// The home count.
+    home_count: i32,
+    /// Phase per count, Q16 (sign included).
+    phase_per_count: i64,
+    /// The joint's range, phases relative to home (signed).
+    min_phase: i32,
+    max_phase: i32,
+    /// Duty (Q16) per torque (Q20 N·mm): `(τ · gain) >> shift`.
+    duty_gain: i64,
+    duty_shift: u32,
+}
+
+/// An arm, its constants folded into gains (start-up code: floating point).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Arm {
+    joints: [Joint; 3],
+    /// `Ln`, Q24 mm.
+    base_q24: i64,
+    /// `Lb`, `Lc`, Q16 mm.
+    upper_q16: i64,
+    fore_q16: i64,
+    /// The tissue's origin in the device frame, Q24 mm.
+    origin_q24: [i64; 3],
+    /// Gravity: `g (m_b c_b + m_c Lb)` and `g m_c c_c`, Q16 N·mm.
+    gravity_b_q16: i64,
+    gravity_c_q16: i64,
+}
+
+impl Arm {
+    /// The arm of `spec`, checked ([`ArmSpec::validate`]).
+    pub fn new(spec: &ArmSpec) -> Result<Arm, ArmError> {
+        spec.validate()?;
+        let joint = |j: &JointSpec| {
+            let per_turn = j.counts_per_rev * j.ratio;
+            let phase = |deg: f64| libm::round(deg / 360.0 * TURN);
+            // Q16 duty per Q20 N·mm: sign / (ratio · Kt · Imax · 1000 N·mm per N·m), then
+            // held to 2²¹ with a shift, so that the product fits 64 bits.
+            let k = j.sign / (j.ratio * j.torque_constant_nm_per_a * j.max_current_a * 1000.0);
+            let mut shift = 20u32;
+            let mut gain = k * 65_536.0;
+            while gain.abs() < (1u64 << 20) as f64 && shift < 60 {
+                gain *= 2.0;
+                shift += 1;
+            }
+            Joint {
+                home_phase: phase(j.home_angle_deg) as i64 as u32,
+                home_count: j.home_count,
+                phase_per_count: libm::round(j.sign * TURN * 65_536.0 / per_turn) as i64,
+                min_phase: phase(j.min_angle_deg - j.home_angle_deg) as i32,
+                max_phase: phase(j.max_angle_deg - j.home_angle_deg) as i32,
+                duty_gain: libm::round(gain) as i64,
+                duty_shift: shift,
+            }
+        };
+        let q = |mm: f64, bits: u32| libm::round(mm * (1u64 << bits) as f64) as i64;
+        let g = spec.gravity.unwrap_or(GravitySpec::NONE);
+        Ok(Arm {
+            joints: [
+                joint(&spec.joints[0]),
+                joint(&spec.joints[1]),
+                joint(&spec.joints[2]),
+            ],
+            base_q24: q(spec.base_height_mm, 24),
+            upper_q16: q(spec.upper_arm_mm, 16),
+            fore_q16: q(spec.forearm_mm, 16),
+            origin_q24: spec.tissue_origin_mm.map(|v| q(v, 24)),
+            gravity_b_q16: q(
+                g.g * (g.upper_arm_mass_kg * g.upper_arm_com_mm
+                    + g.forearm_mass_kg * spec.upper_arm_mm),
+                16,
+            ),
+            gravity_c_q16: q(g.g * g.forearm_mass_kg * g.forearm_com_mm, 16),
+        })
+    }
+}
