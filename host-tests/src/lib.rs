@@ -4,6 +4,7 @@
 //! tests can catch the core's mistakes.
 #![deny(missing_docs)]
 
+pub mod arm;
 pub mod cli;
 pub mod fit;
 pub mod link;

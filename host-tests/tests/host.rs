@@ -8,6 +8,8 @@ mod common;
 mod architecture;
 #[path = "arith.rs"]
 mod arith;
+#[path = "arm.rs"]
+mod arm;
 #[path = "cap.rs"]
 mod cap;
 #[path = "cli/mod.rs"]

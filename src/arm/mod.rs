@@ -21,7 +21,8 @@
 //!
 //! # Fixed point
 //! Angles are full-turn phases (`u32`, 2³² a turn); `cos`/`sin` come from quartiq's
-//! `idsp::cossin` (Q31, 9e-6 at most from the true values); lengths are Q16 mm, the
+//! `idsp::cossin` (its amplitude, 2³¹ (1 − 2⁻¹⁶), scaled to Q31; 9e-6 at most from the
+//! true values); lengths are Q16 mm, the
 //! device-frame position Q24 mm in `i64`, the tissue-frame probe the core's `Length`
 //! (Q24 mm, ±128 mm, saturated), torques Q20 N·mm, duties Q16 (65,536 = 100 %). Every
 //! constant that divides is folded into a gain when the arm is made ([`Arm::new`]); the

@@ -1,0 +1,7 @@
+//! The 3-DOF arm on the host: its `f64` twin ([`twin`]), the device file
+//! ([`device_file`]).
+
+pub mod device_file;
+pub mod twin;
+
+pub use twin::ArmTwin;
