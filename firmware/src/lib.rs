@@ -8,6 +8,8 @@
 //!   [`ProbePath`](probe_path::ProbePath);
 //! - [`drivers`]: the AS5047P SPI encoder and the PWM motor (embedded-hal 1.0), and
 //!   [`one_dof`], a 1-DOF device made of the two;
+//! - [`arm_device`]: a 3-DOF arm (three quadrature joints, PWM motors) through the
+//!   core's `Arm`;
 //! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
 //!   buffer between the main loop and the tick interrupt;
 //! - [`link`]: the device's side of the host link (`mccs-link`);
@@ -20,6 +22,7 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+pub mod arm_device;
 pub mod controller;
 pub mod demo;
 pub mod device;

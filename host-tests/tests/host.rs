@@ -10,6 +10,8 @@ mod architecture;
 mod arith;
 #[path = "arm.rs"]
 mod arm;
+#[path = "arm_device.rs"]
+mod arm_device;
 #[path = "cap.rs"]
 mod cap;
 #[path = "cli/mod.rs"]

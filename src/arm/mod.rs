@@ -75,6 +75,11 @@ pub struct Arm {
 }
 
 impl Arm {
+    /// The joints' counts at the home pose.
+    pub fn home_counts(&self) -> [i32; 3] {
+        self.joints.map(|j| j.home_count)
+    }
+
     /// The arm of `spec`, checked ([`ArmSpec::validate`]).
     pub fn new(spec: &ArmSpec) -> Result<Arm, ArmError> {
         spec.validate()?;

@@ -8,6 +8,7 @@ use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+mod arm;
 mod check;
 mod curve;
 mod demo;
@@ -180,6 +181,9 @@ enum Command {
     /// budget=<b> fits=yes|no`: the core's stability bound's substeps, the tick estimated
     /// from the bench's measured costs (exit 1 when it does not fit).
     Check(check::Args),
+    /// The 3-DOF arm (docs/arm.md): `fk` (counts to the probe) and `torque` (counts and a
+    /// force to the joints' torques and duties), fixed point or the f64 twin.
+    Arm(arm::Args),
     /// Talk to a device over the host link (docs/link.md): hello, status, load a tissue,
     /// replay a trajectory on the device, watch its live telemetry, pose, arm, disarm.
     Link(link::Args),
@@ -199,6 +203,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Replay(a) => replay::run(a, out),
         Command::Check(a) => check::run(a, out),
         Command::Link(a) => link::run(a, out),
+        Command::Arm(a) => arm::run(a, out),
     }
 }
 

@@ -2,6 +2,7 @@
 //! Here the parameter files, help and usage, the demo check and the progress of long
 //! runs; each subcommand's own in its file.
 
+mod arm;
 mod check;
 mod curve;
 mod fit;

@@ -1,0 +1,227 @@
+//! [`ArmDevice`]: a 3-DOF arm as the tick's [`HapticDevice`] — three joints, each a
+//! [`JointEncoder`] and a PWM channel with a direction pin, one driver-enable pin and a
+//! home input — through the core's [`Arm`] (counts to the probe, the force to duties).
+//!
+//! # Safety
+//! - **No force before the arm is homed.** Until the home input reads high once (the arm
+//!   held at its home pose), the counts are not known: every write is zero duty. At the
+//!   home input each joint's count becomes its `home_count`.
+//! - **Faults end at the actuator.** A failed read or write is an error for the
+//!   controller, which puts the device in its safe state: zero duty on every joint first
+//!   (each attempted whatever the others did), then the driver disabled. A failed duty
+//!   or direction write sets all three duties to zero before it returns.
+//! - A direction change goes through zero duty (a failed pin write leaves the joint
+//!   idle, never pushing the wrong way).
+//! - The joints' limits are reported ([`ArmDevice::flags`]); a probe beyond what the
+//!   tissue's frame holds reads far above the tissue: no contact.
+
+use crate::device::HapticDevice;
+use crate::drivers::joint_encoder::{Extended, JointEncoder};
+use embedded_hal::digital::{InputPin, OutputPin};
+use embedded_hal::pwm::SetDutyCycle;
+use mccs::arm::OUTSIDE;
+use mccs::{Arm, ArmPose, Force, Length};
+
+/// One joint's parts.
+#[derive(Debug)]
+pub struct JointParts<E, P, D> {
+    /// Its counter.
+    pub encoder: E,
+    /// Its motor's PWM channel.
+    pub pwm: P,
+    /// Its motor's direction pin (high: the joint's angle grows).
+    pub direction: D,
+}
+
+/// Which part of the arm failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArmFault {
+    /// Joint `0..3`'s counter.
+    Encoder(u8),
+    /// Its PWM channel.
+    Pwm(u8),
+    /// Its direction pin.
+    Direction(u8),
+    /// The driver-enable pin.
+    Enable,
+    /// The home input.
+    Home,
+}
+
+/// A joint's part that failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PartFailed;
+
+/// What a joint does for the device (its parts behind one interface, so that three
+/// joints of different timer and pin types make one device without an indirect call).
+pub trait Joint {
+    /// The counter now.
+    fn read(&mut self) -> Result<u16, PartFailed>;
+    /// A duty (counts, ≤ the channel's full scale).
+    fn duty(&mut self, duty: u16) -> Result<(), PartFailed>;
+    /// The direction pin.
+    fn direction(&mut self, forward: bool) -> Result<(), PartFailed>;
+    /// The channel's full scale.
+    fn max_duty(&self) -> u16;
+}
+
+impl<E: JointEncoder, P: SetDutyCycle, D: OutputPin> Joint for JointParts<E, P, D> {
+    fn read(&mut self) -> Result<u16, PartFailed> {
+        self.encoder.read().map_err(|_| PartFailed)
+    }
+    fn duty(&mut self, duty: u16) -> Result<(), PartFailed> {
+        self.pwm.set_duty_cycle(duty).map_err(|_| PartFailed)
+    }
+    fn direction(&mut self, forward: bool) -> Result<(), PartFailed> {
+        if forward {
+            self.direction.set_high()
+        } else {
+            self.direction.set_low()
+        }
+        .map_err(|_| PartFailed)
+    }
+    fn max_duty(&self) -> u16 {
+        self.pwm.max_duty_cycle()
+    }
+}
+
+/// A 3-DOF arm.
+#[derive(Debug)]
+pub struct ArmDevice<A, B, C, EN, HOME> {
+    arm: Arm,
+    joints: (A, B, C),
+    enable: EN,
+    home: HOME,
+    counts: [Extended; 3],
+    /// The directions last written (None: unknown).
+    forward: [Option<bool>; 3],
+    homed: bool,
+    pose: Option<ArmPose>,
+    duty: [i32; 3],
+}
+
+impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B, C, EN, HOME> {
+    /// The device, not homed (zero duty until it is), the driver not enabled.
+    pub fn new(arm: Arm, joints: (A, B, C), enable: EN, home: HOME) -> Self {
+        Self {
+            arm,
+            joints,
+            enable,
+            home,
+            counts: [Extended::default(); 3],
+            forward: [None; 3],
+            homed: false,
+            pose: None,
+            duty: [0; 3],
+        }
+    }
+
+    /// Enables the driver (duties still zero).
+    pub fn enable(&mut self) -> Result<(), ArmFault> {
+        self.enable.set_high().map_err(|_| ArmFault::Enable)
+    }
+
+    /// Whether the arm has been homed.
+    pub fn homed(&self) -> bool {
+        self.homed
+    }
+
+    /// The last pose's flags (`mccs::arm::LIMIT_*`, `OUTSIDE`); 0 before the first read.
+    pub fn flags(&self) -> u8 {
+        self.pose.map_or(0, |p| p.flags)
+    }
+
+    /// The duties last written, Q16 (±65,536: ±100 %).
+    pub fn duties(&self) -> [i32; 3] {
+        self.duty
+    }
+
+    /// The joints' counts.
+    pub fn counts(&self) -> [i32; 3] {
+        self.counts.map(|c| c.count())
+    }
+
+    /// Zero duty on every joint, each attempted; the first failure.
+    fn zero(&mut self) -> Result<(), ArmFault> {
+        let a = self.joints.0.duty(0).map_err(|_| ArmFault::Pwm(0));
+        let b = self.joints.1.duty(0).map_err(|_| ArmFault::Pwm(1));
+        let c = self.joints.2.duty(0).map_err(|_| ArmFault::Pwm(2));
+        self.duty = [0; 3];
+        a.and(b).and(c)
+    }
+}
+
+/// Writes one joint's duty (Q16, signed), a direction change through zero duty.
+fn write_joint<J: Joint>(
+    j: &mut J,
+    forward_was: &mut Option<bool>,
+    k: u8,
+    duty_q16: i32,
+) -> Result<(), ArmFault> {
+    let forward = duty_q16 > 0;
+    let max = j.max_duty() as i64;
+    let counts = ((duty_q16.unsigned_abs() as i64 * max) >> 16).min(max) as u16;
+    if counts > 0 && *forward_was != Some(forward) {
+        // Through zero duty: a failed pin write leaves the joint idle.
+        j.duty(0).map_err(|_| ArmFault::Pwm(k))?;
+        *forward_was = None;
+        j.direction(forward).map_err(|_| ArmFault::Direction(k))?;
+        *forward_was = Some(forward);
+    }
+    j.duty(counts).map_err(|_| ArmFault::Pwm(k))
+}
+
+impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
+    for ArmDevice<A, B, C, EN, HOME>
+{
+    type Error = ArmFault;
+
+    fn read_position(&mut self) -> Result<[Length; 3], ArmFault> {
+        let raw = [
+            self.joints.0.read().map_err(|_| ArmFault::Encoder(0))?,
+            self.joints.1.read().map_err(|_| ArmFault::Encoder(1))?,
+            self.joints.2.read().map_err(|_| ArmFault::Encoder(2))?,
+        ];
+        let mut counts = [0i32; 3];
+        for k in 0..3 {
+            counts[k] = self.counts[k].update(raw[k]);
+        }
+        if !self.homed && self.home.is_high().map_err(|_| ArmFault::Home)? {
+            let home = self.arm.home_counts();
+            for k in 0..3 {
+                self.counts[k].rebase(home[k]);
+            }
+            counts = home;
+            self.homed = true;
+        }
+        let pose = self.arm.pose(counts);
+        self.pose = Some(pose);
+        if pose.flags & OUTSIDE != 0 {
+            // Beyond the tissue's frame: far above it, no contact.
+            return Ok([Length::ZERO, Length::ZERO, Length::MAX]);
+        }
+        Ok(pose.probe)
+    }
+
+    fn write_force(&mut self, force: [Force; 3]) -> Result<(), ArmFault> {
+        let duty = match (self.homed, self.pose) {
+            (true, Some(pose)) => self.arm.drive(&pose, force).duty_q16,
+            _ => [0; 3],
+        };
+        let written = write_joint(&mut self.joints.0, &mut self.forward[0], 0, duty[0])
+            .and_then(|()| write_joint(&mut self.joints.1, &mut self.forward[1], 1, duty[1]))
+            .and_then(|()| write_joint(&mut self.joints.2, &mut self.forward[2], 2, duty[2]));
+        if let Err(e) = written {
+            let _ = self.zero();
+            return Err(e);
+        }
+        self.duty = duty;
+        Ok(())
+    }
+
+    fn safe_state(&mut self) -> Result<(), ArmFault> {
+        let duty = self.zero();
+        let enable = self.enable.set_low().map_err(|_| ArmFault::Enable);
+        duty.and(enable)
+    }
+}

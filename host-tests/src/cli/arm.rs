@@ -1,0 +1,170 @@
+//! `mccs arm`: the 3-DOF arm's kinematics and torques on the host, in the fixed point the
+//! firmware runs (default) or the `f64` twin (docs/arm.md).
+
+use super::{arg_error, io_error, Backend, CliError};
+use crate::arm::{device_file, ArmTwin};
+use mccs::{Arm, Force};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args, Debug)]
+pub(super) struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Command {
+    /// The probe in the device frame, CSV `x_mm,y_mm,z_mm`, for each row of joint counts.
+    Fk {
+        /// The device file (docs/arm.md; devices/woodenhaptics.toml).
+        #[arg(long)]
+        device: PathBuf,
+        /// CSV `count_a,count_b,count_c` (whole numbers).
+        #[arg(long)]
+        counts: PathBuf,
+        /// Fixed point, as the firmware computes it, or the f64 twin.
+        #[arg(long, value_enum, default_value_t = Backend::Fixed)]
+        backend: Backend,
+    },
+    /// The joints' torques before saturation (Jᵀ F + gravity, N·m) and the duties after
+    /// it, CSV `tau_a_nm,tau_b_nm,tau_c_nm,duty_a,duty_b,duty_c`, for each row of counts
+    /// and force (N, the tissue's frame).
+    Torque {
+        /// The device file.
+        #[arg(long)]
+        device: PathBuf,
+        /// CSV `count_a,count_b,count_c,fx_n,fy_n,fz_n`.
+        #[arg(long)]
+        input: PathBuf,
+        /// Fixed point, as the firmware computes it, or the f64 twin.
+        #[arg(long, value_enum, default_value_t = Backend::Fixed)]
+        backend: Backend,
+    },
+}
+
+/// The rows of a numeric CSV file with exactly `header`; one line naming the file and
+/// the row (the header is row 1) for anything else.
+fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
+    let file = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::new(format!("{file}: cannot read: {e}")))?;
+    let mut lines = text.lines();
+    let want = header.join(",");
+    match lines
+        .next()
+        .map(|h| h.trim().trim_start_matches('\u{feff}'))
+    {
+        Some(h) if h == want => {}
+        Some(h) => {
+            return Err(CliError::new(format!(
+                "{file}: row 1: the header must be `{want}`, not `{h}`"
+            )))
+        }
+        None => return Err(CliError::new(format!("{file}: empty file"))),
+    }
+    let mut out = Vec::new();
+    for (i, line) in lines.enumerate() {
+        let row = i + 2;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != header.len() {
+            return Err(CliError::new(format!(
+                "{file}: row {row}: {} fields, {} expected",
+                fields.len(),
+                header.len()
+            )));
+        }
+        let mut v = Vec::with_capacity(fields.len());
+        for (f, name) in fields.iter().zip(header) {
+            let x: f64 = f
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .ok_or_else(|| {
+                    CliError::new(format!(
+                        "{file}: row {row}: {name}: `{f}` is not a finite number"
+                    ))
+                })?;
+            if name.starts_with("count_") && (x.fract() != 0.0 || x.abs() > i32::MAX as f64) {
+                return Err(CliError::new(format!(
+                    "{file}: row {row}: {name}: must be a whole number of counts"
+                )));
+            }
+            if name.ends_with("_n") && x.abs() > 2000.0 {
+                return Err(CliError::new(format!(
+                    "{file}: row {row}: {name}: must be within ±2000 N"
+                )));
+            }
+            v.push(x);
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
+    let (device, backend) = match &a.command {
+        Command::Fk {
+            device, backend, ..
+        }
+        | Command::Torque {
+            device, backend, ..
+        } => (device, *backend),
+    };
+    let spec = device_file::read(device).map_err(CliError::new)?;
+    let arm = Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
+    let twin = ArmTwin { spec };
+    let mut w = std::io::BufWriter::new(out);
+    match a.command {
+        Command::Fk { counts, .. } => {
+            let rows = rows(&counts, &["count_a", "count_b", "count_c"])?;
+            writeln!(w, "x_mm,y_mm,z_mm").map_err(io_error)?;
+            for r in rows {
+                let c = [r[0], r[1], r[2]];
+                let p = match backend {
+                    Backend::Fixed => arm.pose(c.map(|x| x as i32)).device_mm(),
+                    Backend::Reference => twin.fk(twin.angles(c)),
+                };
+                writeln!(w, "{},{},{}", p[0], p[1], p[2]).map_err(io_error)?;
+            }
+        }
+        Command::Torque { input, .. } => {
+            let rows = rows(
+                &input,
+                &["count_a", "count_b", "count_c", "fx_n", "fy_n", "fz_n"],
+            )?;
+            writeln!(w, "tau_a_nm,tau_b_nm,tau_c_nm,duty_a,duty_b,duty_c").map_err(io_error)?;
+            for r in rows {
+                let c = [r[0], r[1], r[2]];
+                let f = [r[3], r[4], r[5]];
+                let (tau, duty) = match backend {
+                    Backend::Fixed => {
+                        let d = arm.drive(
+                            &arm.pose(c.map(|x| x as i32)),
+                            f.map(Force::saturating_from_num),
+                        );
+                        (
+                            d.torque_q20
+                                .map(|t| t as f64 / (1u64 << 20) as f64 / 1000.0),
+                            d.duty_q16.map(|x| x as f64 / 65_536.0),
+                        )
+                    }
+                    Backend::Reference => {
+                        let t = twin.torque(twin.angles(c), f);
+                        (t.map(|x| x / 1000.0), twin.duties(t).0)
+                    }
+                };
+                writeln!(
+                    w,
+                    "{},{},{},{},{},{}",
+                    tau[0], tau[1], tau[2], duty[0], duty[1], duty[2]
+                )
+                .map_err(io_error)?;
+            }
+        }
+    }
+    w.flush().map_err(io_error)
+}

@@ -1,0 +1,304 @@
+//! The arm as a device (`mccs_firmware::arm_device`): the encoders' 16-bit counts carried
+//! to 32 bits at any speed the arm reaches, no force before homing, and a fault injected
+//! at every device call ending with every duty at zero and the driver disabled.
+
+use mccs::{Arm, Force, Length};
+use mccs_firmware::arm_device::{ArmDevice, ArmFault, Joint, PartFailed};
+use mccs_firmware::drivers::joint_encoder::Extended;
+use mccs_firmware::HapticDevice;
+use proptest::prelude::*;
+use std::cell::Cell;
+use std::rc::Rc;
+
+proptest! {
+    /// Steps of up to ±32,767 counts a tick (beyond any arm's speed), the counter
+    /// wrapping at 16 bits: the carried count is the true one.
+    #[test]
+    fn the_count_is_carried_past_16_bits(start in any::<i32>(), steps in proptest::collection::vec(-32_767i32..=32_767, 1..500)) {
+        let mut truth = start as i64;
+        let mut e = Extended::new(start as u16, start);
+        for s in steps {
+            truth += s as i64;
+            let raw = truth as u16;
+            let got = e.update(raw);
+            prop_assert_eq!(got, truth as i32);
+        }
+    }
+}
+
+/// Every call the device makes, numbered; the one numbered `fail_at` fails.
+#[derive(Default)]
+struct Calls {
+    n: Cell<usize>,
+    fail_at: Cell<Option<usize>>,
+}
+
+impl Calls {
+    fn call(&self) -> Result<(), PartFailed> {
+        let n = self.n.get();
+        self.n.set(n + 1);
+        if self.fail_at.get() == Some(n) {
+            Err(PartFailed)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// A joint in memory: its counter, its last duty and direction.
+struct MockJoint {
+    calls: Rc<Calls>,
+    raw: Rc<Cell<u16>>,
+    duty: Rc<Cell<u16>>,
+    forward: Rc<Cell<Option<bool>>>,
+}
+
+impl Joint for MockJoint {
+    fn read(&mut self) -> Result<u16, PartFailed> {
+        self.calls.call().map(|()| self.raw.get())
+    }
+    fn duty(&mut self, d: u16) -> Result<(), PartFailed> {
+        self.calls.call()?;
+        self.duty.set(d);
+        Ok(())
+    }
+    fn direction(&mut self, f: bool) -> Result<(), PartFailed> {
+        self.calls.call()?;
+        self.forward.set(Some(f));
+        Ok(())
+    }
+    fn max_duty(&self) -> u16 {
+        4200
+    }
+}
+
+/// A pin in memory.
+struct Pin {
+    calls: Rc<Calls>,
+    level: Rc<Cell<bool>>,
+}
+
+impl embedded_hal::digital::ErrorType for Pin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for Pin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.level.set(false);
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.level.set(true);
+        Ok(())
+    }
+}
+
+/// A failing pin: the home input or the enable pin, through the shared calls.
+struct CountedPin(Pin);
+
+#[derive(Debug)]
+struct PinError;
+impl embedded_hal::digital::Error for PinError {
+    fn kind(&self) -> embedded_hal::digital::ErrorKind {
+        embedded_hal::digital::ErrorKind::Other
+    }
+}
+impl embedded_hal::digital::ErrorType for CountedPin {
+    type Error = PinError;
+}
+impl embedded_hal::digital::OutputPin for CountedPin {
+    fn set_low(&mut self) -> Result<(), PinError> {
+        self.0.calls.call().map_err(|_| PinError)?;
+        self.0.level.set(false);
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), PinError> {
+        self.0.calls.call().map_err(|_| PinError)?;
+        self.0.level.set(true);
+        Ok(())
+    }
+}
+impl embedded_hal::digital::InputPin for CountedPin {
+    fn is_high(&mut self) -> Result<bool, PinError> {
+        self.0.calls.call().map_err(|_| PinError)?;
+        Ok(self.0.level.get())
+    }
+    fn is_low(&mut self) -> Result<bool, PinError> {
+        self.is_high().map(|h| !h)
+    }
+}
+
+/// The rig: the device and handles on its parts.
+struct Rig {
+    calls: Rc<Calls>,
+    raw: [Rc<Cell<u16>>; 3],
+    duty: [Rc<Cell<u16>>; 3],
+    enable: Rc<Cell<bool>>,
+    home: Rc<Cell<bool>>,
+}
+
+type Device = ArmDevice<MockJoint, MockJoint, MockJoint, CountedPin, CountedPin>;
+
+fn rig() -> (Rig, Device) {
+    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../devices/woodenhaptics.toml"
+    )))
+    .unwrap();
+    let calls = Rc::new(Calls::default());
+    let cell = || Rc::new(Cell::new(0u16));
+    let raw = [cell(), cell(), cell()];
+    let duty = [cell(), cell(), cell()];
+    let joint = |k: usize| MockJoint {
+        calls: calls.clone(),
+        raw: raw[k].clone(),
+        duty: duty[k].clone(),
+        forward: Rc::new(Cell::new(None)),
+    };
+    let enable = Rc::new(Cell::new(false));
+    let home = Rc::new(Cell::new(false));
+    let dev = ArmDevice::new(
+        Arm::new(&spec).unwrap(),
+        (joint(0), joint(1), joint(2)),
+        CountedPin(Pin {
+            calls: calls.clone(),
+            level: enable.clone(),
+        }),
+        CountedPin(Pin {
+            calls: calls.clone(),
+            level: home.clone(),
+        }),
+    );
+    (
+        Rig {
+            calls,
+            raw,
+            duty,
+            enable,
+            home,
+        },
+        dev,
+    )
+}
+
+/// Counts at a pose in the workspace, with the force pressing into it.
+fn at_work(r: &Rig) {
+    // B 20°, C 38°: the probe near the tissue's origin, on the working branch
+    // (docs/arm.md).
+    let counts = [
+        0i32,
+        (20.0 / 360.0 * 24_000.0) as i32,
+        (38.0 / 360.0 * 24_000.0) as i32,
+    ];
+    for k in 0..3 {
+        r.raw[k].set(counts[k] as u16);
+    }
+}
+
+#[test]
+fn no_force_before_the_arm_is_homed() {
+    let (r, mut dev) = rig();
+    dev.enable().unwrap();
+    at_work(&r);
+    let force = [
+        Force::from_num(1.0),
+        Force::from_num(-0.5),
+        Force::from_num(2.0),
+    ];
+    for _ in 0..5 {
+        dev.read_position().unwrap();
+        dev.write_force(force).unwrap();
+        assert!(r.duty.iter().all(|d| d.get() == 0), "a duty before homing");
+        assert!(!dev.homed());
+    }
+    // The home input: the counts are the home counts (0); the arm then moves to work.
+    for k in 0..3 {
+        r.raw[k].set(0);
+    }
+    r.home.set(true);
+    dev.read_position().unwrap();
+    assert!(dev.homed());
+    r.home.set(false);
+    at_work(&r);
+    let p = dev.read_position().unwrap();
+    assert!(p.iter().all(|c| c.abs() < Length::from_num(127)), "{p:?}");
+    dev.write_force(force).unwrap();
+    assert!(r.duty.iter().any(|d| d.get() > 0), "no duty after homing");
+}
+
+#[test]
+fn a_fault_at_every_device_call_ends_at_zero_duty() {
+    // How many calls a homed tick takes.
+    let (r, mut dev) = rig();
+    let force = [
+        Force::from_num(1.5),
+        Force::from_num(1.0),
+        Force::from_num(-2.0),
+    ];
+    dev.enable().unwrap();
+    r.home.set(true);
+    dev.read_position().unwrap();
+    r.home.set(false);
+    at_work(&r);
+    dev.read_position().unwrap();
+    dev.write_force(force).unwrap();
+    // A steady tick (the directions known).
+    let before = r.calls.n.get();
+    dev.read_position().unwrap();
+    dev.write_force(force).unwrap();
+    let per_tick = r.calls.n.get() - before;
+    assert!(per_tick >= 6, "{per_tick} calls a tick");
+    let mut faults = Vec::new();
+    for fail in 0..per_tick {
+        let (r, mut dev) = rig();
+        dev.enable().unwrap();
+        r.home.set(true);
+        dev.read_position().unwrap();
+        r.home.set(false);
+        at_work(&r);
+        // A tick at full force first (duties up), then one with the fault.
+        dev.read_position().unwrap();
+        dev.write_force(force).unwrap();
+        assert!(r.duty.iter().any(|d| d.get() > 0));
+        r.calls.fail_at.set(Some(r.calls.n.get() + fail));
+        let result = dev.read_position().and_then(|_| dev.write_force(force));
+        let e = result.expect_err("the injected fault was not seen");
+        faults.push(e);
+        // What the controller does next: the safe state.
+        r.calls.fail_at.set(None);
+        dev.safe_state().unwrap();
+        assert!(
+            r.duty.iter().all(|d| d.get() == 0),
+            "call {fail} ({e:?}): a duty left on"
+        );
+        assert!(!r.enable.get(), "call {fail}: the driver left enabled");
+    }
+    assert!(
+        faults.contains(&ArmFault::Encoder(0))
+            && faults.iter().any(|f| matches!(f, ArmFault::Pwm(_)))
+    );
+}
+
+/// A failed duty write zeroes every duty before it returns, and the safe state does
+/// even when a duty write fails (each attempted, the driver disabled).
+#[test]
+fn a_failed_write_and_a_failing_safe_state_still_end_at_zero() {
+    let (r, mut dev) = rig();
+    dev.enable().unwrap();
+    r.home.set(true);
+    dev.read_position().unwrap();
+    r.home.set(false);
+    at_work(&r);
+    let force = [
+        Force::from_num(1.5),
+        Force::from_num(1.0),
+        Force::from_num(-2.0),
+    ];
+    dev.read_position().unwrap();
+    dev.write_force(force).unwrap();
+    // The safe state with joint A's duty failing: B and C still zero, the driver off.
+    r.calls.fail_at.set(Some(r.calls.n.get()));
+    assert_eq!(dev.safe_state(), Err(ArmFault::Pwm(0)));
+    assert_eq!((r.duty[1].get(), r.duty[2].get()), (0, 0));
+    assert!(!r.enable.get());
+}

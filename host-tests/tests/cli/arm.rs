@@ -1,0 +1,179 @@
+//! `mccs arm`: the device file's errors (one line naming the file, line and key, the
+//! nearest key for a typo), the counts' and inputs' errors by row, and both backends.
+
+use super::*;
+
+const WOODEN: &str = include_str!("../../../devices/woodenhaptics.toml");
+
+fn fk(device: &str, counts: &str, backend: &str) -> std::process::Output {
+    mccs(&[
+        "arm",
+        "fk",
+        "--device",
+        device,
+        "--counts",
+        counts,
+        "--backend",
+        backend,
+    ])
+}
+
+#[test]
+fn bad_device_files_name_the_file_line_and_key() {
+    let counts = temp_file("arm-counts.csv", "count_a,count_b,count_c\n0,1000,2000\n");
+    let c = counts.to_str().unwrap();
+    let cases: [(&str, String, &[&str]); 7] = [
+        (
+            "typo.toml",
+            WOODEN.replace("upper_arm_mm = 205.0", "upper_arm_mn = 205.0"),
+            &["line 6: arm.upper_arm_mn: unknown key; did you mean arm.upper_arm_mm?"],
+        ),
+        (
+            "missing.toml",
+            WOODEN.replace("forearm_mm = 245.0", ""),
+            &["arm.forearm_mm: missing"],
+        ),
+        (
+            "zero_kt.toml",
+            WOODEN.replacen(
+                "torque_constant_nm_per_a = 0.0603",
+                "torque_constant_nm_per_a = 0",
+                1,
+            ),
+            &["joint.b.torque_constant_nm_per_a: must be > 0"],
+        ),
+        (
+            "negative_length.toml",
+            WOODEN.replace("upper_arm_mm = 205.0", "upper_arm_mm = -205.0"),
+            &["line 6: arm.upper_arm_mm: must be > 0 and ≤ 1000 mm"],
+        ),
+        (
+            "sign.toml",
+            WOODEN.replacen("sign = 1", "sign = 2", 1),
+            &["joint.a.sign: must be 1 or -1"],
+        ),
+        (
+            "ratio.toml",
+            WOODEN.replace("ratio = 16.0", "ratio = 0"),
+            &["joint.a.ratio: must be > 0"],
+        ),
+        (
+            "joint.toml",
+            WOODEN.replace("[joint.c]", "[joint.d]"),
+            &["joint.d: unknown key"],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let path = temp_file(name, &text);
+        let needles: Vec<&str> = [name].iter().chain(needles).copied().collect();
+        assert_one_line_error(&fk(path.to_str().unwrap(), c, "fixed"), &needles);
+    }
+}
+
+#[test]
+fn bad_rows_are_named() {
+    let d = "devices/woodenhaptics.toml";
+    for (text, needle) in [
+        (
+            "a,b,c\n0,0,0\n",
+            "row 1: the header must be `count_a,count_b,count_c`, not `a,b,c`",
+        ),
+        (
+            "count_a,count_b,count_c\n0,0.5,0\n",
+            "row 2: count_b: must be a whole number of counts",
+        ),
+        (
+            "count_a,count_b,count_c\n0,0\n",
+            "row 2: 2 fields, 3 expected",
+        ),
+        (
+            "count_a,count_b,count_c\n0,0,nan\n",
+            "row 2: count_c: `nan` is not a finite number",
+        ),
+    ] {
+        let p = temp_file("arm-bad.csv", text);
+        assert_one_line_error(&fk(d, p.to_str().unwrap(), "fixed"), &[needle]);
+    }
+    let p = temp_file(
+        "arm-bad-force.csv",
+        "count_a,count_b,count_c,fx_n,fy_n,fz_n\n0,0,0,0,0,1e6\n",
+    );
+    assert_one_line_error(
+        &mccs(&[
+            "arm",
+            "torque",
+            "--device",
+            d,
+            "--input",
+            p.to_str().unwrap(),
+        ]),
+        &["row 2: fz_n: must be within ±2000 N"],
+    );
+}
+
+#[test]
+fn both_backends_agree() {
+    let d = "devices/woodenhaptics.toml";
+    let mut counts = String::from("count_a,count_b,count_c\n");
+    let mut input = String::from("count_a,count_b,count_c,fx_n,fy_n,fz_n\n");
+    for i in 0..50i32 {
+        let c = [
+            (i * 97) % 5000 - 2500,
+            (i * 131) % 6000 - 1000,
+            (i * 173) % 7000,
+        ];
+        counts.push_str(&format!("{},{},{}\n", c[0], c[1], c[2]));
+        input.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            c[0],
+            c[1],
+            c[2],
+            i % 7 - 3,
+            i % 5 - 2,
+            -(i % 11)
+        ));
+    }
+    let parse = |o: std::process::Output| -> Vec<Vec<f64>> {
+        assert!(o.status.success(), "{o:?}");
+        String::from_utf8(o.stdout)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let cp = temp_file("arm-counts-50.csv", &counts);
+    let (fixed, exact) = (
+        parse(fk(d, cp.to_str().unwrap(), "fixed")),
+        parse(fk(d, cp.to_str().unwrap(), "reference")),
+    );
+    for (a, b) in fixed.iter().zip(&exact) {
+        let dist = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        assert!(dist < 0.01, "{a:?} against {b:?}");
+    }
+    let ip = temp_file("arm-input-50.csv", &input);
+    let torque = |b: &str| {
+        parse(mccs(&[
+            "arm",
+            "torque",
+            "--device",
+            d,
+            "--input",
+            ip.to_str().unwrap(),
+            "--backend",
+            b,
+        ]))
+    };
+    for (a, b) in torque("fixed").iter().zip(&torque("reference")) {
+        for k in 0..3 {
+            assert!(
+                (a[k] - b[k]).abs() <= 0.005 * b[k].abs() + 1e-5,
+                "torque {k}: {a:?} against {b:?}"
+            );
+            assert!(
+                (a[k + 3] - b[k + 3]).abs() <= 1e-3,
+                "duty {k}: {a:?} against {b:?}"
+            );
+        }
+    }
+}
