@@ -225,3 +225,40 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         duty.and(enable)
     }
 }
+
+/// The WoodenHaptics arm of `devices/woodenhaptics.toml`, for the firmware's bench and
+/// demo (a host test holds the two equal).
+pub const WOODENHAPTICS: mccs::ArmSpec = {
+    use mccs::{ArmSpec, GravitySpec, JointSpec};
+    const fn joint(ratio: f64, kt: f64, min: f64, max: f64) -> JointSpec {
+        JointSpec {
+            counts_per_rev: 2000.0,
+            ratio,
+            sign: 1.0,
+            home_count: 0,
+            home_angle_deg: 0.0,
+            torque_constant_nm_per_a: kt,
+            max_current_a: 3.0,
+            min_angle_deg: min,
+            max_angle_deg: max,
+        }
+    }
+    ArmSpec {
+        base_height_mm: 80.0,
+        upper_arm_mm: 205.0,
+        forearm_mm: 245.0,
+        tissue_origin_mm: [220.0, 0.0, 80.0],
+        joints: [
+            joint(16.0, 0.321, -60.0, 60.0),
+            joint(12.0, 0.0603, -30.0, 90.0),
+            joint(12.0, 0.0603, -30.0, 120.0),
+        ],
+        gravity: Some(GravitySpec {
+            upper_arm_mass_kg: 0.170,
+            upper_arm_com_mm: 51.0,
+            forearm_mass_kg: 0.110,
+            forearm_com_mm: 91.0,
+            g: 9.81,
+        }),
+    }
+};

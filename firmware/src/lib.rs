@@ -9,7 +9,7 @@
 //! - [`drivers`]: the AS5047P SPI encoder and the PWM motor (embedded-hal 1.0), and
 //!   [`one_dof`], a 1-DOF device made of the two;
 //! - [`arm_device`]: a 3-DOF arm (three quadrature joints, PWM motors) through the
-//!   core's `Arm`;
+//!   core's `Arm`; [`arm_f32`], the same chain in `f32`, the bench's peer;
 //! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
 //!   buffer between the main loop and the tick interrupt;
 //! - [`link`]: the device's side of the host link (`mccs-link`);
@@ -23,6 +23,7 @@
 #![deny(missing_docs)]
 
 pub mod arm_device;
+pub mod arm_f32;
 pub mod controller;
 pub mod demo;
 pub mod device;

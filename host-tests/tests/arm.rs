@@ -96,8 +96,8 @@ fn torques_are_the_virtual_work_of_the_forward_kinematics() {
         let f: [f64; 3] = std::array::from_fn(|_| rng.random_range(-5.0..5.0));
         let fixed = arm
             .drive(&arm.pose(c), f.map(Force::from_num))
-            .torque_q20
-            .map(|t| t as f64 / (1u64 << 20) as f64);
+            .torque_q8
+            .map(|t| t as f64 / 256.0);
         // Central differences of F · p(θ), in the twin, at the counts' angles.
         let t = twin.angles(c.map(f64::from));
         let h = 1e-6;
@@ -111,9 +111,10 @@ fn torques_are_the_virtual_work_of_the_forward_kinematics() {
         });
         let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for k in 0..3 {
+            // 0.5 % and a few of the torque's LSBs (1/256 N·mm): its products' truncations.
             let err = (fixed[k] - fd[k]).abs();
             assert!(
-                err <= 0.005 * scale + 1e-3,
+                err <= 0.005 * scale + 4.0 / 256.0,
                 "joint {k}: {} against {} N·mm",
                 fixed[k],
                 fd[k]
@@ -135,8 +136,8 @@ fn gravity_is_the_gradient_of_the_potential() {
         let c = counts_in(&spec, &twin, &mut rng);
         let fixed = arm
             .drive(&arm.pose(c), [Force::ZERO; 3])
-            .torque_q20
-            .map(|t| t as f64 / (1u64 << 20) as f64);
+            .torque_q8
+            .map(|t| t as f64 / 256.0);
         let t = twin.angles(c.map(f64::from));
         let h = 1e-6;
         for k in 0..3 {
@@ -147,7 +148,7 @@ fn gravity_is_the_gradient_of_the_potential() {
             let grad = (twin.potential(a) - twin.potential(b)) / (2.0 * h);
             let err = (fixed[k] - grad).abs();
             assert!(
-                err <= 0.005 * grad.abs() + 1e-3,
+                err <= 0.005 * grad.abs() + 4.0 / 256.0,
                 "joint {k}: {} against {grad} N·mm",
                 fixed[k]
             );
@@ -244,4 +245,35 @@ fn the_reciprocal_holds_over_its_domain() {
     }
     println!("ARM case=recip max_rel_err={worst:.2e}");
     assert!(worst < 1e-8, "{worst}");
+}
+
+/// The firmware's WoodenHaptics constant is the shipped device file.
+#[test]
+fn the_firmware_s_arm_is_the_device_file() {
+    assert_eq!(mccs_firmware::arm_device::WOODENHAPTICS, woodenhaptics());
+}
+
+/// The f32 peer the bench measures computes the same chain (within micromath's error).
+#[test]
+fn the_f32_peer_computes_the_same_chain() {
+    let spec = woodenhaptics();
+    let arm = Arm::new(&spec).unwrap();
+    let peer = mccs_firmware::arm_f32::ArmF32::new(&spec);
+    let twin = ArmTwin { spec };
+    let mut rng = ChaCha8Rng::seed_from_u64(58);
+    let mut worst = 0.0f64;
+    for _ in 0..100_000 {
+        let c = counts_on_branch(&spec, &twin, &mut rng);
+        let (p, _) = peer.chain(c, [0.0; 3]);
+        let exact = twin.fk(twin.angles(c.map(f64::from)));
+        let tissue: [f64; 3] = std::array::from_fn(|k| exact[k] - spec.tissue_origin_mm[k]);
+        worst = worst.max(dist(p.map(f64::from), tissue));
+        let fixed = arm.pose(c).probe.map(|l| l.to_num::<f64>());
+        for k in 0..3 {
+            if fixed[k].abs() < 127.0 {
+                assert!((p[k] as f64 - fixed[k]).abs() < 2.0, "{p:?} against {fixed:?}");
+            }
+        }
+    }
+    println!("ARM case=f32_peer fk_max_um={:.0}", worst * 1000.0);
 }

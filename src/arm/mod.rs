@@ -20,11 +20,13 @@
 //!   keeps its direction.
 //!
 //! # Fixed point
-//! Angles are full-turn phases (`u32`, 2³² a turn); `cos`/`sin` come from quartiq's
-//! `idsp::cossin` (its amplitude, 2³¹ (1 − 2⁻¹⁶), scaled to Q31; 9e-6 at most from the
-//! true values); lengths are Q16 mm, the
-//! device-frame position Q24 mm in `i64`, the tissue-frame probe the core's `Length`
-//! (Q24 mm, ±128 mm, saturated), torques Q20 N·mm, duties Q16 (65,536 = 100 %). Every
+//! Every product is of two 32-bit operands, most kept as their high word (one long
+//! multiply, `smmul` on the M4F). Angles are full-turn phases (`u32`, 2³² a turn);
+//! `cos`/`sin` come from quartiq's
+//! `idsp::cossin` (Q31 less 2⁻¹⁶, which the lengths make up; 9e-6 at most from the true
+//! values); lengths are Q17/Q18 mm, the device-frame position Q16 mm, the
+//! tissue-frame probe the core's `Length`
+//! (Q24 mm, ±128 mm, saturated), torques Q8 N·mm, duties Q16 (65,536 = 100 %). Every
 //! constant that divides is folded into a gain when the arm is made ([`Arm::new`]); the
 //! tick ([`Arm::pose`], [`Arm::drive`]) multiplies and shifts, and scales the duties by a
 //! reciprocal found by Newton's iteration ([`recip`]).
@@ -53,8 +55,8 @@ struct Joint {
     /// The joint's range, phases relative to home (signed).
     min_phase: i32,
     max_phase: i32,
-    /// Duty (Q16) per torque (Q20 N·mm): `(τ · gain) >> shift`.
-    duty_gain: i64,
+    /// Duty (Q16) per torque (Q8 N·mm): `(τ · gain) >> shift` (`gain` < 2²¹).
+    duty_gain: i32,
     duty_shift: u32,
 }
 
@@ -62,16 +64,19 @@ struct Joint {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Arm {
     joints: [Joint; 3],
-    /// `Ln`, Q24 mm.
-    base_q24: i64,
-    /// `Lb`, `Lc`, Q16 mm.
-    upper_q16: i64,
-    fore_q16: i64,
-    /// The tissue's origin in the device frame, Q24 mm.
-    origin_q24: [i64; 3],
-    /// Gravity: `g (m_b c_b + m_c Lb)` and `g m_c c_c`, Q16 N·mm.
-    gravity_b_q16: i64,
-    gravity_c_q16: i64,
+    /// `Ln`, Q16 mm.
+    base_q16: i32,
+    /// `Lb`, `Lc`, Q18 mm (for the reach, Q17) and Q17 mm (for the height, Q16); ≤ 1,000
+    /// mm: each product's high word is the value (one long multiply).
+    upper_q18: i32,
+    fore_q18: i32,
+    upper_q17: i32,
+    fore_q17: i32,
+    /// The tissue's origin in the device frame, Q16 mm.
+    origin_q16: [i32; 3],
+    /// Gravity: `g (m_b c_b + m_c Lb)` and `g m_c c_c`, Q16 N·mm (< 32,768 N·mm).
+    gravity_b_q16: i32,
+    gravity_c_q16: i32,
 }
 
 impl Arm {
@@ -86,11 +91,11 @@ impl Arm {
         let joint = |j: &JointSpec| {
             let per_turn = j.counts_per_rev * j.ratio;
             let phase = |deg: f64| libm::round(deg / 360.0 * TURN);
-            // Q16 duty per Q20 N·mm: sign / (ratio · Kt · Imax · 1000 N·mm per N·m), then
-            // held to 2²¹ with a shift, so that the product fits 64 bits.
+            // Q16 duty per Q8 N·mm: sign / (ratio · Kt · Imax · 1000 N·mm per N·m), then
+            // raised to 2²⁰ … 2²¹ with a shift, for the product's precision.
             let k = j.sign / (j.ratio * j.torque_constant_nm_per_a * j.max_current_a * 1000.0);
-            let mut shift = 20u32;
-            let mut gain = k * 65_536.0;
+            let mut shift = 0u32;
+            let mut gain = k * 256.0;
             while gain.abs() < (1u64 << 20) as f64 && shift < 60 {
                 gain *= 2.0;
                 shift += 1;
@@ -101,11 +106,16 @@ impl Arm {
                 phase_per_count: libm::round(j.sign * TURN * 65_536.0 / per_turn) as i64,
                 min_phase: phase(j.min_angle_deg - j.home_angle_deg) as i32,
                 max_phase: phase(j.max_angle_deg - j.home_angle_deg) as i32,
-                duty_gain: libm::round(gain) as i64,
+                duty_gain: libm::round(gain) as i32,
                 duty_shift: shift,
             }
         };
         let q = |mm: f64, bits: u32| libm::round(mm * (1u64 << bits) as f64) as i64;
+        // idsp's cos and sin have the amplitude 65,535 · 2¹⁵ = 2³¹ (1 − 2⁻¹⁶), not 2³¹: a
+        // length that multiplies one of them is raised by 1/(1 − 2⁻¹⁶), the reach's (x
+        // and y multiply two) by its square (a bias of 1.5e-5 otherwise: 7 µm on a
+        // 450 mm arm). The torques' 1.5e-5 is left (their bound is 0.5 %).
+        let amp = 1.0 / (1.0 - 1.0 / 65_536.0);
         let g = spec.gravity.unwrap_or(GravitySpec::NONE);
         Ok(Arm {
             joints: [
@@ -113,16 +123,18 @@ impl Arm {
                 joint(&spec.joints[1]),
                 joint(&spec.joints[2]),
             ],
-            base_q24: q(spec.base_height_mm, 24),
-            upper_q16: q(spec.upper_arm_mm, 16),
-            fore_q16: q(spec.forearm_mm, 16),
-            origin_q24: spec.tissue_origin_mm.map(|v| q(v, 24)),
+            base_q16: q(spec.base_height_mm, 16) as i32,
+            upper_q18: q(spec.upper_arm_mm * amp * amp, 18) as i32,
+            fore_q18: q(spec.forearm_mm * amp * amp, 18) as i32,
+            upper_q17: q(spec.upper_arm_mm * amp, 17) as i32,
+            fore_q17: q(spec.forearm_mm * amp, 17) as i32,
+            origin_q16: spec.tissue_origin_mm.map(|v| q(v, 16) as i32),
             gravity_b_q16: q(
                 g.g * (g.upper_arm_mass_kg * g.upper_arm_com_mm
                     + g.forearm_mass_kg * spec.upper_arm_mm),
                 16,
-            ),
-            gravity_c_q16: q(g.g * g.forearm_mass_kg * g.forearm_com_mm, 16),
+            ) as i32,
+            gravity_c_q16: q(g.g * g.forearm_mass_kg * g.forearm_com_mm, 16) as i32,
         })
     }
 }

@@ -19,10 +19,10 @@ pub const OUTSIDE: u8 = 8;
 pub struct ArmPose {
     /// `(cos, sin)` of A, B, C, Q31.
     pub cos_sin: [(i32, i32); 3],
-    /// `r = Lb sin B + Lc sin C`, Q20 mm.
-    pub reach_q20: i64,
-    /// The probe in the device frame, Q24 mm.
-    pub device_q24: [i64; 3],
+    /// `r = Lb sin B + Lc sin C`, Q17 mm (within ±2,000 mm).
+    pub reach_q17: i32,
+    /// The probe in the device frame, Q16 mm.
+    pub device_q16: [i32; 3],
     /// The probe in the tissue's frame (saturated at ±128 mm).
     pub probe: [Length; 3],
     /// [`LIMIT_A`], [`LIMIT_B`], [`LIMIT_C`], [`OUTSIDE`].
@@ -32,9 +32,18 @@ pub struct ArmPose {
 impl ArmPose {
     /// The probe in the device frame, mm (for the host and the log).
     pub fn device_mm(&self) -> [f64; 3] {
-        self.device_q24.map(|v| v as f64 / (1u64 << 24) as f64)
+        self.device_q16.map(|v| v as f64 / 65_536.0)
     }
 }
+
+/// The high word of a 32 × 32-bit product: `a b / 2³²` (one `smmul` on the M4F).
+#[inline(always)]
+pub(super) fn hi(a: i32, b: i32) -> i32 {
+    ((a as i64 * b as i64) >> 32) as i32
+}
+
+/// 128 mm in Q16, the tissue frame's end.
+const HOLD_Q16: i32 = (1 << 23) - 1;
 
 impl Arm {
     /// The arm at joint counts `counts` (A, B, C).
@@ -51,32 +60,30 @@ impl Arm {
                 flags |= 1 << k;
             }
             let phase = j.home_phase.wrapping_add(from_home as u32);
-            // idsp's amplitude is 65,535 · 2¹⁵ = 2³¹ (1 − 2⁻¹⁶): scaled up to Q31 (a
-            // bias of 1.5e-5, 7 µm on a 450 mm arm, otherwise).
-            let (c, s) = idsp::cossin(phase as i32);
-            cos_sin[k] = (c.saturating_add(c >> 16), s.saturating_add(s >> 16));
+            // (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the lengths.)
+            cos_sin[k] = idsp::cossin(phase as i32);
         }
-        let [(ca, sa), (cb, sb), (cc, sc)] = cos_sin.map(|(c, s)| (c as i64, s as i64));
-        // Q16 mm × Q31 = Q47: r in Q20, z in Q24.
-        let reach_q20 = (self.upper_q16 * sb + self.fore_q16 * sc) >> 27;
-        let device_q24 = [
-            (reach_q20 * ca) >> 27,
-            (reach_q20 * sa) >> 27,
-            self.base_q24 + ((self.upper_q16 * cb - self.fore_q16 * cc) >> 23),
+        let [(ca, sa), (cb, sb), (cc, sc)] = cos_sin;
+        // Q18 mm × Q31 / 2³² = Q17; Q17 × Q31 / 2³² = Q16.
+        let reach_q17 = hi(self.upper_q18, sb) + hi(self.fore_q18, sc);
+        let device_q16 = [
+            hi(reach_q17, ca),
+            hi(reach_q17, sa),
+            self.base_q16 + hi(self.upper_q17, cb) - hi(self.fore_q17, cc),
         ];
         let mut probe = [Length::ZERO; 3];
         for k in 0..3 {
-            let p = device_q24[k] - self.origin_q24[k];
-            let held = p.max(i32::MIN as i64).min(i32::MAX as i64);
+            let p = device_q16[k] - self.origin_q16[k];
+            let held = p.clamp(-HOLD_Q16, HOLD_Q16);
             if held != p {
                 flags |= OUTSIDE;
             }
-            probe[k] = Length::from_bits(held as i32);
+            probe[k] = Length::from_bits(held << 8);
         }
         ArmPose {
             cos_sin,
-            reach_q20,
-            device_q24,
+            reach_q17,
+            device_q16,
             probe,
             flags,
         }

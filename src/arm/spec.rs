@@ -84,7 +84,8 @@ pub enum ArmError {
     Motor(u8),
     /// A range not within ±180° with `min < home < max`.
     Range(u8),
-    /// A mass or centre of mass negative or not finite, or `g` not finite.
+    /// A mass or centre of mass negative or not finite, `g` not finite, or a gravity
+    /// torque of 32,768 N·mm or more.
     Gravity,
 }
 
@@ -98,7 +99,7 @@ impl ArmError {
             Self::Sign(_) => "joint: sign must be 1 or -1",
             Self::Motor(_) => "joint: torque_constant_nm_per_a and max_current_a must be finite and > 0",
             Self::Range(_) => "joint: min_angle_deg < home_angle_deg < max_angle_deg, within ±180",
-            Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g finite",
+            Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g finite, the torques under 32768 N·mm",
         }
     }
 
@@ -172,6 +173,13 @@ impl ArmSpec {
                 && ok(g.forearm_com_mm)
                 && g.g.is_finite())
             {
+                return Err(ArmError::Gravity);
+            }
+            let b = g.g
+                * (g.upper_arm_mass_kg * g.upper_arm_com_mm
+                    + g.forearm_mass_kg * self.upper_arm_mm);
+            let c = g.g * g.forearm_mass_kg * g.forearm_com_mm;
+            if !(b.abs() < 32_768.0 && c.abs() < 32_768.0) {
                 return Err(ArmError::Gravity);
             }
         }

@@ -147,8 +147,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                             f.map(Force::saturating_from_num),
                         );
                         (
-                            d.torque_q20
-                                .map(|t| t as f64 / (1u64 << 20) as f64 / 1000.0),
+                            d.torque_q8.map(|t| t as f64 / 256.0 / 1000.0),
                             d.duty_q16.map(|x| x as f64 / 65_536.0),
                         )
                     }

@@ -19,6 +19,8 @@ fn main() {
 mod fw_common;
 
 #[cfg(target_os = "none")]
+mod arm;
+#[cfg(target_os = "none")]
 mod cases;
 #[cfg(target_os = "none")]
 mod harness;
@@ -40,7 +42,7 @@ mod firmware {
     use super::report::{
         check_budgets, fits, largest_patch, substep_case, Figures, Steps, SPRING_PATH_SPREAD,
     };
-    use super::{cases, harness, hold_check, kernel_check, report, ticks};
+    use super::{arm, cases, harness, hold_check, kernel_check, report, ticks};
     use cases::TablePath;
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -204,6 +206,9 @@ mod firmware {
         figs.report("tick_proxy", ticks::tick_proxy(&h, table) - empty);
         // What the host link adds to a tick (the board's TIM2).
         figs.report("tick_link", ticks::tick_link(&h, table));
+        // The arm's counts to duties without the solver, fixed point and its f32 peer.
+        figs.report("arm_kinematics", arm::arm_kinematics(&h) - empty);
+        figs.report("arm_kinematics_f32", arm::arm_kinematics_f32(&h) - empty);
         // The solver's start-up for the demo's patch, once (millions of instructions).
         let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
         report::startup(&mut figs, grid, ticks::startup(&h, table));
