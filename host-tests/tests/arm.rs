@@ -271,7 +271,10 @@ fn the_f32_peer_computes_the_same_chain() {
         let fixed = arm.pose(c).probe.map(|l| l.to_num::<f64>());
         for k in 0..3 {
             if fixed[k].abs() < 127.0 {
-                assert!((p[k] as f64 - fixed[k]).abs() < 2.0, "{p:?} against {fixed:?}");
+                assert!(
+                    (p[k] as f64 - fixed[k]).abs() < 2.0,
+                    "{p:?} against {fixed:?}"
+                );
             }
         }
     }
