@@ -177,7 +177,8 @@ host_tests() {
 # The host link against the board firmware in QEMU (scripts/qemu-link.sh, which builds it
 # with the link's QEMU feature): one test, its figures in target/qemu/link.log.
 link_qemu() {
-  MCCS_LINK_QEMU=1 cargo test -p mccs-host --test host link::qemu:: -- --show-output \
+  # (--workspace: the host build's features, so that the test binary is not rebuilt.)
+  MCCS_LINK_QEMU=1 cargo test --workspace --test host -- link::qemu:: --show-output \
     > target/qemu/link.log 2>&1
   local status=$?
   grep -E '^LINK |test result' target/qemu/link.log

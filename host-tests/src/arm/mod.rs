@@ -2,6 +2,7 @@
 //! ([`device_file`]).
 
 pub mod device_file;
+pub mod joints;
 pub mod twin;
 
 pub use twin::ArmTwin;

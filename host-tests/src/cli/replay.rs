@@ -22,8 +22,16 @@ pub(super) struct Args {
     params: PathBuf,
     /// Probe trajectory, CSV `time_s,x_mm,y_mm,z_mm` (patch frame, surface at z = 0),
     /// times strictly increasing; sampled linearly at the tick rate.
-    #[arg(long)]
-    probe: PathBuf,
+    #[arg(long, required_unless_present = "joints", conflicts_with = "joints")]
+    probe: Option<PathBuf>,
+    /// A recorded arm motion instead, CSV `time_s,count_a,count_b,count_c`: each tick's
+    /// probe is the fixed forward kinematics of --device less its tissue origin, and the
+    /// rows end with the arm's duties (docs/arm.md).
+    #[arg(long, requires = "device")]
+    joints: Option<PathBuf>,
+    /// The arm's device file (with --joints).
+    #[arg(long, requires = "joints")]
+    device: Option<PathBuf>,
     #[command(flatten)]
     patch: PatchArgs,
     #[command(flatten)]
@@ -235,7 +243,71 @@ fn replay<const S: usize>(
     table: Option<&mccs::ForceTable<S>>,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    let traj = trajectory::read(&a.probe).map_err(|e| CliError::new(e.to_string()))?;
+    // The trajectory, or the arm's: each tick's probe from its counts, and its pose for
+    // the duties.
+    let (traj, arm) = match (&a.probe, &a.joints, &a.device) {
+        (Some(p), _, _) => (
+            trajectory::read(p).map_err(|e| CliError::new(e.to_string()))?,
+            None,
+        ),
+        (None, Some(j), Some(d)) => {
+            let spec = crate::arm::device_file::read(d).map_err(CliError::new)?;
+            let arm = mccs::Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
+            let rows = crate::arm::joints::read(j).map_err(CliError::new)?;
+            let ticks = crate::arm::joints::ticks(&rows, a.patch.rate, &arm);
+            let samples: Vec<(f64, [f64; 3])> = ticks
+                .iter()
+                .map(|(t, _, pose)| (*t, pose.probe.map(|c| c.to_num::<f64>())))
+                .collect();
+            let traj = trajectory::Trajectory::new(samples).map_err(|e| {
+                arg_error(
+                    "--joints",
+                    &format!(
+                        "the arm's probe (--device's fixed kinematics less its tissue origin): {}",
+                        e.what
+                    ),
+                )
+            })?;
+            (
+                traj,
+                Some((
+                    arm,
+                    ticks.into_iter().map(|(_, _, p)| p).collect::<Vec<_>>(),
+                )),
+            )
+        }
+        _ => {
+            return Err(arg_error(
+                "--probe",
+                "give --probe, or --joints with --device",
+            ))
+        }
+    };
+    // With an arm, each row ends with its duties at that tick.
+    let duties = |k: usize, force: [f64; 3]| -> String {
+        match &arm {
+            Some((arm, poses)) => {
+                let d = arm.drive(
+                    &poses[k.min(poses.len() - 1)],
+                    force.map(mccs::Force::saturating_from_num),
+                );
+                let q = |x: i32| x as f64 / 65_536.0;
+                format!(
+                    ",{},{},{}",
+                    q(d.duty_q16[0]),
+                    q(d.duty_q16[1]),
+                    q(d.duty_q16[2])
+                )
+            }
+            None => String::new(),
+        }
+    };
+    let duty_columns = if arm.is_some() {
+        ",duty_a,duty_b,duty_c"
+    } else {
+        ""
+    };
+    let mut tick = 0usize;
     let replay = Replay {
         grid: a.patch.grid,
         spacing: a.patch.spacing,
@@ -280,7 +352,7 @@ fn replay<const S: usize>(
     let done = match roaming {
         Some(roaming) => csv(
             w,
-            &header(true),
+            &format!("{}{duty_columns}", header(true)),
             |row| {
                 replay.roam_with(p, table, &traj, &roaming, |r: RoamRow| {
                     if let Some(line) = setup.take() {
@@ -288,14 +360,16 @@ fn replay<const S: usize>(
                     }
                     progress.at(r.time);
                     watch.see(r.time, r.probe, r.force);
-                    row(roam_line(&r))
+                    let k = tick;
+                    tick += 1;
+                    row(format!("{}{}", roam_line(&r), duties(k, r.force)))
                 })
             },
             fail,
         ),
         None => csv(
             w,
-            &header(false),
+            &format!("{}{duty_columns}", header(false)),
             |row| {
                 replay.run_with(p, table, &traj, |r| {
                     if let Some(line) = setup.take() {
@@ -303,7 +377,9 @@ fn replay<const S: usize>(
                     }
                     progress.at(r.time);
                     watch.see(r.time, r.probe, r.force);
-                    row(glued_line(&r))
+                    let k = tick;
+                    tick += 1;
+                    row(format!("{}{}", glued_line(&r), duties(k, r.force)))
                 })
             },
             fail,

@@ -177,3 +177,95 @@ fn both_backends_agree() {
         }
     }
 }
+
+/// A joint-space replay is the Cartesian replay at the fixed kinematics: the same forces
+/// (within 1e-3 N) with the probe at `FK − origin` each tick, and the duties the arm's
+/// drive gives for them.
+#[test]
+fn a_joint_space_replay_is_the_cartesian_replay_at_the_fixed_kinematics() {
+    let d = "devices/woodenhaptics.toml";
+    let joints = temp_file(
+        "arm-joints.csv",
+        "time_s,count_a,count_b,count_c\n0,0,1300,2450\n0.3,0,1333,2533\n1.0,400,1333,2533\n",
+    );
+    // The probe each tick: the counts interpolated and rounded, the core's kinematics.
+    let spec =
+        mccs_host::arm::device_file::read(std::path::Path::new("../devices/woodenhaptics.toml"))
+            .unwrap();
+    let arm = mccs::Arm::new(&spec).unwrap();
+    let mut probe = String::from("time_s,x_mm,y_mm,z_mm\n");
+    let keys = [
+        (0.0, [0.0, 1300.0, 2450.0]),
+        (0.3, [0.0, 1333.0, 2533.0]),
+        (1.0, [400.0, 1333.0, 2533.0]),
+    ];
+    for k in 0..=1000 {
+        let t = k as f64 / 1000.0;
+        let i = keys.iter().rposition(|(kt, _)| *kt <= t).unwrap().min(1);
+        let ((ta, a), (tb, b)) = (keys[i], keys[i + 1]);
+        let u = (t - ta) / (tb - ta);
+        let c: [i32; 3] = std::array::from_fn(|j| (a[j] + (b[j] - a[j]) * u).round() as i32);
+        let p = arm.pose(c).probe.map(|l| l.to_num::<f64>());
+        probe.push_str(&format!("{t:?},{:?},{:?},{:?}\n", p[0], p[1], p[2]));
+    }
+    let probe = temp_file("arm-probe.csv", &probe);
+    let common = [
+        "--params",
+        "params/table2.toml",
+        "--backend",
+        "fixed",
+        "--tissue",
+        "64,64",
+        "--friction",
+        "0.3,0.2",
+    ];
+    let rows = |o: std::process::Output| -> (String, Vec<Vec<f64>>) {
+        assert!(o.status.success(), "{o:?}");
+        let text = String::from_utf8(o.stdout).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap().to_string();
+        (
+            header,
+            lines
+                .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+                .collect(),
+        )
+    };
+    let (jh, jr) = rows(mccs(
+        &[
+            &[
+                "replay",
+                "--device",
+                d,
+                "--joints",
+                joints.to_str().unwrap(),
+            ][..],
+            &common,
+        ]
+        .concat(),
+    ));
+    let (ph, pr) = rows(mccs(
+        &[&["replay", "--probe", probe.to_str().unwrap()][..], &common].concat(),
+    ));
+    assert_eq!(jh, format!("{ph},duty_a,duty_b,duty_c"));
+    assert_eq!(jr.len(), pr.len());
+    let mut pressed = 0;
+    for (j, p) in jr.iter().zip(&pr) {
+        for k in 1..4 {
+            assert!(
+                (j[k] - p[k]).abs() <= 1e-3,
+                "t = {}: {j:?} against {p:?}",
+                j[0]
+            );
+        }
+        assert!(j[p.len()..].iter().all(|d| d.abs() <= 1.0));
+        if p[3] > 0.01 {
+            pressed += 1;
+            assert!(
+                j[p.len()..].iter().any(|d| *d != 0.0),
+                "a press without a duty"
+            );
+        }
+    }
+    assert!(pressed > 100, "{pressed} ticks in contact");
+}
