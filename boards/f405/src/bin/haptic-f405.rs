@@ -49,7 +49,7 @@ mod firmware {
     use haptic_f405::tissue::TISSUE;
     use heapless::spsc::{Consumer, Producer, Queue};
     use mccs::{ForceTable, ParamSet, Wide};
-    use mccs_firmware::link::{Effect, Guard, Live, Now, Replayer, Session};
+    use mccs_firmware::link::{Effect, Live, Now, Replayer, Session, TickLink};
     use mccs_firmware::{Mailbox, Shared};
     use mccs_link::{frame::parse, Core, Decoder, ToDevice, ToHost, MAX_FRAME};
     use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
@@ -72,13 +72,10 @@ mod firmware {
     /// chunk while the main loop checks a tissue (the host waits for each chunk's status).
     const RX_QUEUE: usize = 2048;
 
-    /// The link's guard, read and stepped by the tick, armed by the main loop.
-    static GUARD: Shared<Guard> = Shared::new(Guard::at_rate(BOARD.tick_hz));
-    /// The tissue's origin the host asked for (Q24 mm).
-    static POSE: Shared<[i32; 3]> = Shared::new([0; 3]);
-    /// A checked tissue for the tick to swap in; the flag spares the tick the copy.
+    /// The link's guard, pose and swap flag, shared by the tick and the main loop.
+    static LINK: TickLink = TickLink::new(BOARD.tick_hz);
+    /// A checked tissue for the tick to swap in.
     static SWAP: Mailbox<Segments> = Mailbox::new();
-    static SWAP_READY: Shared<bool> = Shared::new(false);
     /// USART2's receiver and the queue's producer, for its interrupt.
     static LINK_RX: Mailbox<(Rx<pac::USART2>, Producer<'static, u8>)> = Mailbox::new();
     /// Bytes the queue could not take.
@@ -299,8 +296,8 @@ mod firmware {
                 ticks: t.run.ticks,
                 overruns: t.run.overruns,
                 fault: t.run.fault.is_some(),
-                armed: GUARD.get().armed(),
-                pose: POSE.get(),
+                armed: LINK.guard.get().armed(),
+                pose: LINK.pose.get(),
             };
             let tx = &mut self.tx;
             let mut send = |m: &ToHost| {
@@ -324,20 +321,19 @@ mod firmware {
                         continue;
                     }
                 };
-                GUARD.update(|g| g.frame(now.ticks));
+                LINK.guard.update(|g| g.frame(now.ticks));
                 match self.session.handle(msg, now, self.replayer, &mut send) {
                     Effect::None => {}
-                    Effect::Arm => GUARD.update(|g| g.arm(now.ticks)),
-                    Effect::Disarm => GUARD.update(|g| g.disarm()),
+                    Effect::Arm => LINK.guard.update(|g| g.arm(now.ticks)),
+                    Effect::Disarm => LINK.guard.update(|g| g.disarm()),
                     Effect::Pose(origin) => {
-                        POSE.set(origin);
+                        LINK.pose.set(origin);
                         now.pose = origin;
                     }
                     Effect::Swap { set, tissue } => {
                         self.pending =
                             Some((*set.table(), tissue, t.run.swaps, t.run.rejected_swaps));
-                        let _ = SWAP.post(set);
-                        SWAP_READY.set(true);
+                        LINK.post_swap(&SWAP, set);
                     }
                 }
                 if bytes >= 512 {
@@ -436,18 +432,7 @@ mod firmware {
             tick.stop();
             return;
         }
-        let ticks = ctl.telemetry().ticks;
-        let gain = GUARD.update(|g| g.gain(ticks));
-        let d = ctl.device_mut();
-        d.set_gain(gain);
-        d.set_target(POSE.get());
-        let swap = if SWAP_READY.get() {
-            SWAP_READY.set(false);
-            SWAP.take()
-        } else {
-            None
-        };
-        ctl.tick(swap);
+        let (_, gain) = LINK.tick(ctl, &SWAP);
         watchdog.feed();
         let us = tick.count();
         let cycles = elapsed(start, cycles());
