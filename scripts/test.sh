@@ -182,6 +182,12 @@ link_qemu() {
     > target/qemu/link.log 2>&1
   local status=$?
   grep -E '^LINK |test result' target/qemu/link.log
+  if [ "$status" != 0 ]; then
+    # What failed, and what the firmware logged last.
+    grep -E -A4 'panicked at' target/qemu/link.log
+    echo "the firmware's log, last lines (target/qemu/link-firmware.log):"
+    tail -n 8 target/qemu/link-firmware.log
+  fi
   return $status
 }
 

@@ -82,6 +82,23 @@ fn hello(link: &mut Link) -> HelloInfo {
     }
 }
 
+/// Waits for the firmware to listen: bytes that reach QEMU's USART before the firmware
+/// enables it are dropped, and a loaded host runs QEMU slowly (a first `Status` sent
+/// at once went unanswered in CI). Says `Hello` every 200 ms, as `mccs link` does.
+fn ready(link: &mut Link) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while Instant::now() < deadline {
+        link.send(&ToDevice::Hello).unwrap();
+        let until = Instant::now() + Duration::from_millis(200);
+        while let Some(m) = link.recv(until).unwrap() {
+            if matches!(m, ToHost::Hello(_)) {
+                return;
+            }
+        }
+    }
+    panic!("the firmware never answered hello");
+}
+
 fn frame(msg: &ToDevice) -> Vec<u8> {
     let mut f = [0u8; MAX_FRAME];
     encode(msg, &mut f).unwrap().to_vec()
@@ -138,6 +155,7 @@ fn the_board_firmware_in_qemu_serves_the_link() {
     let _qemu = start(&socket);
     let addr = format!("unix:{}", socket.display());
     let mut link = Link::connect(&Addr::parse(&addr).unwrap()).unwrap();
+    ready(&mut link);
 
     // Hello within 50 ticks: the ticks between a status before and one after.
     let s0 = status(&mut link);
