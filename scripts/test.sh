@@ -41,7 +41,9 @@ clippy_thumb() {
     --lib --bins -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu -- -D warnings || return 1
-  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu-link -- -D warnings
+  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu-link -- -D warnings || return 1
+  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features arm,qemu -- -D warnings || return 1
+  cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features arm -- -D warnings
 }
 
 # Without warnings, which fails the stage: rustc's on the M3 are checked here, as the
@@ -167,6 +169,20 @@ board_f405() {
   python3 scripts/check_tick_path.py "$elf" TIM2 "$init" | tail -n 1
 }
 
+# The arm variant of the board (--features arm): its size, its tick path (the arm's
+# kinematics in it), and its QEMU run (never homed there: no fault, zero duty).
+board_f405_arm() {
+  local t=thumbv7em-none-eabihf elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
+  cargo build --release -p haptic-f405 --target "$t" --bin haptic-f405 --features arm || return 1
+  python3 scripts/size.py "$elf" "$t" haptic-f405-arm 98304 32768 | tee target/qemu/sizes-f405-arm.txt
+  [ "${PIPESTATUS[0]}" = 0 ] || return 1
+  python3 scripts/check_tick_path.py "$elf" TIM2 haptic_f405::firmware::init | tail -n 1 || return 1
+  bash scripts/f405-qemu.sh --arm > target/qemu/f405-arm.log || { tail -n 5 target/qemu/f405-arm.log; return 1; }
+  grep '^INFO  arm homed' target/qemu/f405-arm.log | tail -n 1
+  tail -n 1 target/qemu/f405-arm.log
+  tail -n 1 target/qemu/f405-arm.log | grep -q '^SUMMARY board=f405-arm .* verdict=ok$'
+}
+
 # The property tests on a fixed seed, so that a run is reproducible (`cargo test` alone
 # draws a new one each time, and so does scripts/long.sh: they explore).
 host_tests() {
@@ -240,6 +256,7 @@ run_stage budget-breach-fails budget_test
 run_stage bench-truncated-fails bench_truncated
 run_stage firmware-size sizes
 run_stage board-f405 board_f405
+run_stage board-f405-arm board_f405_arm
 run_stage link-qemu link_qemu
 run_stage host-tests wait_host_tests
 run_stage docs-figures python3 scripts/figures.py check

@@ -8,7 +8,7 @@ use crate::tissue::SEGMENTS;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
-use mccs::{ForceTable, Solver, SolverError, Topology, TopologyError};
+use mccs::{ArmError, ForceTable, Solver, SolverError, Topology, TopologyError};
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
 use mccs_firmware::link::LinkedDevice;
@@ -52,6 +52,8 @@ pub type BoardController<D, const S: usize = SEGMENTS> = Controller<D, NODES, ED
 pub enum StartError<E> {
     /// A constant of the [`BoardConfig`].
     Config(BoardConfigError),
+    /// The arm's device constant ([`crate::arm`]).
+    Arm(ArmError),
     /// Putting the new device in its safe state failed.
     SafeState(E),
     /// The patch.
@@ -66,6 +68,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
     pub fn fault(&self) -> StartFault {
         match self {
             Self::Config(e) => StartFault::Config(*e),
+            Self::Arm(e) => StartFault::Arm(*e),
             Self::SafeState(e) => StartFault::SafeState(match e {
                 OneDofError::Spi(_) => DevicePart::Spi,
                 OneDofError::Encoder => DevicePart::Encoder,
@@ -85,6 +88,8 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
 pub enum StartFault {
     /// A constant of the [`BoardConfig`].
     Config(BoardConfigError),
+    /// The arm's device constant.
+    Arm(ArmError),
     /// Putting the device in its safe state failed, at this part.
     SafeState(DevicePart),
     /// The patch.
@@ -106,6 +111,14 @@ pub enum DevicePart {
     Direction,
     /// The motor driver's enable pin.
     Enable,
+    /// The arm's joint `0..3` (A, B, C): its quadrature counter.
+    JointEncoder(u8),
+    /// Its PWM channel.
+    JointPwm(u8),
+    /// Its direction pin.
+    JointDirection(u8),
+    /// The arm's home input.
+    Home,
 }
 
 impl DevicePart {
@@ -117,7 +130,41 @@ impl DevicePart {
             Self::Pwm => "the motor's PWM channel",
             Self::Direction => "the motor's direction pin",
             Self::Enable => "the motor driver's enable pin",
+            Self::JointEncoder(k) => pick(
+                *k,
+                [
+                    "joint A's counter",
+                    "joint B's counter",
+                    "joint C's counter",
+                ],
+            ),
+            Self::JointPwm(k) => pick(
+                *k,
+                [
+                    "joint A's PWM channel",
+                    "joint B's PWM channel",
+                    "joint C's PWM channel",
+                ],
+            ),
+            Self::JointDirection(k) => pick(
+                *k,
+                [
+                    "joint A's direction pin",
+                    "joint B's direction pin",
+                    "joint C's direction pin",
+                ],
+            ),
+            Self::Home => "the arm's home input",
         }
+    }
+}
+
+/// Joint `k`'s name of three (C past the end).
+const fn pick(k: u8, names: [&'static str; 3]) -> &'static str {
+    match k {
+        0 => names[0],
+        1 => names[1],
+        _ => names[2],
     }
 }
 
@@ -125,6 +172,10 @@ impl core::fmt::Display for StartFault {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::Config(e) => write!(f, "config: {e}"),
+            Self::Arm(e) => match e.joint() {
+                Some(k) => write!(f, "{} (joint {})", e.message(), pick(k, ["A", "B", "C"])),
+                None => f.write_str(e.message()),
+            },
             Self::SafeState(p) => write!(f, "safe state: {} failed", p.name()),
             Self::Topology(e) => write!(f, "{e}"),
             Self::Solver(e) => write!(f, "solver: {e}"),
@@ -137,6 +188,15 @@ impl defmt::Format for StartFault {
     fn format(&self, f: defmt::Formatter) {
         match self {
             Self::Config(e) => defmt::write!(f, "config: {=str}", e.message()),
+            Self::Arm(e) => match e.joint() {
+                Some(k) => defmt::write!(
+                    f,
+                    "{=str} (joint {=str})",
+                    e.message(),
+                    pick(k, ["A", "B", "C"])
+                ),
+                None => defmt::write!(f, "{=str}", e.message()),
+            },
             Self::SafeState(p) => defmt::write!(f, "safe state: {=str} failed", p.name()),
             Self::Topology(e) => defmt::write!(f, "{}", e),
             Self::Solver(e) => defmt::write!(f, "solver: {}", e),
@@ -179,7 +239,7 @@ where
 pub fn controller_into<SPI, PWM, DIR, EN, const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
-    mut device: BoardDevice<SPI, PWM, DIR, EN>,
+    device: BoardDevice<SPI, PWM, DIR, EN>,
     slot: &mut Option<BoardController<Linked<SPI, PWM, DIR, EN>, S>>,
 ) -> Result<
     (),
@@ -194,6 +254,23 @@ where
     DIR: OutputPin,
     EN: OutputPin,
 {
+    controller_with(config, table, device, slot, |d| {
+        d.motor.enable().map_err(OneDofError::Motor)
+    })
+}
+
+/// [`controller_into`] for any device (the arm's too, [`crate::arm`]): the patch and the
+/// solver on `config` and `table`, then `enable` (the motor driver on, duty still zero);
+/// on an error the device is put in its safe state and handed back with the error.
+#[inline(never)]
+#[allow(clippy::type_complexity)]
+pub fn controller_with<D: HapticDevice, const S: usize>(
+    config: &BoardConfig,
+    table: ForceTable<S>,
+    mut device: D,
+    slot: &mut Option<BoardController<LinkedDevice<D>, S>>,
+    enable: impl FnOnce(&mut D) -> Result<(), D::Error>,
+) -> Result<(), (StartError<D::Error>, D)> {
     let built = Topology::standard_patch(config.grid, SPACING_MM)
         .map_err(StartError::Topology)
         .and_then(|topo| Solver::new(topo, table, &config.solver()).map_err(StartError::Solver));
@@ -204,9 +281,9 @@ where
             return Err((e, device));
         }
     };
-    if let Err(e) = device.motor.enable() {
+    if let Err(e) = enable(&mut device) {
         let _ = device.safe_state();
-        return Err((StartError::SafeState(OneDofError::Motor(e)), device));
+        return Err((StartError::SafeState(e), device));
     }
     *slot = Some(Controller::new(
         solver,

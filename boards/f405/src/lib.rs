@@ -7,15 +7,19 @@
 //!
 //! - [`config`]: [`BoardConfig`](config::BoardConfig), every constant a port changes
 //!   but the pins, held to the parts' limits, and the HAL's clock arithmetic;
+//! - [`arm`]: the arm variant's device (`--features arm`: the WoodenHaptics arm);
 //! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
 //! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
 //! - [`tissue`]: the force table the firmware runs (`boards/f405/tissue.rs`);
-//! - `pins` (firmware builds only): the pin map.
+//! - `pins`, `arm_pins` (firmware builds only): the pin maps, 1-DOF and arm.
 //!
 //! docs/firmware.md, "Bring-up on a board", is the firmware engineer's guide.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+pub mod arm;
+#[cfg(target_os = "none")]
+pub mod arm_pins;
 pub mod config;
 pub mod device;
 #[cfg(target_os = "none")]

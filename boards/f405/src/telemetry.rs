@@ -26,6 +26,12 @@ pub struct BoardTelemetry {
     pub probe: [i32; 3],
     /// The host link's force gain on the last tick (Q15).
     pub gain: u16,
+    /// The arm's joint duties last written, Q16 (the arm variant; zero on the 1-DOF).
+    pub duties: [i32; 3],
+    /// The arm's pose flags (`mccs::arm::LIMIT_*`, `OUTSIDE`).
+    pub arm_flags: u8,
+    /// Whether the arm has been homed.
+    pub homed: bool,
 }
 
 impl BoardTelemetry {
@@ -45,6 +51,9 @@ impl BoardTelemetry {
             fault_tick: None,
             probe: [0; 3],
             gain: mccs_firmware::link::guard::FULL,
+            duties: [0; 3],
+            arm_flags: 0,
+            homed: false,
         }
     }
 
@@ -93,6 +102,8 @@ pub enum QemuMismatch {
     Fault,
     /// Putting the device in its safe state reported an error.
     SafeState,
+    /// An arm that was never homed drove a joint.
+    Unhomed,
 }
 
 impl QemuMismatch {
@@ -103,29 +114,35 @@ impl QemuMismatch {
             Self::Overrun => "a tick overran its period",
             Self::Fault => "the encoder's zeros did not fault the read on the expected tick",
             Self::SafeState => "the safe state reported an error",
+            Self::Unhomed => "a joint was driven before the arm was homed",
         }
     }
 }
 
-/// Holds a QEMU run (the encoder reads zeros there) to the fault rules.
-pub fn qemu_verdict(config: &BoardConfig, t: &BoardTelemetry) -> Result<(), QemuMismatch> {
+/// Holds a QEMU run to the fault rules: the safe state entered through a failed read on
+/// `fault_tick` (the 1-DOF board: its SPI reads zeros, [`zeros_fault_tick`]) or never
+/// (`None`: the arm, whose counters read and whose home input stays low), and no duty on
+/// an arm that was never homed.
+pub fn qemu_verdict(
+    config: &BoardConfig,
+    t: &BoardTelemetry,
+    fault_tick: Option<u32>,
+) -> Result<(), QemuMismatch> {
     if t.run.ticks != config.qemu_ticks {
         return Err(QemuMismatch::Ticks);
     }
     if t.run.overruns != 0 {
         return Err(QemuMismatch::Overrun);
     }
-    let expected = zeros_fault_tick(config);
-    let fault = if expected.is_some() {
-        Some(Fault::Read)
-    } else {
-        None
-    };
-    if t.run.fault != fault || t.fault_tick != expected {
+    let fault = fault_tick.map(|_| Fault::Read);
+    if t.run.fault != fault || t.fault_tick != fault_tick {
         return Err(QemuMismatch::Fault);
     }
     if t.run.safe_state_errors != 0 {
         return Err(QemuMismatch::SafeState);
+    }
+    if !t.homed && t.duties != [0; 3] {
+        return Err(QemuMismatch::Unhomed);
     }
     Ok(())
 }

@@ -4,6 +4,9 @@
 //! `--features qemu` runs it in QEMU (`netduinoplus2`) instead: see docs/firmware.md,
 //! "Bring-up on a board", and `haptic_f405` for the parts tested on the host.
 //!
+//! `--features arm` drives the WoodenHaptics 3-DOF arm instead (`haptic_f405::arm`:
+//! three quadrature timers, TIM1's three PWM channels; docs/arm.md).
+//!
 //! - The tick interrupt owns the hardware: `main` builds the device (in its safe state)
 //!   and hands it over; the tick's first run builds the controller, enables the driver,
 //!   starts the watchdog and the tick timer.
@@ -28,6 +31,14 @@ fn main() {
     std::process::exit(2);
 }
 
+// The device each variant drives: its pins, its parts, its controller.
+#[cfg(all(target_os = "none", feature = "arm"))]
+#[path = "variant/arm.rs"]
+mod arm;
+#[cfg(all(target_os = "none", not(feature = "arm")))]
+#[path = "variant/one_dof.rs"]
+mod one_dof;
+
 #[cfg(target_os = "none")]
 mod firmware {
     #[cfg(not(feature = "qemu"))]
@@ -39,12 +50,8 @@ mod firmware {
 
     use cortex_m::peripheral::NVIC;
     use cortex_m_rt::entry;
-    use embedded_hal_bus::spi::{ExclusiveDevice, NoDelay};
-    use haptic_f405::config::{self, spi_clock_hz, tick_timer, AS5047P_MAX_SPI_HZ, BOARD};
-    use haptic_f405::device::{
-        self, BoardController, Linked, StartFault, EDGES, NODES, SPACING_MM,
-    };
-    use haptic_f405::pins::{EncoderCs, MotorDirection, MotorEnable, Pins};
+    use haptic_f405::config::{self, tick_timer, BOARD};
+    use haptic_f405::device::{StartFault, EDGES, NODES, SPACING_MM};
     use haptic_f405::telemetry::BoardTelemetry;
     use haptic_f405::tissue::TISSUE;
     use heapless::spsc::{Consumer, Producer, Queue};
@@ -55,14 +62,14 @@ mod firmware {
     use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
     use stm32f4xx_hal::prelude::*;
     use stm32f4xx_hal::serial::{Rx, Tx};
-    use stm32f4xx_hal::spi::Spi;
-    use stm32f4xx_hal::timer::{PwmChannel, Timer};
+    use stm32f4xx_hal::timer::Timer;
     use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
-    type Encoder = ExclusiveDevice<Spi<pac::SPI1>, EncoderCs, NoDelay>;
-    type Motor = PwmChannel<pac::TIM1, 0>;
-    type Device = haptic_f405::device::BoardDevice<Encoder, Motor, MotorDirection, MotorEnable>;
-    type Ctl = BoardController<Linked<Encoder, Motor, MotorDirection, MotorEnable>>;
+    #[cfg(feature = "arm")]
+    use crate::arm as variant;
+    #[cfg(not(feature = "arm"))]
+    use crate::one_dof as variant;
+    use variant::{build_device, take_pins, Ctl, Device, Timers};
     type Segments = ParamSet<{ haptic_f405::tissue::SEGMENTS }, Wide>;
 
     /// Path samples a replay buffers.
@@ -131,10 +138,25 @@ mod firmware {
             cp.SYST.enable_counter();
         }
 
-        let pins = Pins::take(dp.GPIOA.split(), dp.GPIOB.split());
+        let pins = take_pins(dp.GPIOA.split(), dp.GPIOB.split(), dp.GPIOC.split());
+        // The device first, in its safe state; it hands back the link's pins.
+        let (device, max_duty, (link_tx, link_rx)) = match build_device(
+            pins,
+            &clocks,
+            Timers {
+                tim1: dp.TIM1,
+                spi1: dp.SPI1,
+                tim3: dp.TIM3,
+                tim4: dp.TIM4,
+                tim5: dp.TIM5,
+            },
+        ) {
+            Ok(built) => built,
+            Err(fault) => fail_with(fault),
+        };
         // The host link: USART2 at 115200 8N1, its receive interrupt feeding a queue.
         let Ok(serial) = dp.USART2.serial(
-            (pins.link_tx, pins.link_rx),
+            (link_tx, link_rx),
             stm32f4xx_hal::serial::Config::default().baudrate(115_200.bps()),
             &clocks,
         ) else {
@@ -149,28 +171,6 @@ mod firmware {
         };
         let (producer, consumer) = queue.split();
         let _ = LINK_RX.post((link_rx, producer));
-        let spi_hz = spi_clock_hz(clocks.pclk2().raw(), BOARD.spi_request_hz);
-        if spi_hz == 0 || spi_hz > AS5047P_MAX_SPI_HZ {
-            fail_with(StartFault::Config(config::BoardConfigError::SpiTooFast));
-        }
-        let spi = Spi::new(
-            dp.SPI1,
-            (pins.sck, pins.miso, pins.mosi),
-            device::SPI_MODE,
-            BOARD.spi_request_hz.Hz(),
-            &clocks,
-        );
-        // The chip select's error is `Infallible`.
-        let Ok(encoder) = ExclusiveDevice::new_no_delay(spi, pins.cs);
-        let (_pwm, (ch1, ..)) = dp.TIM1.pwm_hz(BOARD.pwm_hz.Hz(), &clocks);
-        let mut motor = ch1.with(pins.pwm);
-        motor.set_duty(0);
-        motor.enable();
-        let max_duty = motor.get_max_duty();
-        let device = match device::device(&BOARD, encoder, motor, pins.direction, pins.enable) {
-            Ok(d) => d,
-            Err(e) => fail_with(e.fault()),
-        };
 
         // QEMU's timers run at 1 GHz whatever the clock tree says.
         let timer_clock = if cfg!(feature = "qemu") {
@@ -209,9 +209,9 @@ mod firmware {
             Start::Pending => fail("the tick's first run did not start"),
         };
         defmt::info!(
-            "mccs haptic-f405: sysclk={=u32} Hz, spi={=u32} Hz (mode 1), pwm={=u32} Hz ({=u16} steps), tick={=u32} Hz, watchdog={=u32} ms; N={=usize} patch, {=usize} springs, {=u32} substeps per tick",
+            "mccs haptic-f405: sysclk={=u32} Hz, device={=str}, pwm={=u32} Hz ({=u16} steps), tick={=u32} Hz, watchdog={=u32} ms; N={=usize} patch, {=usize} springs, {=u32} substeps per tick",
             clocks.sysclk().raw(),
-            spi_hz,
+            variant::DEVICE,
             BOARD.pwm_hz,
             max_duty,
             BOARD.tick_hz,
@@ -403,6 +403,7 @@ mod firmware {
             e.implausible,
             e.diagnostic
         );
+        variant::log_second(t);
         if let (Some(fault), Some(at)) = (t.run.fault, t.fault_tick) {
             defmt::error!("safe state since tick {=u32}: {}", at, fault);
         }
@@ -440,12 +441,8 @@ mod firmware {
             ctl.note_overrun();
         }
         let mut t = TELEMETRY.get();
-        t.record(
-            ctl.telemetry(),
-            us,
-            cycles,
-            ctl.device().inner().encoder.errors(),
-        );
+        t.record(ctl.telemetry(), us, cycles, variant::encoder_errors(ctl));
+        variant::record(ctl, &mut t);
         t.probe = ctl.device().probe().map(|c| c.to_bits());
         t.gain = gain;
         TELEMETRY.set(t);
@@ -483,7 +480,7 @@ mod firmware {
         else {
             return;
         };
-        match device::controller_into(&BOARD, TISSUE, device, ctl) {
+        match variant::controller_into(&BOARD, TISSUE, device, ctl) {
             Ok(()) => {
                 if let Some(c) = ctl {
                     START.set(Start::Running {
@@ -496,7 +493,7 @@ mod firmware {
                 *hw = Some((tick, watchdog));
             }
             // The device is in its safe state; the timer never starts.
-            Err((e, _)) => START.set(Start::Failed(e.fault())),
+            Err((fault, _)) => START.set(Start::Failed(fault)),
         }
     }
 
@@ -548,11 +545,12 @@ mod firmware {
     #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
     fn qemu_end(t: &BoardTelemetry) -> ! {
         use haptic_f405::telemetry::qemu_verdict;
-        let verdict = qemu_verdict(&BOARD, t);
+        let verdict = qemu_verdict(&BOARD, t, variant::QEMU_FAULT_TICK);
         // SysTick counts at 168 MHz → instructions at 2^shift ns each (-icount shift=3).
         let instructions = t.worst_cycles as f32 * 1e9 / (168e6 * 8.0);
         defmt::println!(
-            "SUMMARY board=f405 ticks={=u32} overruns={=u32} fault={=str} fault_tick={=i32} worst_tick_instructions={=u32} safe_state_errors={=u32} verdict={=str}",
+            "SUMMARY board={=str} ticks={=u32} overruns={=u32} fault={=str} fault_tick={=i32} worst_tick_instructions={=u32} safe_state_errors={=u32} verdict={=str}",
+            variant::NAME,
             t.run.ticks,
             t.run.overruns,
             match t.run.fault {

@@ -1,0 +1,82 @@
+//! The board's arm variant (`--features arm`): the WoodenHaptics arm of
+//! `devices/woodenhaptics.toml` ([`ARM`]) as the tick's device — three quadrature
+//! counters, three PWM channels with their direction pins, one driver enable and a home
+//! input ([`ArmDevice`]) — from any embedded-hal 1.0 parts (the HAL's on the board, mocks
+//! in `tests/arm_wiring.rs`). docs/arm.md, "The arm on the board", has the pins and the
+//! bring-up.
+
+use crate::config::BoardConfig;
+use crate::device::{controller_with, BoardController, DevicePart, StartError, StartFault};
+use embedded_hal::digital::{InputPin, OutputPin};
+use mccs::{Arm, ArmSpec, ForceTable};
+use mccs_firmware::arm_device::{ArmDevice, ArmFault, Joint};
+use mccs_firmware::link::LinkedDevice;
+use mccs_firmware::HapticDevice;
+
+/// The arm the board drives: the firmware's WoodenHaptics constant, which a host test
+/// holds equal to `devices/woodenhaptics.toml`. A port to another arm replaces it.
+pub const ARM: ArmSpec = mccs_firmware::arm_device::WOODENHAPTICS;
+
+/// The board's arm on these parts.
+pub type BoardArm<A, B, C, EN, HOME> = ArmDevice<A, B, C, EN, HOME>;
+/// The board's arm as the tick drives it, with the host link's pose and force gain.
+pub type LinkedArm<A, B, C, EN, HOME> = LinkedDevice<BoardArm<A, B, C, EN, HOME>>;
+
+impl StartError<ArmFault> {
+    /// The error as the log tells it ([`StartFault`]), the device's error by the part
+    /// that failed.
+    pub fn fault(&self) -> StartFault {
+        match self {
+            Self::Config(e) => StartFault::Config(*e),
+            Self::Arm(e) => StartFault::Arm(*e),
+            Self::SafeState(e) => StartFault::SafeState(match *e {
+                ArmFault::Encoder(k) => DevicePart::JointEncoder(k),
+                ArmFault::Pwm(k) => DevicePart::JointPwm(k),
+                ArmFault::Direction(k) => DevicePart::JointDirection(k),
+                ArmFault::Enable => DevicePart::Enable,
+                ArmFault::Home => DevicePart::Home,
+            }),
+            Self::Topology(e) => StartFault::Topology(*e),
+            Self::Solver(e) => StartFault::Solver(*e),
+        }
+    }
+}
+
+/// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
+/// driver disabled) before it is returned; not homed (no force until the home input
+/// reads high).
+#[allow(clippy::type_complexity)]
+pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    joints: (A, B, C),
+    enable: EN,
+    home: HOME,
+) -> Result<BoardArm<A, B, C, EN, HOME>, StartError<ArmFault>> {
+    config.check().map_err(StartError::Config)?;
+    let arm = Arm::new(spec).map_err(StartError::Arm)?;
+    let mut device = ArmDevice::new(arm, joints, enable, home);
+    device.safe_state().map_err(StartError::SafeState)?;
+    Ok(device)
+}
+
+/// [`crate::device::controller_into`] for the arm: the controller into `slot`, then the
+/// driver enabled (duties still zero, and zero until the arm is homed). The error hands
+/// the device back, in its safe state (large: no heap to box it in, and it runs once).
+#[inline(never)]
+#[allow(clippy::type_complexity, clippy::result_large_err)]
+pub fn arm_controller_into<
+    A: Joint,
+    B: Joint,
+    C: Joint,
+    EN: OutputPin,
+    HOME: InputPin,
+    const S: usize,
+>(
+    config: &BoardConfig,
+    table: ForceTable<S>,
+    device: BoardArm<A, B, C, EN, HOME>,
+    slot: &mut Option<BoardController<LinkedArm<A, B, C, EN, HOME>, S>>,
+) -> Result<(), (StartError<ArmFault>, BoardArm<A, B, C, EN, HOME>)> {
+    controller_with(config, table, device, slot, |d| d.enable())
+}
