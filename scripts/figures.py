@@ -43,7 +43,7 @@ def figures() -> dict:
     for path in sources:
         if not path.exists():
             continue
-        core = re.match(r"demo-(\w+)\.log", path.name)
+        core = re.match(r"demo-([\w-]+)\.log", path.name)
         for raw in path.read_text(errors="replace").splitlines():
             m = LINE.match(raw.strip())
             if not m:

@@ -39,6 +39,7 @@ clippy_thumb() {
   cargo clippy --release -p mccs -p mccs-link --target thumbv6m-none-eabi -- -D warnings || return 1
   cargo clippy --release -p mccs-firmware --target thumbv6m-none-eabi --target thumbv7em-none-eabihf \
     --lib --bins -- -D warnings || return 1
+  cargo clippy --release -p mccs-firmware --target thumbv7em-none-eabihf --bins --features arm -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu -- -D warnings || return 1
   cargo clippy --release -p haptic-f405 --target thumbv7em-none-eabihf --lib --bins --features qemu-link -- -D warnings || return 1
@@ -78,6 +79,21 @@ demo_core() {
   bash scripts/firmware.sh "$core" > "$out" || return 1
   tail -n 2 "$out"
   target/debug/mccs demo --core "$core" --check "$out"
+}
+
+# The demo on the arm (--features arm, the M4F): the palpation through the WoodenHaptics
+# arm's joint counts, its SUMMARY with the duties equal to the host's run, its tick path
+# checked (the arm's chain in it); then the demo firmware rebuilt without the feature,
+# for the stages after.
+demo_arm() {
+  local out=target/qemu/demo-m4f-arm.log elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic
+  bash scripts/firmware.sh m4f --features arm > "$out" || { tail -n 5 "$out"; return 1; }
+  tail -n 2 "$out"
+  target/debug/mccs demo --core m4f --arm --check "$out" || return 1
+  python3 scripts/check_tick_path.py "$elf" | tail -n 1 || return 1
+  python3 scripts/size.py "$elf" thumbv7em-none-eabihf haptic-arm 98304 16384 | tee target/qemu/sizes-arm.txt
+  [ "${PIPESTATUS[0]}" = 0 ] || return 1
+  cargo build --release -p mccs-firmware --target thumbv7em-none-eabihf --bin haptic
 }
 
 tick_path() {
@@ -249,6 +265,7 @@ run_stage firmware-builds firmware_builds
 run_stage demo-m4f-in-a-terminal demo_in_a_terminal
 run_stage demo-m3 demo_core m3
 run_stage demo-m0 demo_core m0
+run_stage demo-m4f-arm demo_arm
 run_stage tick-path tick_path
 run_stage panic-exits-with-failure panic_test
 run_stage bench bash scripts/bench.sh

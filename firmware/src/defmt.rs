@@ -1,5 +1,6 @@
 //! Every `defmt::Format` impl of the device layer, in one place (feature `defmt`).
 
+use crate::arm_sim::SimArmError;
 use crate::demo::DemoError;
 use crate::{Fault, PathError};
 use defmt::{write, Format, Formatter};
@@ -16,6 +17,15 @@ impl Format for PathError {
     }
 }
 
+impl Format for SimArmError {
+    fn format(&self, f: Formatter) {
+        match self {
+            Self::Unreachable(t) => write!(f, "{=str} (tick {=u32})", self.message(), t),
+            _ => write!(f, "{=str}", self.message()),
+        }
+    }
+}
+
 impl Format for DemoError {
     fn format(&self, f: Formatter) {
         match self {
@@ -23,6 +33,7 @@ impl Format for DemoError {
             Self::Solver(e) => write!(f, "{}", e),
             Self::Path(e) => write!(f, "{}", e),
             Self::Contact(e) => write!(f, "{}", e),
+            Self::Arm(e) => write!(f, "{}", e),
         }
     }
 }

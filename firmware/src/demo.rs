@@ -8,6 +8,7 @@
 //! [`Mailbox`](crate::mailbox::Mailbox). Each core runs the
 //! [`DemoSpec`] that fits its instruction budget.
 
+use crate::arm_sim::{samples_for, SimArmError, SimulatedArm};
 use crate::controller::{Controller, Roaming};
 use crate::device::SimulatedDevice;
 use crate::probe_path::{palpation_path, PathError, ProbePath};
@@ -150,6 +151,32 @@ impl DemoSpec {
         Ok(())
     }
 
+    /// [`Self::controller_into`] on the arm ([`ArmDemoControllerIn`]): the same solver,
+    /// contact and palpation, the probe read through the WoodenHaptics arm's joint
+    /// counts (the path converted once, here) and the force written as its duties.
+    #[inline(never)]
+    pub fn arm_controller_into<const N: usize, const E: usize, A: Arith>(
+        &self,
+        table: &ForceTable64,
+        slot: &mut Option<ArmDemoControllerIn<N, E, A>>,
+    ) -> Result<(), DemoError> {
+        let topo = Topology::standard_patch(self.grid, SPACING).map_err(DemoError::Topology)?;
+        let path = palpation_path(self.tick_hz).map_err(DemoError::Path)?;
+        let arm = SimulatedArm::from_path(&ARM, &path, self.ticks(), self.steady_tick())
+            .map_err(DemoError::Arm)?;
+        let mut solver = Solver::with_arith(topo, *table, &self.config(), A::default())
+            .map_err(DemoError::Solver)?;
+        let start = path.at(0).map(|c| c.to_num::<f64>());
+        let contact = self.roaming(&mut solver, start[0], start[1])?;
+        *slot = Some(Controller::with_contact(
+            solver,
+            contact,
+            arm,
+            self.steady_tick(),
+        ));
+        Ok(())
+    }
+
     /// The demo's contact for `solver`, the window centred at `(x, y)` (mm, tissue frame).
     /// Out of line, like the other start-up builders.
     #[inline(never)]
@@ -228,6 +255,18 @@ pub const FRICTION: (f64, f64) = (0.6, 0.4);
 
 /// The demo's device.
 pub type DemoDevice = SimulatedDevice<9>;
+/// The arm the arm demo drives: WoodenHaptics (`devices/woodenhaptics.toml`).
+pub const ARM: mccs::ArmSpec = crate::arm_device::WOODENHAPTICS;
+/// Samples of joint counts the arm demo's 4 s at 1 kHz take.
+pub const ARM_SAMPLES: usize = samples_for(4000);
+/// The arm demo's device: the palpation through the arm's joints.
+pub type ArmDemoDevice = SimulatedArm<ARM_SAMPLES>;
+/// An arm demo controller ([`DemoSpec::arm_controller_into`]).
+pub type ArmDemoControllerIn<const NODES: usize, const EDGES: usize, A> =
+    Controller<ArmDemoDevice, NODES, EDGES, 64, A, Roaming<EDGES>>;
+/// An arm demo controller in this core's arithmetic.
+pub type ArmDemoControllerOf<const NODES: usize, const EDGES: usize> =
+    ArmDemoControllerIn<NODES, EDGES, mccs::DefaultArith>;
 /// A demo controller in arithmetic `A` with capacity for `NODES` node slots (the ground
 /// included) and `EDGES` springs.
 pub type DemoControllerIn<const NODES: usize, const EDGES: usize, A> =
@@ -261,6 +300,8 @@ pub enum DemoError {
     Path(PathError),
     /// The proxy or the window.
     Contact(ProxyError),
+    /// The arm demo's arm.
+    Arm(SimArmError),
 }
 
 impl core::fmt::Display for DemoError {
@@ -270,6 +311,7 @@ impl core::fmt::Display for DemoError {
             Self::Solver(e) => e.fmt(f),
             Self::Path(e) => e.fmt(f),
             Self::Contact(e) => e.fmt(f),
+            Self::Arm(e) => e.fmt(f),
         }
     }
 }
@@ -319,4 +361,60 @@ fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
         steady_force: t.steady_force.to_num(),
         window_shifts: t.window_shifts,
     })
+}
+
+/// What the arm demo ends with besides [`Summary`]: the duties (Q16 → fractions of full
+/// scale) at the steady tick, and the largest |duty| of any joint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArmSummary {
+    /// Joints A, B, C at the steady tick.
+    pub steady_duty: [f32; 3],
+    /// The largest |duty| over the run.
+    pub max_duty: f32,
+}
+
+impl ArmSummary {
+    /// Of the demo's arm after its run.
+    pub fn of(arm: &ArmDemoDevice) -> Self {
+        let q16 = |d: i32| d as f32 / 65_536.0;
+        Self {
+            steady_duty: arm.steady_duties().map(q16),
+            max_duty: q16(arm.max_duty()),
+        }
+    }
+}
+
+/// [`run_on_host`] on the arm ([`DemoSpec::arm_controller_into`]).
+pub fn run_arm_on_host(spec: &DemoSpec) -> Result<(Summary, ArmSummary), DemoError> {
+    if spec.core == "m0" {
+        run_arm_on_host_in::<Narrow>(spec)
+    } else {
+        run_arm_on_host_in::<Wide>(spec)
+    }
+}
+
+fn run_arm_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<(Summary, ArmSummary), DemoError> {
+    let mut slot: Option<ArmDemoControllerIn<37, 214, A>> = None;
+    spec.arm_controller_into(&TABLE2, &mut slot)?;
+    let mut ctl = slot.ok_or(DemoError::Path(PathError::Count))?;
+    let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
+    for tick in 0..spec.ticks() {
+        let s = if tick >= spec.swap_tick() {
+            swap.take()
+        } else {
+            None
+        };
+        ctl.tick(s);
+    }
+    let t = ctl.telemetry();
+    Ok((
+        Summary {
+            ticks: t.ticks,
+            overruns: t.overruns,
+            max_force: t.max_force.to_num(),
+            steady_force: t.steady_force.to_num(),
+            window_shifts: t.window_shifts,
+        },
+        ArmSummary::of(ctl.device()),
+    ))
 }

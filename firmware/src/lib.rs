@@ -24,6 +24,7 @@
 
 pub mod arm_device;
 pub mod arm_f32;
+pub mod arm_sim;
 pub mod controller;
 pub mod demo;
 pub mod device;

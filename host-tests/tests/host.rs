@@ -10,6 +10,8 @@ mod architecture;
 mod arith;
 #[path = "arm.rs"]
 mod arm;
+#[path = "arm_demo.rs"]
+mod arm_demo;
 #[path = "arm_device.rs"]
 mod arm_device;
 #[path = "cap.rs"]

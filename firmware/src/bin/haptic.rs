@@ -49,8 +49,24 @@ mod firmware {
     /// the M3, N = 4 on the M0, whose 16 KiB of RAM must also hold the start-up's stack).
     const NODES: usize = mccs::topology::standard_capacity(SPEC.grid).0;
     const EDGES: usize = mccs::topology::standard_capacity(SPEC.grid).1;
-    /// The controller type.
+    /// The controller type: the palpation on a simulated probe, or (`--features arm`)
+    /// through the simulated arm's joints.
+    #[cfg(not(feature = "arm"))]
     type Ctl = demo::DemoControllerOf<NODES, EDGES>;
+    #[cfg(feature = "arm")]
+    type Ctl = demo::ArmDemoControllerOf<NODES, EDGES>;
+    // The M0's 16 KiB of RAM do not hold the arm demo's samples of counts (3 KB) beside
+    // its controller and its start-up's stack.
+    const _: () = assert!(
+        !(cfg!(feature = "arm") && matches!(CORE, Core::M0)),
+        "the arm demo runs on the M4F and the M3, not the M0"
+    );
+    /// The start line's device.
+    const DEVICE: &str = if cfg!(feature = "arm") {
+        " on the arm (WoodenHaptics)"
+    } else {
+        ""
+    };
 
     /// Log every this many ticks (every 0.1 s).
     const TRACE_EVERY: u32 = SPEC.tick_hz / 10;
@@ -71,6 +87,9 @@ mod firmware {
     static START: Shared<Start> = Shared::new(Start::Pending);
     static SWAP: Mailbox<ParamSet<64>> = Mailbox::new();
     static TELEMETRY: Shared<Telemetry> = Shared::new(Telemetry::new());
+    /// The arm's duties (`--features arm`): the last, the steady tick's, the largest.
+    #[cfg(feature = "arm")]
+    static DUTIES: Shared<([i32; 3], [i32; 3], i32)> = Shared::new(([0; 3], [0; 3], 0));
     /// The longest tick so far, SysTick counts.
     static WORST_TICK: Shared<u32> = Shared::new(0);
     /// SysTick counts per tick.
@@ -95,8 +114,9 @@ mod firmware {
         };
         let swap_substeps = post_swap();
         defmt::info!(
-            "mccs haptic demo: core={=str} tick={=u32} Hz, N={=usize} window on a {=usize} x {=usize} tissue, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
+            "mccs haptic demo: core={=str}{=str} tick={=u32} Hz, N={=usize} window on a {=usize} x {=usize} tissue, {=usize} springs, {=u32} substeps per tick ({=u32} after the swap), budget {=u32} instructions per tick",
             SPEC.core,
+            DEVICE,
             SPEC.tick_hz,
             SPEC.grid,
             demo::WINDOW.tissue_w,
@@ -128,6 +148,17 @@ mod firmware {
                     t.force[2].to_num::<f32>(),
                     t.window_shifts
                 );
+                #[cfg(feature = "arm")]
+                {
+                    let (d, ..) = DUTIES.get();
+                    defmt::info!(
+                        "tick={=u32} duty=({=f32}, {=f32}, {=f32})",
+                        t.ticks,
+                        q16(d[0]),
+                        q16(d[1]),
+                        q16(d[2])
+                    );
+                }
             }
             if let Some(fault) = t.fault {
                 defmt::error!("safe state: {}", defmt::Debug2Format(&fault));
@@ -143,6 +174,7 @@ mod firmware {
                     SPEC.icount_shift,
                     SPEC.budget()
                 );
+                #[cfg(not(feature = "arm"))]
                 defmt::println!(
                     "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32}",
                     t.ticks,
@@ -151,6 +183,22 @@ mod firmware {
                     t.steady_force.to_num::<f32>(),
                     t.window_shifts
                 );
+                #[cfg(feature = "arm")]
+                {
+                    let (_, steady, max) = DUTIES.get();
+                    defmt::println!(
+                        "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32} steady_duty_a={=f32} steady_duty_b={=f32} steady_duty_c={=f32} max_duty={=f32}",
+                        t.ticks,
+                        t.overruns,
+                        t.max_force.to_num::<f32>(),
+                        t.steady_force.to_num::<f32>(),
+                        t.window_shifts,
+                        q16(steady[0]),
+                        q16(steady[1]),
+                        q16(steady[2]),
+                        q16(max)
+                    );
+                }
                 exit(t.fault.is_none());
             }
         }
@@ -158,9 +206,19 @@ mod firmware {
 
     #[exception]
     fn SysTick() {
-        static mut CTL: Option<Ctl> = None;
-        let Some(ctl) = CTL.as_mut() else {
-            init(CTL);
+        // The controller in `.bss`: an `Option<Ctl>` static is initialised data (its
+        // `None` is a niche value), its image in flash as large as the controller.
+        // Written `None` once.
+        static mut CTL: core::mem::MaybeUninit<Option<Ctl>> = core::mem::MaybeUninit::uninit();
+        static mut CTL_WRITTEN: bool = false;
+        if !*CTL_WRITTEN {
+            CTL.write(None);
+            *CTL_WRITTEN = true;
+        }
+        // SAFETY: written above before its first read.
+        let slot = unsafe { CTL.assume_init_mut() };
+        let Some(ctl) = slot.as_mut() else {
+            init(slot);
             return;
         };
         run_tick(ctl);
@@ -201,13 +259,28 @@ mod firmware {
         }
         WORST_TICK.set(WORST_TICK.get().max(elapsed));
         TELEMETRY.set(ctl.telemetry());
+        #[cfg(feature = "arm")]
+        {
+            let arm = ctl.device();
+            DUTIES.set((arm.duties(), arm.steady_duties(), arm.max_duty()));
+        }
+    }
+
+    /// A Q16 duty as a fraction of full scale (the host's `demo::ArmSummary` the same).
+    #[cfg(feature = "arm")]
+    fn q16(d: i32) -> f32 {
+        d as f32 / 65_536.0
     }
 
     /// Builds the controller into the tick's slot. Out of line: its construction's stack
     /// space is free again before the ticks start (the M0 has 16 KiB of RAM).
     #[inline(never)]
     fn init(slot: &mut Option<Ctl>) {
-        match SPEC.controller_into(&demo::TABLE2, slot) {
+        #[cfg(not(feature = "arm"))]
+        let built = SPEC.controller_into(&demo::TABLE2, slot);
+        #[cfg(feature = "arm")]
+        let built = SPEC.arm_controller_into(&demo::TABLE2, slot);
+        match built {
             Ok(()) => {
                 if let Some(ctl) = slot {
                     START.set(Start::Built(Info {
