@@ -34,10 +34,10 @@ fn main() {
 // The device each variant drives: its pins, its parts, its controller.
 #[cfg(all(target_os = "none", feature = "arm"))]
 #[path = "variant/arm.rs"]
-mod arm;
+mod variant;
 #[cfg(all(target_os = "none", not(feature = "arm")))]
 #[path = "variant/one_dof.rs"]
-mod one_dof;
+mod variant;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -65,11 +65,7 @@ mod firmware {
     use stm32f4xx_hal::timer::Timer;
     use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
-    #[cfg(feature = "arm")]
-    use crate::arm as variant;
-    #[cfg(not(feature = "arm"))]
-    use crate::one_dof as variant;
-    use variant::{build_device, take_pins, Ctl, Device, Timers};
+    use crate::variant::{self, build_device, take_pins, Ctl, Device, Timers};
     type Segments = ParamSet<{ haptic_f405::tissue::SEGMENTS }, Wide>;
 
     /// Path samples a replay buffers.
