@@ -62,6 +62,11 @@ firmware_builds() {
   fi
 }
 
+# A demo log's longest tick as a figure line: `TICK demo=<name> instructions=<i>`.
+longest_tick() {
+  sed -n "s/^INFO  longest tick: .* = \([0-9.]*\) instructions under .*/TICK demo=$1 instructions=\1/p" "$2"
+}
+
 # The main job as a person runs it (the README's two steps): scripts/demo.sh in a
 # terminal (script(1) gives it a pseudo-terminal), whose firmware output must end with
 # its SUMMARY line, then `mccs demo --check` on the log the demo leaves.
@@ -71,7 +76,8 @@ demo_in_a_terminal() {
   tr -d '\r' < "$out.raw" | grep -vE '^(\.\.\.  |ok   |setup: )' > "$out.seen"
   tail -n 1 "$out.seen" | grep -q '^SUMMARY ' || { echo "the demo did not end with its SUMMARY line"; return 1; }
   cmp -s "$out.seen" "$out" || { echo "the demo's log $out is not what the terminal showed"; return 1; }
-  target/debug/mccs demo --core m4f --check "$out"
+  target/debug/mccs demo --core m4f --check "$out" || return 1
+  longest_tick m4f "$out" > target/qemu/demo-tick-m4f.txt
 }
 
 demo_core() {
@@ -80,6 +86,7 @@ demo_core() {
   tail -n 2 "$out"
   target/debug/mccs demo --core "$core" --check "$out"
 }
+
 
 # The demo on the arm (--features arm, the M4F): the palpation through the WoodenHaptics
 # arm's joint counts, its SUMMARY with the duties equal to the host's run, its tick path
@@ -90,6 +97,11 @@ demo_arm() {
   bash scripts/firmware.sh m4f --features arm > "$out" || { tail -n 5 "$out"; return 1; }
   tail -n 2 "$out"
   target/debug/mccs demo --core m4f --arm --check "$out" || return 1
+  longest_tick m4f-arm "$out" > target/qemu/demo-tick-m4f-arm.txt
+  # The largest patch at 1 kHz within half a tick on the arm: 84,000 instructions at 168 MHz.
+  [ -s target/qemu/demo-tick-m4f-arm.txt ] \
+    && awk '{split($3, a, "="); if (a[2] + 0 > 84000 || a[2] == "") exit 1}' target/qemu/demo-tick-m4f-arm.txt \
+    || { echo "the arm demo's longest tick is over half a tick (84000 instructions)"; return 1; }
   python3 scripts/check_tick_path.py "$elf" | tail -n 1 || return 1
   python3 scripts/size.py "$elf" thumbv7em-none-eabihf haptic-arm 98304 16384 | tee target/qemu/sizes-arm.txt
   [ "${PIPESTATUS[0]}" = 0 ] || return 1
