@@ -344,6 +344,14 @@ pub fn run_on_host(spec: &DemoSpec) -> Result<Summary, DemoError> {
 
 fn run_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<Summary, DemoError> {
     let mut ctl: DemoControllerIn<37, 214, A> = spec.controller(&TABLE2)?;
+    run_ticks(spec, &mut ctl)
+}
+
+/// The demo's ticks on `ctl`, the swap handed over as the firmware does; its summary.
+fn run_ticks<D: crate::device::HapticDevice, A: Arith>(
+    spec: &DemoSpec,
+    ctl: &mut Controller<D, 37, 214, 64, A, Roaming<214>>,
+) -> Result<Summary, DemoError> {
     let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
     for tick in 0..spec.ticks() {
         let s = if tick >= spec.swap_tick() {
@@ -397,24 +405,6 @@ fn run_arm_on_host_in<A: Arith>(spec: &DemoSpec) -> Result<(Summary, ArmSummary)
     let mut slot: Option<ArmDemoControllerIn<37, 214, A>> = None;
     spec.arm_controller_into(&TABLE2, &mut slot)?;
     let mut ctl = slot.ok_or(DemoError::Path(PathError::Count))?;
-    let mut swap = Some(spec.swapped_set::<37, 214, A>()?);
-    for tick in 0..spec.ticks() {
-        let s = if tick >= spec.swap_tick() {
-            swap.take()
-        } else {
-            None
-        };
-        ctl.tick(s);
-    }
-    let t = ctl.telemetry();
-    Ok((
-        Summary {
-            ticks: t.ticks,
-            overruns: t.overruns,
-            max_force: t.max_force.to_num(),
-            steady_force: t.steady_force.to_num(),
-            window_shifts: t.window_shifts,
-        },
-        ArmSummary::of(ctl.device()),
-    ))
+    let summary = run_ticks(spec, &mut ctl)?;
+    Ok((summary, ArmSummary::of(ctl.device())))
 }
