@@ -8,8 +8,13 @@ use mccs::{Arm, ArmPose};
 /// The rows of a joints file, or one line naming the file and the row (the header is
 /// row 1).
 pub fn read(path: &std::path::Path) -> Result<Vec<(f64, [f64; 3])>, String> {
-    let file = path.display();
+    let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| format!("{file}: cannot read: {e}"))?;
+    parse(&text, &file)
+}
+
+/// [`read`] on text; `file` names it in errors.
+pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, [f64; 3])>, String> {
     let header = "time_s,count_a,count_b,count_c";
     let mut lines = text.lines();
     match lines
