@@ -276,7 +276,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     }
 
     /// Rest position of node `i` (Q24 mm), `None` if it does not exist.
-    pub(crate) fn rest_q24(&self, i: usize) -> Option<[i32; 3]> {
+    pub fn rest_q24(&self, i: usize) -> Option<[i32; 3]> {
         self.rest.get(i).copied()
     }
 

@@ -21,7 +21,7 @@ pub mod table_bytes;
 
 pub use frame::{encode, Decoder, FrameError, MAX_FRAME, MAX_PAYLOAD};
 pub use message::{
-    Core, HelloInfo, NakReason, ReplayRow, ReplaySpec, RoamSpec, SpecOption, StatusInfo, Telemetry,
-    ToDevice, ToHost,
+    Core, HelloInfo, MeshPart, NakReason, ReplayRow, ReplaySpec, RoamSpec, SpecOption, StatusInfo,
+    Telemetry, ToDevice, ToHost, MESH_PART,
 };
 pub use schema::{PROTOCOL, SCHEMA};

@@ -58,6 +58,12 @@ pub enum ToDevice<'a> {
         /// The samples.
         points: &'a [u8],
     },
+    /// The live patch's node positions every `every` ticks (0: none), for the visuals;
+    /// the device holds it to 60 a second at most. Answered by [`ToHost::Mesh`] parts.
+    WatchMesh {
+        /// Ticks between two meshes.
+        every: u16,
+    },
 }
 
 /// From the device to the host.
@@ -88,6 +94,29 @@ pub enum ToHost {
         /// Ticks run.
         ticks: u32,
     },
+    /// A part of a live mesh: up to [`MESH_PART`] nodes' positions.
+    Mesh(MeshPart),
+}
+
+/// Nodes one [`ToHost::Mesh`] part carries (its frame stays within 256 bytes).
+pub const MESH_PART: usize = 12;
+
+/// Nodes `first .. first + MESH_PART` (those below `nodes`) of the live patch at `tick`:
+/// each free node's rest position plus its displacement, in the patch's frame, Q24 mm
+/// (`x, y, z`). The parts of one mesh share `seq` and `tick`; a mesh the device could
+/// not send is counted in the telemetry's drops and its `seq` skipped.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct MeshPart {
+    /// Counts meshes, sent or dropped: a gap is a drop.
+    pub seq: u32,
+    /// The tick the positions are from.
+    pub tick: u32,
+    /// The first node in this part.
+    pub first: u16,
+    /// The nodes in the whole mesh.
+    pub nodes: u16,
+    /// Positions, Q24 mm; past `nodes − first`, zero.
+    pub positions: [[i32; 3]; MESH_PART],
 }
 
 /// The core a device runs on.

@@ -5,15 +5,18 @@
 //!   gain;
 //! - [`session`]: each message handled in the main loop, a tissue load checked whole
 //!   before the tick sees it;
-//! - [`replayer`]: a host's replay run on the device's own solver.
+//! - [`replayer`]: a host's replay run on the device's own solver;
+//! - [`mesh`]: the live patch's node positions for the host's visuals.
 
 pub mod guard;
 pub mod linked;
+pub mod mesh;
 pub mod replayer;
 pub mod session;
 
 pub use guard::Guard;
 pub use linked::LinkedDevice;
+pub use mesh::{Mesh, MeshClock};
 pub use replayer::Replayer;
 pub use session::{Effect, Live, Now, Session};
 
@@ -21,9 +24,10 @@ use crate::{Controller, Mailbox, Shared};
 use mccs::{Arith, Force, ParamSet};
 
 /// What the tick shares with the main loop for the link: the guard (the tick steps its
-/// gain, the main loop arms and disarms it), the pose the host asked for, and whether a
+/// gain, the main loop arms and disarms it), the pose the host asked for, whether a
 /// checked tissue waits in the swap mailbox (a flag, so that the tick copies a parameter
-/// set only when there is one). The board's statics; the bench measures the same.
+/// set only when there is one), and when a mesh is due for the visuals. The board's
+/// statics; the bench measures the same.
 pub struct TickLink {
     /// The guard.
     pub guard: Shared<Guard>,
@@ -31,6 +35,8 @@ pub struct TickLink {
     pub pose: Shared<[i32; 3]>,
     /// A parameter set waits in the swap mailbox.
     pub swap_ready: Shared<bool>,
+    /// When the tick takes a mesh.
+    pub mesh: MeshClock,
 }
 
 impl TickLink {
@@ -40,12 +46,14 @@ impl TickLink {
             guard: Shared::new(Guard::at_rate(tick_hz)),
             pose: Shared::new([0; 3]),
             swap_ready: Shared::new(false),
+            mesh: MeshClock::new(),
         }
     }
 
     /// One tick of `ctl` with the link: the guard's gain and the pose to the device,
-    /// then the controller's tick with the set waiting in `swap`, if any. Returns the
-    /// force the controller computed (the device renders it times the gain) and the gain.
+    /// then the controller's tick with the set waiting in `swap`, if any, then, when one
+    /// is due, the patch's mesh posted to `mesh` for the main loop. Returns the force the
+    /// controller computed (the device renders it times the gain) and the gain.
     pub fn tick<
         D: crate::HapticDevice,
         const N: usize,
@@ -57,6 +65,7 @@ impl TickLink {
         &self,
         ctl: &mut Controller<LinkedDevice<D>, N, E, S, A, C>,
         swap: &Mailbox<ParamSet<S, A>>,
+        mesh: &Mailbox<Mesh<N>>,
     ) -> ([Force; 3], u16) {
         let ticks = ctl.telemetry().ticks;
         let gain = self.guard.update(|g| g.gain(ticks));
@@ -69,7 +78,11 @@ impl TickLink {
         } else {
             None
         };
-        (ctl.tick(set), gain)
+        let force = ctl.tick(set);
+        if self.mesh.due() {
+            let _ = mesh.post(Mesh::of(ctl.solver(), ticks));
+        }
+        (force, gain)
     }
 
     /// Posts a checked parameter set for the next tick.

@@ -11,7 +11,9 @@
 
 use super::replayer::Replayer;
 use mccs::{Arith, ForceTable, ParamSet, RawTable, Solver, SolverConfig, TableBound, Topology};
-use mccs_link::message::{HelloInfo, NakReason, StatusInfo, Telemetry, ToDevice, ToHost};
+use mccs_link::message::{
+    HelloInfo, MeshPart, NakReason, StatusInfo, Telemetry, ToDevice, ToHost, MESH_PART,
+};
 use mccs_link::{table_bytes, Core, PROTOCOL, SCHEMA};
 
 /// The live device, as the session describes it.
@@ -60,6 +62,8 @@ pub enum Effect<const S: usize, A: Arith> {
     Disarm,
     /// Move the tissue's origin here (Q24 mm).
     Pose([i32; 3]),
+    /// Take a mesh every this many ticks (0: none; [`super::MeshClock::set`]).
+    WatchMesh(u16),
 }
 
 /// A table arriving in pieces: its words as they are written.
@@ -83,6 +87,9 @@ pub struct Session<const S: usize> {
     next_watch: u32,
     seq: u32,
     dropped: u32,
+    mesh_every: u32,
+    last_mesh: Option<u32>,
+    mesh_seq: u32,
 }
 
 impl<const S: usize> Session<S> {
@@ -98,6 +105,9 @@ impl<const S: usize> Session<S> {
             next_watch: 0,
             seq: 0,
             dropped: 0,
+            mesh_every: 0,
+            last_mesh: None,
+            mesh_seq: 0,
         }
     }
 
@@ -163,6 +173,14 @@ impl<const S: usize> Session<S> {
                 self.watch_every = every as u32;
                 self.next_watch = now.ticks;
                 Effect::None
+            }
+            ToDevice::WatchMesh { every } => {
+                // 60 meshes a second at most.
+                let least = super::mesh::least_every(self.live.config.tick_hz as u32);
+                let every = if every == 0 { 0 } else { every.max(least) };
+                self.mesh_every = every as u32;
+                self.last_mesh = None;
+                Effect::WatchMesh(every)
             }
             ToDevice::TissueBegin {
                 segments,
@@ -321,6 +339,50 @@ impl<const S: usize> Session<S> {
         if !send(&msg) {
             self.dropped = self.dropped.saturating_add(1);
         }
+    }
+}
+
+impl<const S: usize> Session<S> {
+    /// Sends a mesh the tick took, in parts of [`MESH_PART`] nodes (`send` returns false
+    /// when it could not take one: the mesh is counted as dropped). Meshes the tick took
+    /// but the main loop never sent (the gap in their ticks) are counted as dropped and
+    /// their numbers skipped.
+    pub fn mesh<const N: usize>(
+        &mut self,
+        m: &super::Mesh<N>,
+        send: &mut dyn FnMut(&ToHost) -> bool,
+    ) {
+        let every = self.mesh_every;
+        if every == 0 {
+            return;
+        }
+        if let Some(last) = self.last_mesh {
+            let missed = (m.tick.saturating_sub(last) / every).saturating_sub(1);
+            self.mesh_seq = self.mesh_seq.wrapping_add(missed);
+            self.dropped = self.dropped.saturating_add(missed);
+        }
+        self.last_mesh = Some(m.tick);
+        let nodes = (m.nodes as usize).min(N);
+        let mut sent = true;
+        for first in (0..nodes).step_by(MESH_PART) {
+            let mut positions = [[0i32; 3]; MESH_PART];
+            for (k, p) in positions.iter_mut().enumerate() {
+                if first + k < nodes {
+                    *p = m.positions[first + k];
+                }
+            }
+            sent &= send(&ToHost::Mesh(MeshPart {
+                seq: self.mesh_seq,
+                tick: m.tick,
+                first: first as u16,
+                nodes: nodes as u16,
+                positions,
+            }));
+        }
+        if !sent {
+            self.dropped = self.dropped.saturating_add(1);
+        }
+        self.mesh_seq = self.mesh_seq.wrapping_add(1);
     }
 }
 

@@ -53,6 +53,16 @@ enum Command {
         #[arg(long, default_value_t = 10)]
         every: u16,
     },
+    /// Stream the live patch's node positions (for the visuals) as CSV for S seconds:
+    /// `seq,tick,node,x_mm,y_mm,z_mm`, one row per node (patch frame).
+    Mesh {
+        /// How long, s (0 … 3600).
+        #[arg(long, default_value_t = 1.0)]
+        seconds: f64,
+        /// Ticks between meshes (1 … 1000; the device takes at most 60 a second).
+        #[arg(long, default_value_t = 17)]
+        every: u16,
+    },
     /// Move the tissue's origin in the device frame, mm.
     Pose {
         /// X,Y,Z, mm (each within ±100).
@@ -136,6 +146,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Load { params, knots } => load(&mut link, &a.connect, &hello, &params, knots, out),
         Command::Replay(r) => replay(&mut link, &a.connect, &hello, r, out),
         Command::Watch { seconds, every } => watch(&mut link, &a.connect, seconds, every, out),
+        Command::Mesh { seconds, every } => mesh(&mut link, &a.connect, seconds, every, out),
     }
 }
 
@@ -457,5 +468,46 @@ fn watch(
         }
     }
     link.send(&ToDevice::Watch { every: 0 }).map_err(gone)?;
+    w.flush().map_err(io_error)
+}
+
+fn mesh(
+    link: &mut Link,
+    addr: &str,
+    seconds: f64,
+    every: u16,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    if !(seconds.is_finite() && (0.0..=3600.0).contains(&seconds)) {
+        return Err(arg_error("--seconds", "must be 0 … 3600"));
+    }
+    if !(1..=1000).contains(&every) {
+        return Err(arg_error("--every", "must be 1 … 1000 ticks"));
+    }
+    let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
+    link.send(&ToDevice::WatchMesh { every }).map_err(gone)?;
+    let mut w = std::io::BufWriter::new(out);
+    writeln!(w, "seq,tick,node,x_mm,y_mm,z_mm").map_err(io_error)?;
+    let end = Instant::now() + Duration::from_secs_f64(seconds);
+    while let Some(m) = link.recv(end).map_err(gone)? {
+        if let ToHost::Mesh(part) = m {
+            let mm = |b: i32| mccs::Length::from_bits(b).to_num::<f64>();
+            let count = (part.nodes.saturating_sub(part.first) as usize).min(part.positions.len());
+            for (k, p) in part.positions[..count].iter().enumerate() {
+                writeln!(
+                    w,
+                    "{},{},{},{},{},{}",
+                    part.seq,
+                    part.tick,
+                    part.first as usize + k,
+                    mm(p[0]),
+                    mm(p[1]),
+                    mm(p[2])
+                )
+                .map_err(io_error)?;
+            }
+        }
+    }
+    link.send(&ToDevice::WatchMesh { every: 0 }).map_err(gone)?;
     w.flush().map_err(io_error)
 }

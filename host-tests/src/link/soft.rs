@@ -1,11 +1,12 @@
 //! A device in software: the firmware's own link session, replayer and guard
 //! (`mccs_firmware::link`) behind a unix socket, its ticks counted from the clock
-//! (1 kHz). It has no live patch: its telemetry reads a probe at rest. What it answers
+//! (1 kHz). Its live patch stays at rest: its telemetry reads a probe at rest, its mesh
+//! the patch's rest positions. What it answers
 //! is what the firmware answers, so the CLI's tests run against it where QEMU would be
 //! too slow; the tests against the board firmware in QEMU are `tests/link/qemu.rs`.
 
-use mccs::{ForceTable64, SolverConfig, Wide};
-use mccs_firmware::link::{Effect, Guard, Live, Now, Replayer, Session};
+use mccs::{ForceTable64, Solver, SolverConfig, Topology, Wide};
+use mccs_firmware::link::{Effect, Guard, Live, Mesh, Now, Replayer, Session};
 use mccs_link::frame::parse;
 use mccs_link::{encode, Core, Decoder, ToDevice, ToHost, MAX_FRAME};
 use std::io::{Read, Write};
@@ -32,7 +33,13 @@ pub fn serve(socket: &Path, table: ForceTable64) -> std::io::Result<std::thread:
             spacing: 2.5,
             config: SolverConfig::default(),
         };
+        let rest = Topology::standard_patch(5, 2.5)
+            .ok()
+            .and_then(|t| Solver::new(t, table, &live.config).ok());
+        let Some(rest) = rest else { return };
         let mut device = Device {
+            rest: Box::new(rest),
+            mesh_every: 0,
             session: Session::<64>::new(live, table),
             replayer: Box::new(Replayer::new(false)),
             guard: Guard::at_rate(1000),
@@ -50,6 +57,10 @@ pub fn serve(socket: &Path, table: ForceTable64) -> std::io::Result<std::thread:
 
 /// The device's state.
 struct Device {
+    /// The live patch, at rest.
+    rest: Box<Solver<NODES, EDGES, 64, Wide>>,
+    /// Ticks between meshes (0: none).
+    mesh_every: u32,
     session: Session<64>,
     replayer: Box<Replayer<NODES, EDGES, 64, Wide, PATH>>,
     guard: Guard,
@@ -59,6 +70,8 @@ struct Device {
 
 fn run(mut stream: UnixStream, d: &mut Device) {
     let Device {
+        rest,
+        mesh_every,
         session,
         replayer,
         guard,
@@ -110,6 +123,7 @@ fn run(mut stream: UnixStream, d: &mut Device) {
                                 session.swapped(*set.table(), tissue, &mut send)
                             }
                             Effect::Pose(p) => *pose = p,
+                            Effect::WatchMesh(every) => *mesh_every = every as u32,
                             Effect::None => {}
                         }
                     }
@@ -131,6 +145,12 @@ fn run(mut stream: UnixStream, d: &mut Device) {
                 send(m);
                 true
             });
+            if *mesh_every != 0 && t % *mesh_every == 0 {
+                session.mesh(&Mesh::of(rest, t), &mut |m| {
+                    send(m);
+                    true
+                });
+            }
         }
         last_tick = tick + 1;
         if !out.is_empty() {

@@ -31,7 +31,8 @@ fn hello_status_arm_pose_and_load() {
     assert_eq!(
         hello,
         format!(
-            "protocol=1 schema={:08x} core=m4f tick_hz=1000 grid=5 tissue=5x5 knots=65 tissue_hash={t2:08x}",
+            "protocol={} schema={:08x} core=m4f tick_hz=1000 grid=5 tissue=5x5 knots=65 tissue_hash={t2:08x}",
+            mccs_link::PROTOCOL,
             mccs_link::SCHEMA
         )
     );
@@ -225,8 +226,57 @@ fn a_device_of_another_schema_is_refused() {
     crate::cli::assert_one_line_error(
         &out,
         &[&format!(
-            "the device speaks protocol 1 schema 12345678, this mccs protocol 1 schema {:08x}",
+            "the device speaks protocol 1 schema 12345678, this mccs protocol {} schema {:08x}",
+            mccs_link::PROTOCOL,
             mccs_link::SCHEMA
         )],
     );
+}
+
+/// `mccs link mesh`: every free node of the device's patch once per mesh, at its rest
+/// position on the soft device (its patch at rest), meshes at least 17 ticks apart (60 a
+/// second at most), numbered without gaps on an idle link; arguments out of range refused.
+#[test]
+fn mesh_streams_every_free_node_of_the_patch() {
+    let addr = device("mesh");
+    let out = mccs_ok(&[
+        "link",
+        "--connect",
+        &addr,
+        "mesh",
+        "--seconds",
+        "0.4",
+        "--every",
+        "1",
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("seq,tick,node,x_mm,y_mm,z_mm"));
+    let topo = mccs::Topology::<37, 214>::standard_patch(5, 2.5).unwrap();
+    let free = topo.node_count() - 1;
+    let mut meshes: std::collections::BTreeMap<u32, (u32, Vec<usize>)> = Default::default();
+    for l in lines {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let (seq, tick, node) = (v[0] as u32, v[1] as u32, v[2] as usize);
+        let rest = topo.rest(node as u16 + 1).unwrap();
+        for k in 0..3 {
+            assert!((v[3 + k] - rest[k]).abs() < 1e-6, "{l}: rest {rest:?}");
+        }
+        let e = meshes.entry(seq).or_insert((tick, Vec::new()));
+        assert_eq!(e.0, tick);
+        e.1.push(node);
+    }
+    assert!(meshes.len() >= 5, "{} meshes in 0.4 s", meshes.len());
+    let seqs: Vec<u32> = meshes.keys().copied().collect();
+    for w in seqs.windows(2) {
+        assert_eq!(w[1], w[0] + 1, "a gap on an idle link");
+        assert!(meshes[&w[1]].0 - meshes[&w[0]].0 >= 17, "over 60 a second");
+    }
+    // Every node once (the last mesh may have been cut by the end of the run).
+    for (seq, (_, nodes)) in meshes.iter().take(meshes.len() - 1) {
+        assert_eq!(*nodes, (0..free).collect::<Vec<_>>(), "mesh {seq}");
+    }
+    let bad = mccs(&["link", "--connect", &addr, "mesh", "--every", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).starts_with("mccs: --every: "));
 }

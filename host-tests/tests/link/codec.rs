@@ -62,6 +62,7 @@ fn every_message() -> (Vec<ToDevice<'static>>, Vec<ToHost>) {
             first: 16,
             points: &BYTES,
         },
+        ToDevice::WatchMesh { every: 17 },
     ];
     let to_host = vec![
         ToHost::Hello(HelloInfo {
@@ -112,6 +113,14 @@ fn every_message() -> (Vec<ToDevice<'static>>, Vec<ToHost>) {
         }),
         ToHost::ReplayCredit { until: 256 },
         ToHost::ReplayEnd { ticks: 7401 },
+        // The largest mesh part: every position at its longest encoding.
+        ToHost::Mesh(MeshPart {
+            seq: u32::MAX,
+            tick: u32::MAX,
+            first: u16::MAX,
+            nodes: u16::MAX,
+            positions: [[i32::MIN; 3]; mccs_link::MESH_PART],
+        }),
     ];
     (to_device, to_host)
 }
@@ -165,7 +174,7 @@ fn the_schema_moves_with_the_encoding() {
     let golden = mccs_link::schema::fnv1a(&all);
     assert_eq!(
         (SCHEMA, golden),
-        (0xa28e_f31a, 0x7f07_592d),
+        (0x094e_6f70, 0x6556_82d7),
         "schema {SCHEMA:#010x}, encoding {golden:#010x}"
     );
 }

@@ -533,3 +533,94 @@ fn telemetry_gaps_are_the_drops() {
     assert_eq!(gaps, last.dropped, "{got:?}");
     assert!(last.dropped > 0);
 }
+
+/// The mesh for the visuals: at most 60 a second, every free node once per mesh in parts
+/// of 12 (rest position plus displacement), the tick's countdown due exactly every
+/// `every` ticks, and a mesh the main loop never sent counted as dropped.
+#[test]
+fn the_mesh_is_every_free_node_at_most_60_times_a_second() {
+    use mccs_firmware::link::{Mesh, MeshClock};
+    let table = ForceTable64::new(&Params::TABLE2).unwrap();
+    let mut s = Session::<64>::new(live(), table);
+    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
+    // Asked for every tick at 1 kHz: held to 17 ticks (58.8 a second).
+    let effect = s.handle(
+        ToDevice::WatchMesh { every: 1 },
+        Now::default(),
+        &mut r,
+        &mut |_| {},
+    );
+    assert_eq!(effect, Effect::WatchMesh(17));
+    let clock = MeshClock::new();
+    assert!(!(0..100).any(|_| clock.due()), "never before it is set");
+    clock.set(17);
+    let at: Vec<u32> = (0..100u32).filter(|_| clock.due()).collect();
+    assert_eq!(at, vec![0, 17, 34, 51, 68, 85]);
+    // A displaced node: rest plus displacement, in its place among the parts.
+    let topo = mccs::Topology::<N, E>::standard_patch(5, 2.5).unwrap();
+    let mut solver = mccs::Solver::new(topo, table, &SolverConfig::default()).unwrap();
+    let shift = [Length::from_num(0.25), Length::ZERO, Length::from_num(-1)];
+    solver.set_state(14, shift, [mccs::Velocity::ZERO; 3]);
+    let mesh = Mesh::of(&solver, 34);
+    let free = solver.topology().node_count() - 1;
+    assert_eq!(mesh.nodes as usize, free);
+    let mut parts = Vec::new();
+    s.mesh(&mesh, &mut |m: &ToHost| {
+        if let ToHost::Mesh(p) = m {
+            parts.push(*p);
+        }
+        true
+    });
+    assert_eq!(parts.len(), free.div_ceil(12));
+    let mut seen = vec![None; free];
+    for p in &parts {
+        assert_eq!((p.tick, p.nodes, p.seq), (34, free as u16, 0));
+        for (k, pos) in p.positions.iter().enumerate() {
+            let node = p.first as usize + k;
+            if node < free {
+                seen[node] = Some(*pos);
+            } else {
+                assert_eq!(*pos, [0; 3], "past the nodes: zero");
+            }
+        }
+    }
+    for (k, pos) in seen.iter().enumerate() {
+        let pos = pos.expect("every free node once");
+        let rest = solver.topology().rest_q24(k + 1).unwrap();
+        let u = if k + 1 == 14 {
+            shift.map(|x| x.to_bits())
+        } else {
+            [0; 3]
+        };
+        assert_eq!(pos, [0, 1, 2].map(|j| rest[j] + u[j]), "node {k}");
+    }
+    // The next mesh the main loop sees is two periods on: one was never sent.
+    let mut seqs = Vec::new();
+    s.mesh(&Mesh::of(&solver, 34 + 2 * 17), &mut |m: &ToHost| {
+        if let ToHost::Mesh(p) = m {
+            seqs.push(p.seq);
+        }
+        true
+    });
+    assert!(seqs.iter().all(|&q| q == 2), "{seqs:?}");
+    let mut dropped = 0;
+    s.handle(ToDevice::Status, Now::default(), &mut r, &mut |m| {
+        if let ToHost::Status(st) = m {
+            dropped = st.dropped_telemetry;
+        }
+    });
+    assert_eq!(dropped, 1);
+    // Off: no mesh.
+    s.handle(
+        ToDevice::WatchMesh { every: 0 },
+        Now::default(),
+        &mut r,
+        &mut |_| {},
+    );
+    let mut any = false;
+    s.mesh(&mesh, &mut |_| {
+        any = true;
+        true
+    });
+    assert!(!any);
+}

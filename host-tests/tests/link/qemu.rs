@@ -359,4 +359,53 @@ fn the_board_firmware_in_qemu_serves_the_link() {
         last.tick - first.tick,
         last.dropped - first.dropped
     );
+
+    // The mesh for the visuals, through the CLI: every free node of the N = 8 patch once
+    // a mesh, near its rest position (the live device is in its safe state in QEMU: its
+    // patch barely moved), at most 60 meshes a second of the device's ticks.
+    drop(link);
+    let out = mccs_ok(&[
+        "link",
+        "--connect",
+        &addr,
+        "mesh",
+        "--seconds",
+        "1",
+        "--every",
+        "1",
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let topo = mccs::Topology::<37, 214>::standard_patch(8, 2.5).unwrap();
+    let free = topo.node_count() - 1;
+    let mut meshes: std::collections::BTreeMap<u32, (u32, Vec<usize>)> = Default::default();
+    let mut worst = 0.0f64;
+    for l in text.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let (seq, tick, node) = (v[0] as u32, v[1] as u32, v[2] as usize);
+        let rest = topo.rest(node as u16 + 1).unwrap();
+        for k in 0..3 {
+            worst = worst.max((v[3 + k] - rest[k]).abs());
+        }
+        let e = meshes.entry(seq).or_insert((tick, Vec::new()));
+        assert_eq!(e.0, tick, "one mesh, one tick");
+        e.1.push(node);
+    }
+    assert!(meshes.len() >= 3, "{} meshes", meshes.len());
+    assert!(worst < 0.5, "a node {worst} mm from rest");
+    let complete = meshes
+        .values()
+        .take(meshes.len() - 1)
+        .filter(|(_, n)| *n == (0..free).collect::<Vec<_>>())
+        .count();
+    assert_eq!(complete, meshes.len() - 1, "a mesh without every node");
+    let ticks: Vec<u32> = meshes.values().map(|(t, _)| *t).collect();
+    assert!(
+        ticks.windows(2).all(|w| w[1] - w[0] >= 17),
+        "over 60 a second: {ticks:?}"
+    );
+    println!(
+        "LINK case=mesh meshes={} nodes={free} least_ticks_apart={}",
+        meshes.len(),
+        ticks.windows(2).map(|w| w[1] - w[0]).min().unwrap_or(0)
+    );
 }

@@ -55,11 +55,12 @@ mod firmware {
     use cortex_m_rt::entry;
     use haptic_f405::config::{self, tick_timer, BOARD};
     use haptic_f405::device::StartFault;
+    use haptic_f405::device::NODES;
     use haptic_f405::telemetry::BoardTelemetry;
     use haptic_f405::tissue::TISSUE;
     use heapless::spsc::Queue;
     use mccs::{ParamSet, Wide};
-    use mccs_firmware::link::TickLink;
+    use mccs_firmware::link::{Mesh, TickLink};
     use mccs_firmware::{Mailbox, Shared};
     use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
     use stm32f4xx_hal::prelude::*;
@@ -74,6 +75,8 @@ mod firmware {
     pub(crate) static LINK: TickLink = TickLink::new(BOARD.tick_hz);
     /// A checked tissue for the tick to swap in.
     pub(crate) static SWAP: Mailbox<Segments> = Mailbox::new();
+    /// The patch's nodes, when the host watches the mesh.
+    pub(crate) static MESH: Mailbox<Mesh<NODES>> = Mailbox::new();
 
     /// What `main` hands the tick.
     struct Hardware {
@@ -282,7 +285,7 @@ mod firmware {
             tick.stop();
             return;
         }
-        let (_, gain) = LINK.tick(ctl, &SWAP);
+        let (_, gain) = LINK.tick(ctl, &SWAP, &MESH);
         watchdog.feed();
         let us = tick.count();
         let cycles = elapsed(start, cycles());

@@ -254,6 +254,7 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
     // the stack: the M0's 16 KiB hold no second parameter set beside the bench's stack).
     let link = TickLink::new(1000);
     let swap: Mailbox<mccs::ParamSet<64>> = Mailbox::new();
+    let mesh: Mailbox<mccs_firmware::link::Mesh<N>> = Mailbox::new();
     let solver = || {
         let Ok(topo) = Topology::<N, E>::standard_patch(3, 2.5) else {
             exit(false)
@@ -273,7 +274,7 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
         u32::MAX,
     );
     let link_tick = |ctl: &mut Controller<LinkedDevice<SimulatedDevice<7>>, N, E, 64>| {
-        let f = link.tick(ctl, &swap);
+        let f = link.tick(ctl, &swap, &mesh);
         black_box(ctl.device().probe());
         f
     };

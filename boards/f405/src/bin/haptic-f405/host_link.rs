@@ -4,7 +4,7 @@
 //! — the guard's arm and disarm, the pose, a checked tissue — through the shared state and
 //! the swap mailbox. The tick never waits on the link.
 
-use crate::firmware::{LINK, SWAP, TELEMETRY};
+use crate::firmware::{LINK, MESH, SWAP, TELEMETRY};
 use haptic_f405::config::BOARD;
 use haptic_f405::device::{EDGES, NODES, SPACING_MM};
 use haptic_f405::tissue::TISSUE;
@@ -109,6 +109,7 @@ impl HostLink {
                     self.pending = Some((*set.table(), tissue, t.run.swaps, t.run.rejected_swaps));
                     LINK.post_swap(&SWAP, set);
                 }
+                Effect::WatchMesh(every) => LINK.mesh.set(every),
             }
             if bytes >= 512 {
                 break;
@@ -123,6 +124,12 @@ impl HostLink {
                 send(&ToHost::Nak(mccs_link::NakReason::Solver));
                 self.pending = None;
             }
+        }
+        if let Some(mesh) = MESH.take() {
+            self.session.mesh(&mesh, &mut |m| {
+                send(m);
+                true
+            });
         }
         let mut stepped = 0;
         while stepped < 4 && self.replayer.step(&mut send) {
