@@ -420,6 +420,17 @@ fn replay(
     w.flush().map_err(io_error)
 }
 
+/// A stream's `--seconds` (0 … 3600) and `--every` (1 … 1000 ticks).
+fn stream_args(seconds: f64, every: u16) -> Result<(), CliError> {
+    if !(seconds.is_finite() && (0.0..=3600.0).contains(&seconds)) {
+        return Err(arg_error("--seconds", "must be 0 … 3600"));
+    }
+    if !(1..=1000).contains(&every) {
+        return Err(arg_error("--every", "must be 1 … 1000 ticks"));
+    }
+    Ok(())
+}
+
 fn watch(
     link: &mut Link,
     addr: &str,
@@ -427,12 +438,7 @@ fn watch(
     every: u16,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    if !(seconds.is_finite() && (0.0..=3600.0).contains(&seconds)) {
-        return Err(arg_error("--seconds", "must be 0 … 3600"));
-    }
-    if !(1..=1000).contains(&every) {
-        return Err(arg_error("--every", "must be 1 … 1000 ticks"));
-    }
+    stream_args(seconds, every)?;
     let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
     link.send(&ToDevice::Watch { every }).map_err(gone)?;
     let mut w = std::io::BufWriter::new(out);
@@ -478,12 +484,7 @@ fn mesh(
     every: u16,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    if !(seconds.is_finite() && (0.0..=3600.0).contains(&seconds)) {
-        return Err(arg_error("--seconds", "must be 0 … 3600"));
-    }
-    if !(1..=1000).contains(&every) {
-        return Err(arg_error("--every", "must be 1 … 1000 ticks"));
-    }
+    stream_args(seconds, every)?;
     let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
     link.send(&ToDevice::WatchMesh { every }).map_err(gone)?;
     let mut w = std::io::BufWriter::new(out);

@@ -250,22 +250,13 @@ fn mesh_streams_every_free_node_of_the_patch() {
         "1",
     ]);
     let text = String::from_utf8(out.stdout).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("seq,tick,node,x_mm,y_mm,z_mm"));
     let topo = mccs::Topology::<37, 214>::standard_patch(5, 2.5).unwrap();
     let free = topo.node_count() - 1;
-    let mut meshes: std::collections::BTreeMap<u32, (u32, Vec<usize>)> = Default::default();
-    for l in lines {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        let (seq, tick, node) = (v[0] as u32, v[1] as u32, v[2] as usize);
-        let rest = topo.rest(node as u16 + 1).unwrap();
-        for k in 0..3 {
-            assert!((v[3 + k] - rest[k]).abs() < 1e-6, "{l}: rest {rest:?}");
-        }
-        let e = meshes.entry(seq).or_insert((tick, Vec::new()));
-        assert_eq!(e.0, tick);
-        e.1.push(node);
-    }
+    let (meshes, worst) = super::meshes(&text, &topo);
+    assert!(
+        worst < 1e-6,
+        "the soft device's patch at rest: {worst} mm off"
+    );
     assert!(meshes.len() >= 5, "{} meshes in 0.4 s", meshes.len());
     let seqs: Vec<u32> = meshes.keys().copied().collect();
     for w in seqs.windows(2) {

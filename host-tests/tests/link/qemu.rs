@@ -377,19 +377,7 @@ fn the_board_firmware_in_qemu_serves_the_link() {
     let text = String::from_utf8(out.stdout).unwrap();
     let topo = mccs::Topology::<37, 214>::standard_patch(8, 2.5).unwrap();
     let free = topo.node_count() - 1;
-    let mut meshes: std::collections::BTreeMap<u32, (u32, Vec<usize>)> = Default::default();
-    let mut worst = 0.0f64;
-    for l in text.lines().skip(1) {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        let (seq, tick, node) = (v[0] as u32, v[1] as u32, v[2] as usize);
-        let rest = topo.rest(node as u16 + 1).unwrap();
-        for k in 0..3 {
-            worst = worst.max((v[3 + k] - rest[k]).abs());
-        }
-        let e = meshes.entry(seq).or_insert((tick, Vec::new()));
-        assert_eq!(e.0, tick, "one mesh, one tick");
-        e.1.push(node);
-    }
+    let (meshes, worst) = super::meshes(&text, &topo);
     assert!(meshes.len() >= 3, "{} meshes", meshes.len());
     assert!(worst < 0.5, "a node {worst} mm from rest");
     let complete = meshes
