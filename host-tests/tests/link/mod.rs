@@ -6,14 +6,27 @@ mod codec;
 mod device;
 mod qemu;
 
-/// `mccs link mesh`'s CSV on `topo`'s patch: each mesh by its `seq` as its tick and its
-/// nodes in order, and the farthest any node was from its rest position, mm. One mesh,
-/// one tick (asserted).
-fn meshes<const N: usize, const E: usize>(
-    csv: &str,
-    topo: &mccs::Topology<N, E>,
-) -> (std::collections::BTreeMap<u32, (u32, Vec<usize>)>, f64) {
-    let mut meshes: std::collections::BTreeMap<u32, (u32, Vec<usize>)> = Default::default();
+/// `mccs link --connect ADDR mesh --seconds S --every 1` on a device whose live patch is
+/// the standard one of `grid`: each mesh by its `seq`, as its tick and its nodes in
+/// order, the farthest any node was from its rest position (mm), and the free nodes.
+/// Held here, for every device: one mesh, one tick; every mesh but the last (which the
+/// run's end may cut) has every free node once, in order; meshes at least 17 ticks apart
+/// (60 a second at most, at 1 kHz).
+fn mesh_run(addr: &str, seconds: &str, grid: usize) -> (Meshes, f64, usize) {
+    let out = crate::cli::mccs_ok(&[
+        "link",
+        "--connect",
+        addr,
+        "mesh",
+        "--seconds",
+        seconds,
+        "--every",
+        "1",
+    ]);
+    let csv = String::from_utf8(out.stdout).unwrap();
+    let topo = mccs::Topology::<37, 214>::standard_patch(grid, 2.5).unwrap();
+    let free = topo.node_count() - 1;
+    let mut meshes = Meshes::default();
     let mut worst = 0.0f64;
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("seq,tick,node,x_mm,y_mm,z_mm"));
@@ -28,5 +41,20 @@ fn meshes<const N: usize, const E: usize>(
         assert_eq!(e.0, tick, "{l}: one mesh, one tick");
         e.1.push(node);
     }
-    (meshes, worst)
+    for (seq, (_, nodes)) in meshes.iter().take(meshes.len().saturating_sub(1)) {
+        assert_eq!(
+            *nodes,
+            (0..free).collect::<Vec<_>>(),
+            "mesh {seq} without every node"
+        );
+    }
+    let ticks: Vec<u32> = meshes.values().map(|(t, _)| *t).collect();
+    assert!(
+        ticks.windows(2).all(|w| w[1] - w[0] >= 17),
+        "over 60 a second: {ticks:?}"
+    );
+    (meshes, worst, free)
 }
+
+/// Meshes by `seq`: their tick and their nodes.
+type Meshes = std::collections::BTreeMap<u32, (u32, Vec<usize>)>;

@@ -38,6 +38,19 @@ mod host_link;
 #[cfg(all(target_os = "none", feature = "arm"))]
 #[path = "variant/arm.rs"]
 mod variant;
+
+/// The peripherals `main` hands a variant's `build_device`; it takes the ones its device
+/// uses (the 1-DOF: TIM1 and SPI1; the arm: TIM1, TIM3, TIM4, TIM5) and drops the rest,
+/// which stay in their reset state (hence `dead_code`: each variant reads only its own).
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+struct Timers {
+    tim1: stm32f4xx_hal::pac::TIM1,
+    spi1: stm32f4xx_hal::pac::SPI1,
+    tim3: stm32f4xx_hal::pac::TIM3,
+    tim4: stm32f4xx_hal::pac::TIM4,
+    tim5: stm32f4xx_hal::pac::TIM5,
+}
 #[cfg(all(target_os = "none", not(feature = "arm")))]
 #[path = "variant/one_dof.rs"]
 mod variant;
@@ -68,7 +81,8 @@ mod firmware {
     use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
     use crate::host_link::{HostLink, LINK_RX, RX_QUEUE};
-    use crate::variant::{self, build_device, take_pins, Ctl, Device, Timers};
+    use crate::variant::{self, build_device, take_pins, Ctl, Device};
+    use crate::Timers;
     pub(crate) type Segments = ParamSet<{ haptic_f405::tissue::SEGMENTS }, Wide>;
 
     /// The link's guard, pose and swap flag, shared by the tick and the main loop.

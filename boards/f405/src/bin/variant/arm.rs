@@ -35,21 +35,6 @@ pub const DEVICE: &str =
 #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
 pub const QEMU_FAULT_TICK: Option<u32> = None;
 
-/// The peripherals a variant may take.
-pub struct Timers {
-    /// The motors' PWM.
-    pub tim1: pac::TIM1,
-    /// Not used here (dropped: the peripheral stays in its reset state).
-    #[allow(dead_code)]
-    pub spi1: pac::SPI1,
-    /// Joint C's counter.
-    pub tim3: pac::TIM3,
-    /// Joint B's counter.
-    pub tim4: pac::TIM4,
-    /// Joint A's counter.
-    pub tim5: pac::TIM5,
-}
-
 /// The pins, the outputs at their safe levels.
 pub fn take_pins(a: gpioa::Parts, b: gpiob::Parts, c: gpioc::Parts) -> ArmPins {
     ArmPins::take(a, b, c)
@@ -59,7 +44,7 @@ pub fn take_pins(a: gpioa::Parts, b: gpiob::Parts, c: gpioc::Parts) -> ArmPins {
 pub fn build_device(
     pins: ArmPins,
     clocks: &Clocks,
-    t: Timers,
+    t: crate::Timers,
 ) -> Result<(Device, u16, (PA2, PA3)), StartFault> {
     let link = (pins.link_tx, pins.link_rx);
     let (_pwm, (ch1, ch2, ch3, ..)) = t.tim1.pwm_hz(BOARD.pwm_hz.Hz(), clocks);

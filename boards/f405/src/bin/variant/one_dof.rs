@@ -30,23 +30,6 @@ pub const DEVICE: &str = "1-DOF (AS5047P on SPI1, motor on TIM1 CH1)";
 #[cfg(all(feature = "qemu", not(feature = "qemu-link")))]
 pub const QEMU_FAULT_TICK: Option<u32> = haptic_f405::telemetry::zeros_fault_tick(&BOARD);
 
-/// The peripherals a variant may take.
-pub struct Timers {
-    /// The motor's PWM.
-    pub tim1: pac::TIM1,
-    /// The encoder's bus.
-    pub spi1: pac::SPI1,
-    /// Not used here (dropped: the peripheral stays in its reset state).
-    #[allow(dead_code)]
-    pub tim3: pac::TIM3,
-    /// Not used here (dropped: the peripheral stays in its reset state).
-    #[allow(dead_code)]
-    pub tim4: pac::TIM4,
-    /// Not used here (dropped: the peripheral stays in its reset state).
-    #[allow(dead_code)]
-    pub tim5: pac::TIM5,
-}
-
 /// The pins, the outputs at their safe levels.
 pub fn take_pins(a: gpioa::Parts, b: gpiob::Parts, _c: gpioc::Parts) -> Pins {
     Pins::take(a, b)
@@ -56,7 +39,7 @@ pub fn take_pins(a: gpioa::Parts, b: gpiob::Parts, _c: gpioc::Parts) -> Pins {
 pub fn build_device(
     pins: Pins,
     clocks: &Clocks,
-    t: Timers,
+    t: crate::Timers,
 ) -> Result<(Device, u16, (PA2, PA3)), StartFault> {
     let link = (pins.link_tx, pins.link_rx);
     let spi_hz = spi_clock_hz(clocks.pclk2().raw(), BOARD.spi_request_hz);
