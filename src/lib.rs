@@ -33,6 +33,7 @@ pub mod shape;
 pub mod solver;
 pub mod state;
 pub mod table;
+pub mod tissue_pose;
 pub mod topology;
 pub mod units;
 pub mod window;
@@ -45,13 +46,14 @@ pub use arm::{Arm, ArmError, ArmPose, ArmSpec, Drive, GravitySpec, JointSpec};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};
-pub use proxy::{Proxy, ProxyConfig, ProxyError};
+pub use proxy::{Friction, Proxy, ProxyConfig, ProxyError};
 pub use shape::{Cap, Flat, Shape, ShapeSpec, Sphere};
 pub use solver::{Bound, ConfigKey, ParamSet, Solver, SolverConfig, SolverError};
 pub use table::{
     ForceTable, ForceTable128, ForceTable16, ForceTable32, ForceTable64, RawTable, TableBound,
     TableError,
 };
+pub use tissue_pose::TissuePose;
 pub use topology::{Edge, End, Topology, TopologyError, GROUND};
 pub use units::{Force, Length, Stiffness, Strain, Velocity};
 pub use window::{Window, WindowConfig};

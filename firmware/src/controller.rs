@@ -23,6 +23,33 @@ pub trait Contact<const NODES: usize, const EDGES: usize, const S: usize, A: Ari
     fn window_shifts(&self) -> u32 {
         0
     }
+    /// Takes new friction coefficients; false for a contact without friction.
+    fn set_friction(&mut self, _friction: mccs::Friction) -> bool {
+        false
+    }
+    /// The friction in use, for a contact with friction.
+    fn friction(&self) -> Option<mccs::Friction> {
+        None
+    }
+    /// Where the contact is after a tick (`None`: a contact that does not know, the
+    /// glued one: the force says it).
+    fn state(&self, _solver: &Solver<NODES, EDGES, S, A>) -> Option<ContactState> {
+        None
+    }
+}
+
+/// Where a roaming contact is: touching or not, slipping or not, the proxy's point and
+/// the window's origin in the tissue's frame (Q24 mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ContactState {
+    /// The proxy is on the surface.
+    pub touching: bool,
+    /// It slides (kinetic friction).
+    pub slipping: bool,
+    /// The proxy's point, tissue frame (zero out of contact).
+    pub proxy: [i32; 3],
+    /// The window's origin (the patch's centre), tissue frame.
+    pub window: [i32; 2],
 }
 
 /// The probe glued to the patch's contact node through a spring on all three axes
@@ -59,6 +86,36 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, Sh: Shape
     fn window_shifts(&self) -> u32 {
         self.window.shifts()
     }
+
+    fn set_friction(&mut self, friction: mccs::Friction) -> bool {
+        self.proxy.set_friction(friction);
+        true
+    }
+
+    fn friction(&self) -> Option<mccs::Friction> {
+        Some(self.proxy.friction())
+    }
+
+    fn state(&self, solver: &Solver<NODES, EDGES, S, A>) -> Option<ContactState> {
+        let origin = self.window.origin_mm().map(Length::to_bits);
+        let touching = self.proxy.grid_position().is_some();
+        let proxy = solver
+            .proxy_point_in(&self.proxy, &self.window)
+            .map_or([0; 3], |p| {
+                let b = p.map(Length::to_bits);
+                [
+                    b[0].saturating_add(origin[0]),
+                    b[1].saturating_add(origin[1]),
+                    b[2],
+                ]
+            });
+        Some(ContactState {
+            touching,
+            slipping: self.proxy.slipping(),
+            proxy,
+            window: origin,
+        })
+    }
 }
 
 /// Why the controller is in its safe state.
@@ -68,6 +125,9 @@ pub enum Fault {
     Read,
     /// The device could not render the force.
     Write,
+    /// Ticks overran their period too many times in a row
+    /// ([`Controller::set_overrun_limit`]).
+    Overruns,
 }
 
 impl Fault {
@@ -76,6 +136,7 @@ impl Fault {
         match self {
             Self::Read => "device read failed",
             Self::Write => "device write failed",
+            Self::Overruns => "ticks overran their period too many times in a row",
         }
     }
 }
@@ -109,6 +170,10 @@ pub struct Telemetry {
     pub rejected_swaps: u32,
     /// Ticks on which putting the device in its safe state itself reported an error.
     pub safe_state_errors: u32,
+    /// Overruns in a row, up to the last tick.
+    pub overruns_in_row: u32,
+    /// The force was held to the coupling's clamp on the last tick.
+    pub clamped: bool,
 }
 
 impl Telemetry {
@@ -125,6 +190,8 @@ impl Telemetry {
             swaps: 0,
             rejected_swaps: 0,
             safe_state_errors: 0,
+            overruns_in_row: 0,
+            clamped: false,
         }
     }
 }
@@ -150,6 +217,8 @@ pub struct Controller<
     device: D,
     steady_tick: u32,
     telemetry: Telemetry,
+    /// Overruns in a row that end in the safe state (0: never).
+    overrun_limit: u32,
 }
 
 impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
@@ -185,6 +254,33 @@ impl<
             device,
             steady_tick,
             telemetry: Telemetry::new(),
+            overrun_limit: 0,
+        }
+    }
+
+    /// A run of `limit` overruns in a row ends in the safe state ([`Fault::Overruns`]);
+    /// 0: overruns are only counted.
+    pub fn set_overrun_limit(&mut self, limit: u32) {
+        self.overrun_limit = limit;
+    }
+
+    /// Swaps in a new tissue between two ticks: its parameter set and, for a contact
+    /// with friction, its friction (`None`: kept). Counted in the telemetry; a set
+    /// prepared for another topology or tick rate is refused, and nothing changes.
+    pub fn swap_tissue(&mut self, set: ParamSet<S, A>, friction: Option<mccs::Friction>) -> bool {
+        let t = &mut self.telemetry;
+        match self.solver.apply(set) {
+            Ok(()) => {
+                t.swaps = t.swaps.saturating_add(1);
+                if let Some(f) = friction {
+                    self.contact.set_friction(f);
+                }
+                true
+            }
+            Err(_) => {
+                t.rejected_swaps = t.rejected_swaps.saturating_add(1);
+                false
+            }
         }
     }
 
@@ -192,11 +288,7 @@ impl<
     /// Returns the force rendered.
     pub fn tick(&mut self, swap: Option<ParamSet<S, A>>) -> [Force; 3] {
         if let Some(set) = swap {
-            let t = &mut self.telemetry;
-            match self.solver.apply(set) {
-                Ok(()) => t.swaps = t.swaps.saturating_add(1),
-                Err(_) => t.rejected_swaps = t.rejected_swaps.saturating_add(1),
-            }
+            self.swap_tissue(set, None);
         }
         let force = if self.telemetry.fault.is_some() {
             self.safe_state();
@@ -215,7 +307,9 @@ impl<
                 Err(_) => self.enter_safe_state(Fault::Read),
             }
         };
+        let clamped = is_clamped(force, self.solver.max_force());
         let t = &mut self.telemetry;
+        t.clamped = clamped;
         if t.ticks == self.steady_tick {
             t.steady_force = force[2];
         }
@@ -242,9 +336,20 @@ impl<
         }
     }
 
-    /// Counts a tick that overran its budget.
+    /// Counts a tick that overran its budget; the limit's run of them in a row puts
+    /// the device in its safe state.
     pub fn note_overrun(&mut self) {
-        self.telemetry.overruns = self.telemetry.overruns.saturating_add(1);
+        let t = &mut self.telemetry;
+        t.overruns = t.overruns.saturating_add(1);
+        t.overruns_in_row = t.overruns_in_row.saturating_add(1);
+        if self.overrun_limit != 0 && t.overruns_in_row >= self.overrun_limit && t.fault.is_none() {
+            self.enter_safe_state(Fault::Overruns);
+        }
+    }
+
+    /// A tick that ended within its budget: the run of overruns is over.
+    pub fn note_on_time(&mut self) {
+        self.telemetry.overruns_in_row = 0;
     }
 
     /// The statistics so far.
@@ -272,8 +377,26 @@ impl<
         &mut self.device
     }
 
+    /// Where the contact is, on a contact that knows.
+    pub fn contact_state(&self) -> Option<ContactState> {
+        self.contact.state(&self.solver)
+    }
+
     /// The solver and the device back.
     pub fn into_parts(self) -> (Solver<NODES, EDGES, S, A>, D) {
         (self.solver, self.device)
     }
+}
+
+/// Whether `f` was held to the clamp `max`: an axis at it (glued, per axis), or its
+/// magnitude within 1/256 of it (through a proxy, in magnitude).
+fn is_clamped(f: [Force; 3], max: Force) -> bool {
+    let m = max.to_bits();
+    let near = m - (m >> 8);
+    let b = f.map(|c| c.to_bits());
+    if b.iter().any(|&c| c.saturating_abs() >= near) {
+        return true;
+    }
+    let f2: i64 = b.iter().map(|&c| c as i64 * c as i64).sum();
+    f2 >= near as i64 * near as i64
 }

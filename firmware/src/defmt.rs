@@ -1,6 +1,6 @@
 //! Every `defmt::Format` impl of the device layer, in one place (feature `defmt`).
 
-use crate::arm_sim::SimArmError;
+use crate::arm::sim::SimArmError;
 use crate::demo::DemoError;
 use crate::{Fault, PathError};
 use defmt::{write, Format, Formatter};

@@ -8,7 +8,7 @@
 //! [`Mailbox`](crate::mailbox::Mailbox). Each core runs the
 //! [`DemoSpec`] that fits its instruction budget.
 
-use crate::arm_sim::{samples_for, SimArmError, SimulatedArm};
+use crate::arm::sim::{samples_for, SimArmError, SimulatedArm};
 use crate::controller::{Controller, Roaming};
 use crate::device::SimulatedDevice;
 use crate::probe_path::{palpation_path, PathError, ProbePath};
@@ -256,7 +256,7 @@ pub const FRICTION: (f64, f64) = (0.6, 0.4);
 /// The demo's device.
 pub type DemoDevice = SimulatedDevice<9>;
 /// The arm the arm demo drives: WoodenHaptics (`devices/woodenhaptics.toml`).
-pub const ARM: mccs::ArmSpec = crate::arm_device::WOODENHAPTICS;
+pub const ARM: mccs::ArmSpec = crate::arm::device::WOODENHAPTICS;
 /// Samples of joint counts the arm demo's 4 s at 1 kHz take.
 pub const ARM_SAMPLES: usize = samples_for(4000);
 /// The arm demo's device: the palpation through the arm's joints.

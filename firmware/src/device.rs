@@ -15,6 +15,32 @@ pub trait HapticDevice {
     /// The safe state: no force, the drive cut, whatever else fails (every part
     /// attempted; the first error returned). Called on a fault and on every tick after.
     fn safe_state(&mut self) -> Result<(), Self::Error>;
+    /// What the device knows of itself beyond the probe, for telemetry: homed (a device
+    /// without homing always is), at a joint limit, the duties last written.
+    fn status(&self) -> DeviceStatus {
+        DeviceStatus::default()
+    }
+}
+
+/// What a device knows of itself beyond the probe ([`HapticDevice::status`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DeviceStatus {
+    /// Its position is known (an arm after homing; always, without homing).
+    pub homed: bool,
+    /// A joint is at or past its limit.
+    pub at_limit: bool,
+    /// The joints' duties last written, Q16 (zero where there are no joints).
+    pub duties: [i32; 3],
+}
+
+impl Default for DeviceStatus {
+    fn default() -> Self {
+        Self {
+            homed: true,
+            at_limit: false,
+            duties: [0; 3],
+        }
+    }
 }
 
 /// A device that replays a probe path, one waypoint tick per read, and keeps the last

@@ -7,9 +7,11 @@
 //!   hardware, and the [`SimulatedDevice`](device::SimulatedDevice) replaying a
 //!   [`ProbePath`](probe_path::ProbePath);
 //! - [`drivers`]: the AS5047P SPI encoder and the PWM motor (embedded-hal 1.0), and
-//!   [`one_dof`], a 1-DOF device made of the two;
-//! - [`arm_device`]: a 3-DOF arm (three quadrature joints, PWM motors) through the
-//!   core's `Arm`; [`arm_f32`], the same chain in `f32`, the bench's peer;
+//!   [`one_dof`], a 1-DOF device made of the two; [`lever_sim`], a simulated lever
+//!   behind those parts;
+//! - [`arm`]: a 3-DOF arm (three quadrature joints, PWM motors) through the core's
+//!   `Arm`, its encoder, its simulations (the demo's, the board's plant) and its `f32`
+//!   peer;
 //! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
 //!   buffer between the main loop and the tick interrupt;
 //! - [`link`]: the device's side of the host link (`mccs-link`);
@@ -22,26 +24,27 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
-pub mod arm_device;
-pub mod arm_f32;
-pub mod arm_sim;
+pub mod arm;
 pub mod controller;
 pub mod demo;
 pub mod device;
 pub mod drivers;
 pub mod entry;
 pub mod float_patch;
+pub mod lever_sim;
 pub mod link;
 pub mod mailbox;
 pub mod one_dof;
 pub mod probe_path;
+pub mod slot;
 pub mod target;
 
 // With the `defmt` feature, and on every firmware target, where defmt is the log.
 #[cfg(any(feature = "defmt", target_os = "none"))]
 mod defmt;
 
-pub use controller::{Contact, Controller, Fault, Glued, Roaming, Telemetry};
-pub use device::{HapticDevice, SimulatedDevice};
+pub use controller::{Contact, ContactState, Controller, Fault, Glued, Roaming, Telemetry};
+pub use device::{DeviceStatus, HapticDevice, SimulatedDevice};
 pub use mailbox::{Mailbox, Shared};
 pub use probe_path::{indentation_path, palpation_path, PathError, ProbePath, Waypoint};
+pub use slot::Slot;

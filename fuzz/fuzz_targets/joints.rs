@@ -9,7 +9,7 @@ fuzz_target!(|text: &str| {
         Ok(rows) => {
             assert!(rows.windows(2).all(|w| w[1].0 > w[0].0));
             assert!(rows.iter().all(|r| r.1.iter().all(|c| c.fract() == 0.0)));
-            let arm = mccs::Arm::new(&mccs_firmware::arm_device::WOODENHAPTICS).expect("valid");
+            let arm = mccs::Arm::new(&mccs_firmware::arm::device::WOODENHAPTICS).expect("valid");
             let ticks = mccs_host::arm::joints::ticks(&rows, 10.0, &arm);
             assert!(!ticks.is_empty());
         }

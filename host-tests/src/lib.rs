@@ -8,10 +8,10 @@ pub mod arm;
 pub mod cli;
 pub mod fit;
 pub mod link;
-pub mod paramfile;
 pub mod patch;
 pub mod reference;
 pub mod replay;
 pub mod roam;
 pub mod stability;
-pub mod trajectory;
+
+pub use mccs_client::{paramfile, trajectory};

@@ -250,7 +250,7 @@ fn the_reciprocal_holds_over_its_domain() {
 /// The firmware's WoodenHaptics constant is the shipped device file.
 #[test]
 fn the_firmware_s_arm_is_the_device_file() {
-    assert_eq!(mccs_firmware::arm_device::WOODENHAPTICS, woodenhaptics());
+    assert_eq!(mccs_firmware::arm::device::WOODENHAPTICS, woodenhaptics());
 }
 
 /// The f32 peer the bench measures computes the same chain (within micromath's error).
@@ -258,7 +258,7 @@ fn the_firmware_s_arm_is_the_device_file() {
 fn the_f32_peer_computes_the_same_chain() {
     let spec = woodenhaptics();
     let arm = Arm::new(&spec).unwrap();
-    let peer = mccs_firmware::arm_f32::ArmF32::new(&spec);
+    let peer = mccs_firmware::arm::float::ArmF32::new(&spec);
     let twin = ArmTwin { spec };
     let mut rng = ChaCha8Rng::seed_from_u64(58);
     let mut worst = 0.0f64;

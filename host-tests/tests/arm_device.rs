@@ -1,10 +1,10 @@
-//! The arm as a device (`mccs_firmware::arm_device`): the encoders' 16-bit counts carried
+//! The arm as a device (`mccs_firmware::arm::device`): the encoders' 16-bit counts carried
 //! to 32 bits at any speed the arm reaches, no force before homing, and a fault injected
 //! at every device call ending with every duty at zero and the driver disabled.
 
 use mccs::{Arm, Force, Length};
-use mccs_firmware::arm_device::{ArmDevice, ArmFault, Joint, PartFailed};
-use mccs_firmware::drivers::joint_encoder::Extended;
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed};
+use mccs_firmware::arm::encoder::Extended;
 use mccs_firmware::HapticDevice;
 use proptest::prelude::*;
 use std::cell::Cell;

@@ -53,25 +53,25 @@ fn firmware_md_a_roaming_controller() -> Result<(), Box<dyn Error>> {
 #[rustfmt::skip]
 fn link_md_a_scene() -> Result<(), Box<dyn Error>> {
     let socket = std::env::temp_dir().join(format!("mccs-doc-scene-{}.sock", std::process::id()));
-    mccs_host::link::soft::serve(&socket, ForceTable64::new(&Params::TABLE2)?)?;
+    let _device = mccs_host::link::soft::serve(&socket, ForceTable64::new(&Params::TABLE2)?)?;
     let addr = &format!("unix:{}", socket.display());
-use mccs_host::link::{Addr, Link};
-use mccs_link::{ToDevice, ToHost};
+use mccs_client::{Device, Pose, Tissue};
 use std::time::{Duration, Instant};
-let mut link = Link::connect(&Addr::parse(addr)?)?;
-link.send(&ToDevice::Watch { every: 16 })?; // about 60 Hz at 1 kHz
-link.send(&ToDevice::Arm)?;
+let device = Device::open(addr)?;                       // hello, with retries
+println!("{}", device.info());                          // what it is, its limits
+device.load_tissue(&Tissue::from_params(&mccs::Params::TABLE2)?.with_friction(0.6, 0.4)?)?;
+device.watch(16)?;                                      // about 60 Hz at 1 kHz
+let armed = device.arm()?;                              // kept alive by the library
 let start = Instant::now();
 while start.elapsed() < Duration::from_secs(1) {
     let breath = 2.0 * (start.elapsed().as_secs_f64() * 1.5).sin(); // mm
-    let z = mccs::Length::from_num(breath).to_bits();
-    link.send(&ToDevice::Pose { origin: [0, 0, z] })?; // also keeps the link armed
-    if let Some(ToHost::Telemetry(t)) = link.recv(Instant::now() + Duration::from_millis(16))? {
-        let fz = mccs::Force::from_bits(t.force[2]).to_num::<f64>();
-        println!("tick {} force {fz:.3} N", t.tick);
+    device.set_pose(Pose::from_mm_deg([0.0, 0.0, breath], [0.0; 3]))?;
+    if let Some(t) = device.telemetry() {
+        println!("tick {} force {:.3} N", t.tick, t.force_n[2]);
     }
+    std::thread::sleep(Duration::from_millis(16));
 }
-link.send(&ToDevice::Disarm)?;
+armed.disarm()?;                                        // or drop it
     Ok(())
 }
 

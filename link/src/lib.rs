@@ -1,27 +1,44 @@
 //! The host link: what a PC that draws the scene and the haptic controller say to each
-//! other (docs/link.md). `no_std`, no heap: the firmware and the host share this crate.
+//! other (docs/protocol.md is the normative page; docs/link.md the how-to). `no_std`, no
+//! heap: the firmware, the host's client and the CLI share this crate.
 //!
-//! - [`message`]: the messages, [`ToDevice`] and [`ToHost`], and what they carry;
+//! - [`message`]: the messages, [`ToDevice`] and [`ToHost`], and the small types they
+//!   carry ([`Pose`], [`Friction`], [`TissueBegin`]);
+//! - [`info`]: what the device tells of itself: hello, status, telemetry, mesh;
+//! - [`nak`]: why it refuses; [`flags`]: a live tick's flags;
 //! - [`frame`]: a message on the wire — postcard bytes, a CRC-32 over them, COBS with a
 //!   `0x00` delimiter, at most [`MAX_FRAME`] bytes — and the byte-stream [`Decoder`];
-//! - [`crc`]: the CRC-32 (IEEE 802.3), so that a corrupted frame is never a different
-//!   valid message;
-//! - [`schema`]: the protocol's version and schema hash, checked in the handshake;
+//! - [`crc`]: the CRC-32 (IEEE 802.3); [`fnv`]: the FNV-1a hash of tissues;
+//! - [`schema`]: the protocol's version and the schema hash derived from the types;
+//! - [`scale`]: the fixed-point scales the messages carry;
+//! - [`rates`]: the byte budget, the keepalive and the stream rates it allows;
 //! - [`table_bytes`]: a force table as the bytes a tissue load carries, and its hash;
-//! - [`replay`]: one tick of a replay in the fixed-point core, the same code on the host
-//!   (`mccs replay --backend fixed`) and on the device (`mccs link replay`).
+//!   [`tissue_file`]: those bytes as a file;
+//! - [`replay`]: a replay both ways (spec, path points, rows) and one replay tick in the
+//!   fixed-point core, the same code on the host and on the device.
 #![no_std]
 
 pub mod crc;
+pub mod flags;
+pub mod fnv;
 pub mod frame;
+pub mod info;
 pub mod message;
+pub mod nak;
+pub mod rates;
 pub mod replay;
+pub mod scale;
 pub mod schema;
 pub mod table_bytes;
+pub mod tissue_file;
 
-pub use frame::{encode, Decoder, FrameError, MAX_FRAME, MAX_PAYLOAD};
-pub use message::{
-    Core, HelloInfo, MeshPart, NakReason, ReplayRow, ReplaySpec, RoamSpec, SpecOption, StatusInfo,
-    Telemetry, ToDevice, ToHost, MESH_PART,
+pub use flags::Flags;
+pub use frame::{encode, parse, Decoder, FrameError, MAX_FRAME, MAX_PAYLOAD};
+pub use info::{
+    ContactKind, Core, DeviceKind, FaultReason, HelloInfo, MeshPart, SolverInfo, StatusInfo,
+    Telemetry, MESH_PART,
 };
+pub use message::{Friction, Pose, TissueBegin, ToDevice, ToHost, TISSUE_CHUNK};
+pub use nak::{NakReason, SpecOption};
+pub use replay::{PathPoint, ReplayRow, ReplaySpec, RoamSpec};
 pub use schema::{PROTOCOL, SCHEMA};

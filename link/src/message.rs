@@ -1,366 +1,215 @@
-//! The messages. Positions and forces travel as the core's raw fixed-point bits
-//! (`Length`: Q24 mm, `Force`: Q20 N), so that the device computes on exactly what the
-//! host sent and the host prints exactly what the device computed.
+//! The messages: [`ToDevice`] and [`ToHost`], and the small types they carry. Each enum's
+//! variants travel as their index (a postcard varint) in declaration order: a new
+//! message goes at the end, and any change here changes [`crate::SCHEMA`]
+//! (docs/protocol.md lists them all, with an example frame each).
 
+use crate::info::{HelloInfo, MeshPart, StatusInfo, Telemetry};
+use crate::nak::NakReason;
+use crate::replay::{ReplayRow, ReplaySpec};
+use postcard_schema::Schema;
 use serde::{Deserialize, Serialize};
 
 /// From the host to the device.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq)]
 pub enum ToDevice<'a> {
-    /// Who are you? Answered with [`ToHost::Hello`].
+    /// 0. Who are you? Answered with [`ToHost::Hello`].
     Hello,
-    /// Answered with [`ToHost::Status`].
+    /// 1. Answered with [`ToHost::Status`].
     Status,
-    /// The host takes the device: from now on, no valid frame for the link timeout fades
-    /// the force to zero and disarms (docs/link.md, "Safety"). Answered with a status.
+    /// 2. The host takes the device: from now on, no valid frame for the link timeout
+    /// fades the force to zero and disarms (docs/protocol.md, "Keepalive"). The force
+    /// ramps up once the probe is out of contact. Answered with a status.
     Arm,
-    /// Force to zero now, until the next `Arm`. Answered with a status.
+    /// 3. Force to zero now, until the next `Arm`. Answered with a status.
     Disarm,
-    /// The tissue's origin in the device frame (Q24 mm each): latest wins; the tick moves
-    /// toward it by a bounded step. Not answered.
-    Pose {
-        /// `x, y, z`, Q24 mm.
-        origin: [i32; 3],
-    },
-    /// A tissue load starts: the force table's `segments` (knots − 1), its length in
-    /// bytes and its hash ([`crate::table_bytes`]).
-    TissueBegin {
-        /// Segments.
-        segments: u16,
-        /// Bytes to come.
-        len: u32,
-        /// FNV-1a of the bytes.
-        hash: u32,
-    },
-    /// The next piece of the table's bytes, at `offset`.
+    /// 4. Where the tissue lies in the device's frame: latest wins; the tick moves toward
+    /// it at the device's slew limits. Refused with a `Nak` outside the workspace or for
+    /// a rotation that is not a unit quaternion; not answered otherwise.
+    Pose(Pose),
+    /// 5. A tissue load starts ([`TissueBegin`]).
+    TissueBegin(TissueBegin),
+    /// 6. The next piece of the table's bytes, at `offset`.
     TissueChunk {
         /// Where it goes (the bytes so far).
         offset: u32,
-        /// The bytes.
+        /// The bytes (at most [`TISSUE_CHUNK`]).
         bytes: &'a [u8],
     },
-    /// The table is whole: the device checks it and swaps it in at a tick boundary, or
-    /// refuses it. Answered with [`ToHost::Ack`] or [`ToHost::Nak`].
+    /// 7. The table is whole: the device checks it (the old tissue renders meanwhile) and
+    /// swaps it in at a tick boundary, or refuses it. Answered with [`ToHost::Ack`] once
+    /// the tick runs it, or [`ToHost::Nak`].
     TissueCommit,
-    /// Live telemetry every `every` ticks (0: none).
+    /// 8. Live telemetry every `every` ticks (0: none); the device holds it to its
+    /// byte budget (`HelloInfo::telemetry_least_every`).
     Watch {
         /// Ticks between two telemetry messages.
         every: u16,
     },
-    /// A replay starts: the patch and the solver it runs on. Answered with a
+    /// 9. A replay starts: the patch and the solver it runs on. Answered with a
     /// [`ToHost::ReplayCredit`] (or a `Nak`).
     ReplayBegin(ReplaySpec),
-    /// Probe positions for ticks `first`, `first + 1`, …: Q24 mm `x, y, z`, 12 bytes each,
-    /// little-endian.
+    /// 10. Probe positions for ticks `first`, `first + 1`, …
+    /// ([`crate::replay::PathPoint`]: 12 bytes each).
     ReplayPath {
         /// The first sample's tick.
         first: u32,
         /// The samples.
         points: &'a [u8],
     },
-    /// The live patch's node positions every `every` ticks (0: none), for the visuals;
-    /// the device holds it to 60 a second at most. Answered by [`ToHost::Mesh`] parts.
+    /// 11. The live patch's node positions every `every` ticks (0: none), for the
+    /// visuals; the device holds it to its byte budget (`HelloInfo::mesh_least_every`).
+    /// Answered by [`ToHost::Mesh`] parts.
     WatchMesh {
         /// Ticks between two meshes.
         every: u16,
     },
+    /// 12. Nothing but a valid frame, which feeds the guard: what a host with nothing
+    /// else to say sends at least every [`crate::rates::KEEPALIVE_MS`]. Not answered.
+    Keepalive,
+}
+
+/// The most table bytes one [`ToDevice::TissueChunk`] carries (its frame stays within
+/// [`crate::MAX_FRAME`]).
+pub const TISSUE_CHUNK: usize = 200;
+
+/// A pose of the tissue in the device's frame: a point `p` of the tissue's frame is at
+/// `origin + R p`, `R` the rotation of the unit quaternion `rotation`.
+#[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pose {
+    /// The tissue frame's origin, Q24 mm.
+    pub origin: [i32; 3],
+    /// The rotation, a unit quaternion `w, x, y, z`, Q30.
+    pub rotation: [i32; 4],
+}
+
+impl Default for Pose {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Pose {
+    /// At the device's origin, unrotated.
+    pub const IDENTITY: Pose = Pose {
+        origin: [0; 3],
+        rotation: [1 << 30, 0, 0, 0],
+    };
+
+    /// From mm and three angles in degrees: the rotation `Rz(rz) Ry(ry) Rx(rx)` (about
+    /// the device's `x`, then `y`, then `z`).
+    pub fn from_mm_deg(origin: [f64; 3], angles_deg: [f64; 3]) -> Pose {
+        let half = angles_deg.map(|a| a.to_radians() / 2.0);
+        let (s, c) = (half.map(libm::sin), half.map(libm::cos));
+        // q = qz ⊗ qy ⊗ qx.
+        let w = c[2] * c[1] * c[0] + s[2] * s[1] * s[0];
+        let x = c[2] * c[1] * s[0] - s[2] * s[1] * c[0];
+        let y = c[2] * s[1] * c[0] + s[2] * c[1] * s[0];
+        let z = s[2] * c[1] * c[0] - c[2] * s[1] * s[0];
+        Pose {
+            origin: origin.map(crate::scale::mm_bits),
+            rotation: [w, x, y, z].map(|q| crate::scale::from_f64(q, crate::scale::QUAT_FRAC)),
+        }
+    }
+
+    /// The origin, mm.
+    pub fn origin_mm(&self) -> [f64; 3] {
+        self.origin.map(crate::scale::mm)
+    }
+
+    /// The rotation as angles `rx, ry, rz` in degrees (`R = Rz Ry Rx`; `ry` within ±90°).
+    pub fn angles_deg(&self) -> [f64; 3] {
+        let [w, x, y, z] = self
+            .rotation
+            .map(|q| crate::scale::to_f64(q, crate::scale::QUAT_FRAC));
+        let rx = libm::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+        let sy = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0);
+        let ry = libm::asin(sy);
+        let rz = libm::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+        [rx, ry, rz].map(f64::to_degrees)
+    }
+}
+
+/// Friction coefficients, Q16: static `mu_s` ≥ kinetic `mu_k`, each 0 … 2.
+#[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Friction {
+    /// Static, Q16.
+    pub mu_s: u32,
+    /// Kinetic, Q16.
+    pub mu_k: u32,
+}
+
+impl Friction {
+    /// The largest coefficient, Q16 (2).
+    pub const MAX: u32 = 2 << crate::scale::FRICTION_FRAC;
+
+    /// From two numbers (rounded to Q16; the device checks them).
+    pub fn new(mu_s: f64, mu_k: f64) -> Friction {
+        let q = |x: f64| crate::scale::from_f64(x, crate::scale::FRICTION_FRAC).max(0) as u32;
+        Friction {
+            mu_s: q(mu_s),
+            mu_k: q(mu_k),
+        }
+    }
+
+    /// `(mu_s, mu_k)` as numbers.
+    pub fn values(&self) -> (f64, f64) {
+        let f = |q: u32| q as f64 / (1u32 << crate::scale::FRICTION_FRAC) as f64;
+        (f(self.mu_s), f(self.mu_k))
+    }
+
+    /// Whether a device takes it: each at most 2, `mu_k ≤ mu_s`.
+    pub fn valid(&self) -> bool {
+        self.mu_s <= Self::MAX && self.mu_k <= self.mu_s
+    }
+}
+
+/// What a tissue load announces: the force table's `segments` (knots − 1), its length
+/// in bytes and its hash ([`crate::table_bytes`]), the tissue's friction (none: keep the
+/// live one's), and the substeps the host computed for the device's patch (0: the device
+/// searches for them, which takes seconds on a small core; it checks a host's number
+/// either way).
+#[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TissueBegin {
+    /// Segments.
+    pub segments: u16,
+    /// Bytes to come.
+    pub len: u32,
+    /// FNV-1a of the bytes.
+    pub hash: u32,
+    /// The tissue's friction, or the live one's.
+    pub friction: Option<Friction>,
+    /// Substeps per tick the host proposes (0: none).
+    pub substeps: u16,
 }
 
 /// From the device to the host.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq)]
 pub enum ToHost {
-    /// The device and its tissue.
+    /// 0. The device, its limits and its tissue.
     Hello(HelloInfo),
-    /// A tissue swapped in, by its hash.
+    /// 1. A tissue swapped in (the tick runs it), by its hash.
     Ack {
         /// The tissue's hash.
         tissue: u32,
     },
-    /// Refused; the device's state is unchanged.
+    /// 2. Refused; the device's state is unchanged.
     Nak(NakReason),
-    /// The counters.
+    /// 3. The counters.
     Status(StatusInfo),
-    /// A live tick.
+    /// 4. A live tick.
     Telemetry(Telemetry),
-    /// A replayed tick.
+    /// 5. A replayed tick.
     ReplayRow(ReplayRow),
-    /// The device takes path samples up to (not including) tick `until`.
+    /// 6. The device takes path samples up to (not including) tick `until`.
     ReplayCredit {
         /// The first tick it has no room for.
         until: u32,
     },
-    /// The replay ran all its ticks.
+    /// 7. The replay ran all its ticks.
     ReplayEnd {
         /// Ticks run.
         ticks: u32,
     },
-    /// A part of a live mesh: up to [`MESH_PART`] nodes' positions.
+    /// 8. A part of a live mesh: up to [`crate::info::MESH_PART`] nodes.
     Mesh(MeshPart),
-}
-
-/// Nodes one [`ToHost::Mesh`] part carries (its frame stays within 256 bytes).
-pub const MESH_PART: usize = 12;
-
-/// Nodes `first .. first + MESH_PART` (those below `nodes`) of the live patch at `tick`:
-/// each free node's rest position plus its displacement, in the patch's frame, Q24 mm
-/// (`x, y, z`). The parts of one mesh share `seq` and `tick`; a mesh the device could
-/// not send is counted in the telemetry's drops and its `seq` skipped.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct MeshPart {
-    /// Counts meshes, sent or dropped: a gap is a drop.
-    pub seq: u32,
-    /// The tick the positions are from.
-    pub tick: u32,
-    /// The first node in this part.
-    pub first: u16,
-    /// The nodes in the whole mesh.
-    pub nodes: u16,
-    /// Positions, Q24 mm; past `nodes − first`, zero.
-    pub positions: [[i32; 3]; MESH_PART],
-}
-
-/// The core a device runs on.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Core {
-    /// Cortex-M0.
-    M0,
-    /// Cortex-M3.
-    M3,
-    /// Cortex-M4F.
-    M4f,
-}
-
-impl Core {
-    /// Its name in lines: `m0`, `m3`, `m4f`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::M0 => "m0",
-            Self::M3 => "m3",
-            Self::M4f => "m4f",
-        }
-    }
-}
-
-/// The answer to `Hello`.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct HelloInfo {
-    /// [`crate::PROTOCOL`] of the device.
-    pub protocol: u16,
-    /// [`crate::SCHEMA`] of the device.
-    pub schema: u32,
-    /// Its core.
-    pub core: Core,
-    /// Its tick rate, Hz.
-    pub tick_hz: u32,
-    /// The live patch's side, nodes.
-    pub grid: u8,
-    /// The largest patch side a replay may ask for.
-    pub max_grid: u8,
-    /// The live tissue's size, nodes (the patch alone: `grid × grid`).
-    pub tissue_w: u8,
-    /// See `tissue_w`.
-    pub tissue_h: u8,
-    /// The force table's knots.
-    pub knots: u16,
-    /// The live tissue's hash ([`crate::table_bytes::hash`]).
-    pub tissue: u32,
-    /// Path samples the device buffers for a replay.
-    pub path_capacity: u32,
-}
-
-/// Why the device refused.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum NakReason {
-    /// A replay or a load is under way.
-    Busy,
-    /// A chunk out of order, or a commit without a begin.
-    Order,
-    /// The bytes received are not the length announced, or not a table's.
-    Length,
-    /// The bytes' hash is not the one announced.
-    Hash,
-    /// The table has another knot count than the device's.
-    Segments,
-    /// The table's own check refused it (`ForceTable::validate`).
-    Table,
-    /// Its recorded error is over the product's bound, or unmeasured.
-    Bound,
-    /// The solver refused it on the device's patch (its substeps or coefficients).
-    Solver,
-    /// A replay without a tissue.
-    NoTissue,
-    /// A replay asks for more than the device holds: the option, and its limit.
-    Option {
-        /// The option at fault.
-        option: SpecOption,
-        /// The device's limit for it.
-        limit: i32,
-    },
-}
-
-impl NakReason {
-    /// In words, for the host's one line.
-    pub const fn message(self) -> &'static str {
-        match self {
-            Self::Busy => "the device is busy with a replay or a load",
-            Self::Order => "a piece out of order, or a commit without a begin",
-            Self::Length => "the bytes received are not the length announced",
-            Self::Hash => "the bytes' hash is not the one announced",
-            Self::Segments => "the table's knot count is not the device's",
-            Self::Table => "the table failed its own check (ForceTable::validate)",
-            Self::Bound => "the table's recorded error is over the product's bound, or unmeasured",
-            Self::Solver => "the device's solver refused the tissue on its patch",
-            Self::NoTissue => "no tissue",
-            Self::Option { .. } => "the device does not hold that option's value",
-        }
-    }
-}
-
-/// An option of a replay the device may not hold.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SpecOption {
-    /// `--grid`.
-    Grid,
-    /// `--spacing`.
-    Spacing,
-    /// `--rate`.
-    Rate,
-    /// `--node-mass`.
-    NodeMass,
-    /// `--arith`.
-    Arith,
-    /// `--tissue`.
-    Tissue,
-    /// `--cap-radius`.
-    CapRadius,
-    /// The path's length.
-    Samples,
-    /// The solver's configuration as a whole (its substeps).
-    Config,
-}
-
-impl SpecOption {
-    /// The host's option it stands for.
-    pub const fn flag(self) -> &'static str {
-        match self {
-            Self::Grid => "--grid",
-            Self::Spacing => "--spacing",
-            Self::Rate => "--rate",
-            Self::NodeMass => "--node-mass",
-            Self::Arith => "--arith",
-            Self::Tissue => "--tissue",
-            Self::CapRadius => "--cap-radius",
-            Self::Samples => "--probe",
-            Self::Config => "--rate",
-        }
-    }
-}
-
-/// The device's counters.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct StatusInfo {
-    /// Ticks run.
-    pub ticks: u32,
-    /// Ticks that overran.
-    pub overruns: u32,
-    /// Frames dropped: a bad CRC, COBS, length or message.
-    pub bad_frames: u32,
-    /// Telemetry messages dropped because transmit was busy.
-    pub dropped_telemetry: u32,
-    /// Whether a host holds the device armed.
-    pub armed: bool,
-    /// Whether the device is in its safe state after a fault.
-    pub fault: bool,
-    /// Whether a replay runs.
-    pub replaying: bool,
-    /// The tissue's origin the host last set (Q24 mm; the tick moves toward it).
-    pub pose: [i32; 3],
-}
-
-/// A live tick.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Telemetry {
-    /// Counts telemetry messages, sent or dropped: a gap is a drop.
-    pub seq: u32,
-    /// The tick.
-    pub tick: u32,
-    /// The probe in the tissue frame, Q24 mm.
-    pub probe: [i32; 3],
-    /// The force rendered, Q20 N.
-    pub force: [i32; 3],
-    /// The link's force gain, Q15 (32768: full; it fades to 0 when a host falls silent).
-    pub gain: u16,
-    /// Bit 0: in contact; bit 1: slipping; bit 2: armed; bit 3: fault.
-    pub flags: u8,
-    /// Telemetry dropped so far.
-    pub dropped: u32,
-}
-
-/// A replay tick's raw outputs; the host prints them as `mccs replay` does.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct ReplayRow {
-    /// The tick (0: the path's first sample).
-    pub tick: u32,
-    /// The device force, Q20 N.
-    pub force: [i32; 3],
-    /// Glued: the contact node's displacement; roaming: the proxy point in the window's
-    /// frame (when bit 2 of `flags`), Q24 mm.
-    pub point: [i32; 3],
-    /// Roaming: the window's origin, Q24 mm.
-    pub origin: [i32; 2],
-    /// The displacement of the node that moved most, Q24 mm.
-    pub max_disp: [i32; 3],
-    /// Bit 0: in contact; bit 1: slipping; bit 2: `point` holds a proxy.
-    pub flags: u8,
-    /// Roaming: the window's shifts so far.
-    pub shifts: u32,
-}
-
-/// The patch and solver of a replay: `mccs replay`'s options.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
-pub struct ReplaySpec {
-    /// `--grid`.
-    pub grid: u8,
-    /// `--spacing`, mm.
-    pub spacing_mm: f64,
-    /// `--rate`, Hz.
-    pub tick_hz: f64,
-    /// `--node-mass`, kg.
-    pub node_mass_kg: f64,
-    /// `--spring-damping`, N·s/m.
-    pub spring_damping: f64,
-    /// `--coupling-stiffness`, N/mm.
-    pub coupling_stiffness: f64,
-    /// `--coupling-damping`, N·s/m.
-    pub coupling_damping: f64,
-    /// `--max-force`, N.
-    pub max_force: f64,
-    /// `--integrator symplectic-damped`.
-    pub symplectic: bool,
-    /// `--arith narrow`.
-    pub narrow: bool,
-    /// Path samples (ticks) to come.
-    pub samples: u32,
-    /// The first sample's `x, y`, mm, as the host read it: where a roaming window
-    /// starts (the host's own replay starts it there, before any rounding).
-    pub start: [f64; 2],
-    /// `--tissue` and its options.
-    pub roaming: Option<RoamSpec>,
-}
-
-/// A roaming replay's tissue, friction and probe.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
-pub struct RoamSpec {
-    /// Tissue nodes along `x`.
-    pub tissue_w: u8,
-    /// Tissue nodes along `y`.
-    pub tissue_h: u8,
-    /// Static friction.
-    pub mu_s: f64,
-    /// Kinetic friction.
-    pub mu_k: f64,
-    /// Probe radius, mm.
-    pub probe_radius: f64,
-    /// A spherical cap's radius, mm (none: flat).
-    pub cap_radius: Option<f64>,
 }

@@ -32,12 +32,13 @@
 //! reciprocal found by Newton's iteration ([`recip`]).
 
 mod drive;
+pub mod inverse;
 mod pose;
 pub mod recip;
 mod spec;
 
 pub use drive::Drive;
-pub use pose::{ArmPose, LIMIT_A, LIMIT_B, LIMIT_C, OUTSIDE};
+pub use pose::{ArmPose, LIMITS, LIMIT_A, LIMIT_B, LIMIT_C, OUTSIDE};
 pub use spec::{ArmError, ArmSpec, GravitySpec, JointSpec};
 
 /// A full turn in phase units (2³²), as `f64`.

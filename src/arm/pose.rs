@@ -10,6 +10,8 @@ pub const LIMIT_A: u8 = 1;
 pub const LIMIT_B: u8 = 2;
 /// Joint C outside its range.
 pub const LIMIT_C: u8 = 4;
+/// Any joint outside its range.
+pub const LIMITS: u8 = LIMIT_A | LIMIT_B | LIMIT_C;
 /// The probe beyond what `Length` holds in the tissue's frame (±128 mm): held there, and
 /// the tissue is not touched.
 pub const OUTSIDE: u8 = 8;

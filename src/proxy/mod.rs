@@ -57,6 +57,43 @@ pub struct ProxyConfig {
     pub probe_radius: f64,
 }
 
+/// A proxy's friction in fixed point: `μ_s`, `μ_k` and the hysteresis cone
+/// `tan(0.6 atan μ_k)`, Q16 — built away from the tick (`f64`), taken by a proxy between
+/// two ticks ([`Proxy::set_friction`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Friction {
+    mu_s: i32,
+    mu_k: i32,
+    mu_h: i32,
+}
+
+impl Friction {
+    /// From the coefficients, each within 0 … 2 (`μ_k > μ_s` slides with no hysteresis
+    /// cone).
+    pub fn new(mu_s: f64, mu_k: f64) -> Result<Friction, ProxyError> {
+        let ok = |m: f64| m.is_finite() && (0.0..=2.0).contains(&m);
+        if !ok(mu_s) || !ok(mu_k) {
+            return Err(ProxyError::Friction);
+        }
+        let mu_h = if mu_k > mu_s {
+            0.0
+        } else {
+            tan_small(0.6 * libm::atan(mu_k))
+        };
+        Ok(Friction {
+            mu_s: from_f64(mu_s, G_FRAC),
+            mu_k: from_f64(mu_k, G_FRAC),
+            mu_h: from_f64(mu_h, G_FRAC),
+        })
+    }
+
+    /// `(μ_s, μ_k)` as numbers.
+    pub fn values(&self) -> (f64, f64) {
+        let f = |q: i32| q as f64 / ONE_G as f64;
+        (f(self.mu_s), f(self.mu_k))
+    }
+}
+
 /// Why a proxy configuration is refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProxyError {
@@ -145,19 +182,11 @@ impl Proxy {
         {
             return Err(ProxyError::Grid);
         }
-        let ok = |m: f64| m.is_finite() && (0.0..=2.0).contains(&m);
-        if !ok(c.mu_s) || !ok(c.mu_k) {
-            return Err(ProxyError::Friction);
-        }
+        let friction = Friction::new(c.mu_s, c.mu_k)?;
         let r = c.probe_radius;
         if !(r.is_finite() && (0.0..=c.spacing / 2.0).contains(&r)) {
             return Err(ProxyError::ProbeRadius);
         }
-        let mu_h = if c.mu_k > c.mu_s {
-            0.0
-        } else {
-            tan_small(0.6 * libm::atan(c.mu_k))
-        };
         // The patch's rectangle: its nodes `0 … n − 1`, the centre node `n/2` at the
         // origin.
         let edge = |k: usize| from_f64(k as f64 * c.spacing, LEN_FRAC);
@@ -167,9 +196,9 @@ impl Proxy {
             spacing: from_f64(c.spacing, LEN_FRAC),
             patch_rect: [lo, hi, lo, hi],
             inv_s: from_f64(1.0 / c.spacing, 30),
-            mu_s: from_f64(c.mu_s, G_FRAC),
-            mu_k: from_f64(c.mu_k, G_FRAC),
-            mu_h: from_f64(mu_h, G_FRAC),
+            mu_s: friction.mu_s,
+            mu_k: friction.mu_k,
+            mu_h: friction.mu_h,
             radius: from_f64(r, LEN_FRAC),
             at: None,
             slipping: false,
@@ -193,6 +222,23 @@ impl Proxy {
     /// a cap, the cap's normal at the proxy's rest point). Meaningful in contact.
     pub fn normal(&self) -> [f64; 3] {
         self.normal.map(|c| crate::units::to_f64(c, 29))
+    }
+
+    /// Takes new friction coefficients (prepared away from the tick: [`Friction::new`]),
+    /// from the next update on; the contact and its place are kept.
+    pub fn set_friction(&mut self, f: Friction) {
+        self.mu_s = f.mu_s;
+        self.mu_k = f.mu_k;
+        self.mu_h = f.mu_h;
+    }
+
+    /// The friction coefficients in use.
+    pub fn friction(&self) -> Friction {
+        Friction {
+            mu_s: self.mu_s,
+            mu_k: self.mu_k,
+            mu_h: self.mu_h,
+        }
     }
 
     /// Whether the contact slips.

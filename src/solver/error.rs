@@ -25,6 +25,12 @@ pub enum SolverError {
         /// The longest rest length allowed, mm.
         max_mm: u32,
     },
+    /// A proposed substep count failed the stability check: its substep is not stable
+    /// with the margin the estimate keeps ([`crate::solver::stability::StabilityCheck`]).
+    Unverified {
+        /// The substeps proposed.
+        substeps: u32,
+    },
 }
 
 impl core::fmt::Display for SolverError {
@@ -42,6 +48,13 @@ impl core::fmt::Display for SolverError {
                 write!(
                     f,
                     "topology: a spring is longer than {max_mm} mm ({})",
+                    self.message()
+                )
+            }
+            Self::Unverified { substeps } => {
+                write!(
+                    f,
+                    "stability: {substeps} substeps per tick: {}",
                     self.message()
                 )
             }
@@ -68,6 +81,9 @@ impl SolverError {
             }
             Self::SpringTooLong { .. } => {
                 "this arithmetic's precision; scale the patch down or use the wide arithmetic"
+            }
+            Self::Unverified { .. } => {
+                "not stable with the estimate's margin on this patch (propose more, or none)"
             }
         }
     }

@@ -124,6 +124,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.substeps
     }
 
+    /// The largest force the coupling renders (`Coupling::max_force`): per axis glued,
+    /// in magnitude through a proxy.
+    pub fn max_force(&self) -> crate::units::Force {
+        crate::units::Force::from_bits(self.c.coupling.max_force)
+    }
+
     /// The topology.
     pub fn topology(&self) -> &Topology<NODES, EDGES> {
         &self.topo

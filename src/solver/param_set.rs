@@ -85,6 +85,43 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             });
         }
         let substeps = stability::substeps_for(topo, &table, config)?;
+        Ok(Self::build(topo, table, config, substeps))
+    }
+
+    /// [`Solver::prepare_for`] with the substeps of a finished stability check of this
+    /// table and configuration on `topo` (run in pieces: [`stability::StabilityCheck`]):
+    /// its outcome, or why not (a check not done, or made for another table or
+    /// configuration, is refused as [`SolverError::ForeignParamSet`]).
+    #[inline(never)]
+    pub fn prepare_checked(
+        topo: &Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+        check: &stability::StabilityCheck<NODES, EDGES>,
+    ) -> Result<ParamSet<S, A>, SolverError> {
+        if !check.made_for(&table, config) {
+            return Err(SolverError::ForeignParamSet);
+        }
+        if topo
+            .edges()
+            .iter()
+            .any(|e| Topology::<NODES, EDGES>::rest_length(e) > A::MAX_REST_LENGTH_MM)
+        {
+            return Err(SolverError::SpringTooLong {
+                max_mm: A::MAX_REST_LENGTH_MM as u32,
+            });
+        }
+        let substeps = check.outcome().ok_or(SolverError::ForeignParamSet)??;
+        Ok(Self::build(topo, table, config, substeps))
+    }
+
+    /// The set for `substeps` substeps a tick.
+    fn build(
+        topo: &Topology<NODES, EDGES>,
+        table: ForceTable<S>,
+        config: &SolverConfig,
+        substeps: u32,
+    ) -> ParamSet<S, A> {
         let h = 1.0 / (config.tick_hz * substeps as f64);
         let c = Coeffs {
             arith: A::coeffs(&StepSpec {
@@ -98,12 +135,12 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             tick_hz: config.tick_hz as i32,
             coupling: CouplingQ::new(&config.coupling),
         };
-        Ok(ParamSet {
+        ParamSet {
             table: ArithTable::new(table),
             substeps,
             c,
             fingerprint: topo.fingerprint(),
-        })
+        }
     }
 
     /// Checks `config` and returns the substeps per tick the stability bound asks for

@@ -6,16 +6,18 @@
 //! bring-up.
 
 use crate::config::BoardConfig;
-use crate::device::{controller_with, BoardController, DevicePart, StartError, StartFault};
+use crate::device::{
+    roaming_controller_with, BoardController, BoardRoaming, DevicePart, StartError, StartFault,
+};
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable};
-use mccs_firmware::arm_device::{ArmDevice, ArmFault, Joint};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
 
 /// The arm the board drives: the firmware's WoodenHaptics constant, which a host test
 /// holds equal to `devices/woodenhaptics.toml`. A port to another arm replaces it.
-pub const ARM: ArmSpec = mccs_firmware::arm_device::WOODENHAPTICS;
+pub const ARM: ArmSpec = mccs_firmware::arm::device::WOODENHAPTICS;
 
 /// The board's arm on these parts.
 pub type BoardArm<A, B, C, EN, HOME> = ArmDevice<A, B, C, EN, HOME>;
@@ -38,6 +40,7 @@ impl StartError<ArmFault> {
             }),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
+            Self::Contact(e) => StartFault::Contact(*e),
         }
     }
 }
@@ -60,9 +63,10 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
     Ok(device)
 }
 
-/// [`crate::device::controller_into`] for the arm: the controller into `slot`, then the
-/// driver enabled (duties still zero, and zero until the arm is homed). The error hands
-/// the device back, in its safe state (large: no heap to box it in, and it runs once).
+/// [`crate::device::controller_into`] for the arm, through the roaming contact with
+/// friction ([`crate::device::roaming`]): the controller into `slot`, then the driver
+/// enabled (duties still zero, and zero until the arm is homed). The error hands the
+/// device back, in its safe state (large: no heap to box it in, and it runs once).
 #[inline(never)]
 #[allow(clippy::type_complexity, clippy::result_large_err)]
 pub fn arm_controller_into<
@@ -76,7 +80,7 @@ pub fn arm_controller_into<
     config: &BoardConfig,
     table: ForceTable<S>,
     device: BoardArm<A, B, C, EN, HOME>,
-    slot: &mut Option<BoardController<LinkedArm<A, B, C, EN, HOME>, S>>,
+    slot: &mut Option<BoardController<LinkedArm<A, B, C, EN, HOME>, BoardRoaming, S>>,
 ) -> Result<(), (StartError<ArmFault>, BoardArm<A, B, C, EN, HOME>)> {
-    controller_with(config, table, device, slot, |d| d.enable())
+    roaming_controller_with(config, table, device, slot, |d| d.enable())
 }

@@ -17,7 +17,7 @@
 //! reset leaves the driver off; the home switch pulls PC3 high while the arm is held in
 //! its home pose.
 
-use mccs_firmware::drivers::joint_encoder::JointEncoder;
+use mccs_firmware::arm::encoder::JointEncoder;
 use stm32f4xx_hal::gpio::{
     gpioa, gpiob, gpioc, Input, Output, PinState, PushPull, PA0, PA1, PA10, PA2, PA3, PA8, PA9,
     PB1, PB6, PB7, PC0, PC1, PC2, PC3, PC6, PC7,
@@ -76,7 +76,7 @@ impl ArmPins {
 }
 
 /// A timer in encoder mode (the HAL's [`Qei`]) as a joint's 16-bit counter: its low 16
-/// bits (TIM2 and TIM5 count 32 bits; [`Extended`](mccs_firmware::drivers::joint_encoder::Extended)
+/// bits (TIM2 and TIM5 count 32 bits; [`Extended`](mccs_firmware::arm::encoder::Extended)
 /// carries 16). A register read: it cannot fail.
 pub struct QeiEncoder<TIM: Instance>(pub Qei<TIM>);
 

@@ -72,6 +72,41 @@ pub struct BoardConfig {
     pub max_force: f64,
     /// Ticks a QEMU run (`--features qemu`) lasts before its SUMMARY.
     pub qemu_ticks: u32,
+    /// The host link's baud rate on USART2, 8N1 (within 1 % of what APB1 can make:
+    /// 1,000,000 is exact at 42 MHz).
+    pub baud: u32,
+    /// The force's ramp from zero after `Arm`, a start or homing, ms (0 … 5,000).
+    pub ramp_ms: u32,
+    /// Overruns in a row that put the device in its safe state (1 … 1,000).
+    pub max_overruns_in_row: u32,
+    /// The pose's slew limits: mm/s per axis of its origin (1 … 1,000), degrees/s of
+    /// its rotation (1 … 3,600).
+    pub pose_speed_mm_s: u16,
+    /// See `pose_speed_mm_s`.
+    pub pose_turn_deg_s: u16,
+    /// Where a pose may put the tissue's origin, mm in the device's frame (the arm: its
+    /// tissue frame of `devices/*.toml`): the low corner, then the high one, each within
+    /// ±100 mm.
+    pub workspace_mm: [[f64; 3]; 2],
+    /// The roaming tissue's size, nodes (the arm; `grid` … 64 a side, within ±100 mm at
+    /// the patch's spacing).
+    pub tissue_nodes: [usize; 2],
+    /// Its friction, static and kinetic (0 … 2, `mu_k ≤ mu_s`).
+    pub mu_s: f64,
+    /// See `mu_s`.
+    pub mu_k: f64,
+    /// Instructions a tick may spend (half a tick at the core's clock: 84,000 at
+    /// 168 MHz), what it costs besides its substeps, and what a substep costs: the
+    /// bench's measured figures for this device's tick (a test holds them to
+    /// `bench/baseline.txt`). A tissue whose tick would pass the budget is refused.
+    pub tick_budget: u32,
+    /// See `tick_budget`.
+    pub tick_base_cost: u32,
+    /// See `tick_budget`.
+    pub substep_cost: u32,
+    /// Steps of a tissue's stability check run between two polls of the link: at most
+    /// 5 ms of the core (a test holds them to the bench's cost of a step).
+    pub check_steps_per_poll: u32,
 }
 
 /// The STM32F405 board: 8 MHz crystal, 168 MHz, a 1 kHz tick, the AS5047P at 5.25 MHz,
@@ -97,6 +132,19 @@ pub const BOARD: BoardConfig = BoardConfig {
     coupling_damping: 0.5,
     max_force: 3.0,
     qemu_ticks: 1000,
+    baud: mccs_link::rates::DEFAULT_BAUD,
+    ramp_ms: 500,
+    max_overruns_in_row: 10,
+    pose_speed_mm_s: 200,
+    pose_turn_deg_s: 180,
+    workspace_mm: [[-50.0, -50.0, -40.0], [50.0, 50.0, 40.0]],
+    tissue_nodes: [64, 64],
+    mu_s: 0.6,
+    mu_k: 0.4,
+    tick_budget: 84_000,
+    tick_base_cost: 27_000,
+    substep_cost: 18_000,
+    check_steps_per_poll: 32,
 };
 
 /// A board constant out of its range: which one, in words.
@@ -128,6 +176,15 @@ pub enum BoardConfigError {
     /// `max_force` is over `force_at_full_duty`: the motor would saturate below the
     /// clamp, without a word.
     ForceClamp,
+    /// `baud` is not within 1 % of what USART2 makes at APB1's clock, or outside
+    /// 9,600 … 2,625,000.
+    Baud,
+    /// `ramp_ms`, `max_overruns_in_row` or the pose's limits out of range.
+    Link,
+    /// The workspace, the tissue's size or its friction out of range.
+    Tissue,
+    /// The tick's budget or costs: zero, or no substep fits.
+    Budget,
 }
 
 impl BoardConfigError {
@@ -148,6 +205,10 @@ impl BoardConfigError {
             Self::Patch => "grid 3 … 8, node_mass_g and spring_damping finite and positive",
             Self::Coupling => "coupling_stiffness > 0 and ≤ 1000 N/mm, coupling_damping 0 … 1000 N·s/m, max_force > 0 N",
             Self::ForceClamp => "max_force: must be at most force_at_full_duty (the motor saturates there)",
+            Self::Baud => "baud: must be 9600 … 2625000 and within 1 % of what USART2 makes at APB1's clock",
+            Self::Link => "ramp_ms 0 … 5000, max_overruns_in_row 1 … 1000, pose_speed_mm_s 1 … 1000, pose_turn_deg_s 1 … 3600",
+            Self::Tissue => "workspace_mm within ±100 mm (low ≤ high), tissue_nodes grid … 64 within ±100 mm, 0 ≤ mu_k ≤ mu_s ≤ 2",
+            Self::Budget => "tick_budget, tick_base_cost, substep_cost > 0, one substep within the budget, check_steps_per_poll ≥ 1",
         }
     }
 }
@@ -207,6 +268,23 @@ pub const fn tick_timer(timer_clock_hz: u32, tick_hz: u32) -> Option<(u16, u32)>
     Some((psc as u16, TICK_COUNTER_HZ / tick_hz - 1))
 }
 
+/// How far the baud rate USART2 makes from `pclk_hz` is from `baud`, parts per million:
+/// oversampling by 16, its divider `pclk / baud` in sixteenths, rounded to nearest (as
+/// the HAL sets `BRR`).
+pub const fn usart_error_ppm(pclk_hz: u32, baud: u32) -> u32 {
+    if baud == 0 {
+        return u32::MAX;
+    }
+    // BRR = USARTDIV · 16 = pclk / baud, to nearest; the rate made is pclk / BRR.
+    let brr = (pclk_hz as u64 + baud as u64 / 2) / baud as u64;
+    if brr < 16 {
+        return u32::MAX;
+    }
+    let made_micro = pclk_hz as u64 * 1_000_000 / brr;
+    let want_micro = baud as u64 * 1_000_000;
+    (made_micro.abs_diff(want_micro) * 1_000_000 / want_micro) as u32
+}
+
 /// The clocks the HAL sets from a [`BoardConfig`]: APB1 and APB2 at their limits (or
 /// the core clock, if lower), timers at twice their bus clock when it is divided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -219,6 +297,8 @@ pub struct Clocks {
     pub tim1_hz: u32,
     /// TIM2 (APB1 timers), Hz.
     pub tim2_hz: u32,
+    /// APB1 (USART2), Hz.
+    pub pclk1_hz: u32,
 }
 
 impl Clocks {
@@ -226,13 +306,14 @@ impl Clocks {
     /// APB at its limit or below, its divider `⌈sysclk / limit⌉` rounded up to a power
     /// of two, its timers at twice its clock when divided.
     pub const fn for_sysclk(sysclk_hz: u32) -> Self {
-        let (_, tim2) = apb(sysclk_hz, PCLK1_MAX_HZ);
+        let (pclk1, tim2) = apb(sysclk_hz, PCLK1_MAX_HZ);
         let (pclk2, tim1) = apb(sysclk_hz, PCLK2_MAX_HZ);
         Self {
             sysclk_hz,
             pclk2_hz: pclk2,
             tim1_hz: tim1,
             tim2_hz: tim2,
+            pclk1_hz: pclk1,
         }
     }
 }
@@ -300,6 +381,40 @@ impl BoardConfig {
         if self.max_force > self.force_at_full_duty {
             return Err(E::ForceClamp);
         }
+        if !(9_600..=2_625_000).contains(&self.baud)
+            || usart_error_ppm(clocks.pclk1_hz, self.baud) > 10_000
+        {
+            return Err(E::Baud);
+        }
+        if self.ramp_ms > 5_000
+            || !(1..=1_000).contains(&self.max_overruns_in_row)
+            || !(1..=1_000).contains(&self.pose_speed_mm_s)
+            || !(1..=3_600).contains(&self.pose_turn_deg_s)
+        {
+            return Err(E::Link);
+        }
+        let [lo, hi] = self.workspace_mm;
+        let half_w = (self.tissue_nodes[0] / 2) as f64 * crate::device::SPACING_MM;
+        let half_h = (self.tissue_nodes[1] / 2) as f64 * crate::device::SPACING_MM;
+        let in_range = |x: f64| x.is_finite() && x.abs() <= 100.0;
+        if !(0..3).all(|k| in_range(lo[k]) && in_range(hi[k]) && lo[k] <= hi[k])
+            || !(self.grid..=64).contains(&self.tissue_nodes[0])
+            || !(self.grid..=64).contains(&self.tissue_nodes[1])
+            || half_w > 100.0
+            || half_h > 100.0
+            || !(self.mu_s.is_finite() && self.mu_k.is_finite())
+            || !(0.0 <= self.mu_k && self.mu_k <= self.mu_s && self.mu_s <= 2.0)
+        {
+            return Err(E::Tissue);
+        }
+        if self.tick_budget == 0
+            || self.tick_base_cost == 0
+            || self.substep_cost == 0
+            || self.check_steps_per_poll == 0
+            || self.tick_base_cost.saturating_add(self.substep_cost) > self.tick_budget
+        {
+            return Err(E::Budget);
+        }
         Ok(())
     }
 
@@ -323,6 +438,20 @@ impl BoardConfig {
         MotorConfig {
             force_at_full_duty: self.force_at_full_duty,
         }
+    }
+
+    /// The tick's budget and costs, for the link's tissue check.
+    pub fn budget(&self) -> mccs_firmware::link::TickBudget {
+        mccs_firmware::link::TickBudget {
+            tick: self.tick_budget,
+            base: self.tick_base_cost,
+            per_substep: self.substep_cost,
+        }
+    }
+
+    /// The workspace in the link's units (Q24 mm).
+    pub fn workspace_q24(&self) -> [[i32; 3]; 2] {
+        self.workspace_mm.map(|c| c.map(mccs_link::scale::mm_bits))
     }
 
     /// The solver's configuration: the board's tick, patch and coupling (the node mass

@@ -8,12 +8,15 @@ use crate::tissue::SEGMENTS;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
-use mccs::{ArmError, ForceTable, Solver, SolverError, Topology, TopologyError};
+use mccs::{
+    ArmError, Flat, ForceTable, ProxyConfig, ProxyError, Solver, SolverError, TissuePose, Topology,
+    TopologyError, Wide, WindowConfig,
+};
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::one_dof::{OneDofDevice, OneDofError};
-use mccs_firmware::{Controller, HapticDevice};
+use mccs_firmware::{Controller, Glued, HapticDevice, Roaming};
 
 /// The AS5047P's SPI mode (datasheet: CPOL = 0, CPHA = 1; data sampled on the falling
 /// edge). The board's SPI1 is set to it.
@@ -40,12 +43,26 @@ pub type BoardDeviceError<SPI, PWM, DIR, EN> = OneDofError<
 /// The board's device as the tick drives it: with the host link's pose and force gain
 /// ([`LinkedDevice`]; standalone, it is the device as wired).
 pub type Linked<SPI, PWM, DIR, EN> = LinkedDevice<BoardDevice<SPI, PWM, DIR, EN>>;
-/// The largest step of the tissue's pose per tick, mm (10 mm/s at 1 kHz: a moved organ,
-/// breathing), whatever the host asks.
-pub const MAX_POSE_STEP_MM: f64 = 0.01;
-/// The board's controller on a device, for a force table of `S` segments (by default the
-/// board's tissue's, [`crate::tissue::TISSUE`]).
-pub type BoardController<D, const S: usize = SEGMENTS> = Controller<D, NODES, EDGES, S>;
+/// The board's controller on a device through a contact (glued: the 1-DOF board; roaming
+/// with friction: the arm), for a force table of `S` segments (by default the board's
+/// tissue's, [`crate::tissue::TISSUE`]).
+pub type BoardController<D, C = Glued, const S: usize = SEGMENTS> =
+    Controller<D, NODES, EDGES, S, Wide, C>;
+/// The arm's contact: a proxy with friction on the board's flat tissue, the patch its
+/// window.
+pub type BoardRoaming = Roaming<EDGES, Flat>;
+
+/// `device` with the host link's pose (at the board's slew limits) and gain.
+pub fn linked<D>(config: &BoardConfig, device: D) -> LinkedDevice<D> {
+    LinkedDevice::new(
+        device,
+        TissuePose::new(
+            config.pose_speed_mm_s as f64,
+            config.pose_turn_deg_s as f64,
+            config.tick_hz as f64,
+        ),
+    )
+}
 
 /// Why the board could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +77,8 @@ pub enum StartError<E> {
     Topology(TopologyError),
     /// The solver.
     Solver(SolverError),
+    /// The roaming contact: its proxy or window.
+    Contact(ProxyError),
 }
 
 impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
@@ -78,6 +97,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
             }),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
+            Self::Contact(e) => StartFault::Contact(*e),
         }
     }
 }
@@ -96,6 +116,8 @@ pub enum StartFault {
     Topology(TopologyError),
     /// The solver (the substeps the stability bound needs, …).
     Solver(SolverError),
+    /// The roaming contact: its proxy or window.
+    Contact(ProxyError),
 }
 
 /// A part of the board's device.
@@ -179,6 +201,7 @@ impl core::fmt::Display for StartFault {
             Self::SafeState(p) => write!(f, "safe state: {} failed", p.name()),
             Self::Topology(e) => write!(f, "{e}"),
             Self::Solver(e) => write!(f, "solver: {e}"),
+            Self::Contact(e) => write!(f, "{e}"),
         }
     }
 }
@@ -200,6 +223,7 @@ impl defmt::Format for StartFault {
             Self::SafeState(p) => defmt::write!(f, "safe state: {=str} failed", p.name()),
             Self::Topology(e) => defmt::write!(f, "{}", e),
             Self::Solver(e) => defmt::write!(f, "solver: {}", e),
+            Self::Contact(e) => defmt::write!(f, "{=str}", e.message()),
         }
     }
 }
@@ -240,7 +264,7 @@ pub fn controller_into<SPI, PWM, DIR, EN, const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
     device: BoardDevice<SPI, PWM, DIR, EN>,
-    slot: &mut Option<BoardController<Linked<SPI, PWM, DIR, EN>, S>>,
+    slot: &mut Option<BoardController<Linked<SPI, PWM, DIR, EN>, Glued, S>>,
 ) -> Result<
     (),
     (
@@ -259,36 +283,115 @@ where
     })
 }
 
-/// [`controller_into`] for any device (the arm's too, [`crate::arm`]): the patch and the
-/// solver on `config` and `table`, then `enable` (the motor driver on, duty still zero);
-/// on an error the device is put in its safe state and handed back with the error.
+/// The board's solver on `config` and `table`.
+fn solver<const S: usize>(
+    config: &BoardConfig,
+    table: ForceTable<S>,
+) -> Result<Solver<NODES, EDGES, S, Wide>, StartError<core::convert::Infallible>> {
+    let topo = Topology::standard_patch(config.grid, SPACING_MM).map_err(StartError::Topology)?;
+    Solver::new(topo, table, &config.solver()).map_err(StartError::Solver)
+}
+
+/// A start-up error of no device's (the patch, the solver, the contact) as one of `E`.
+fn widen<E>(e: StartError<core::convert::Infallible>) -> StartError<E> {
+    match e {
+        StartError::Config(c) => StartError::Config(c),
+        StartError::Arm(a) => StartError::Arm(a),
+        StartError::Topology(t) => StartError::Topology(t),
+        StartError::Solver(s) => StartError::Solver(s),
+        StartError::Contact(c) => StartError::Contact(c),
+        StartError::SafeState(never) => match never {},
+    }
+}
+
+/// The board's roaming contact on `solver`: a point probe with the board's friction on
+/// its flat tissue of `tissue_nodes`, the window centred on the tissue.
+pub fn roaming<const S: usize>(
+    config: &BoardConfig,
+    solver: &mut Solver<NODES, EDGES, S, Wide>,
+) -> Result<BoardRoaming, ProxyError> {
+    let proxy = solver.proxy(&ProxyConfig {
+        grid: config.grid,
+        spacing: SPACING_MM,
+        mu_s: config.mu_s,
+        mu_k: config.mu_k,
+        probe_radius: 0.0,
+    })?;
+    let window = solver.window(
+        &WindowConfig {
+            tissue_w: config.tissue_nodes[0],
+            tissue_h: config.tissue_nodes[1],
+            hysteresis: 0.1,
+        },
+        &Flat,
+        &proxy,
+        0.0,
+        0.0,
+    )?;
+    Ok(Roaming { proxy, window })
+}
+
+/// [`controller_into`] for any device (the arm's too, [`crate::arm`]), glued: the patch
+/// and the solver on `config` and `table`, then `enable` (the motor driver on, duty still
+/// zero); on an error the device is put in its safe state and handed back with the
+/// error.
 #[inline(never)]
 #[allow(clippy::type_complexity)]
 pub fn controller_with<D: HapticDevice, const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
     mut device: D,
-    slot: &mut Option<BoardController<LinkedDevice<D>, S>>,
+    slot: &mut Option<BoardController<LinkedDevice<D>, Glued, S>>,
     enable: impl FnOnce(&mut D) -> Result<(), D::Error>,
 ) -> Result<(), (StartError<D::Error>, D)> {
-    let built = Topology::standard_patch(config.grid, SPACING_MM)
-        .map_err(StartError::Topology)
-        .and_then(|topo| Solver::new(topo, table, &config.solver()).map_err(StartError::Solver));
-    let solver = match built {
+    let solver = match solver(config, table) {
         Ok(s) => s,
         Err(e) => {
             let _ = device.safe_state();
-            return Err((e, device));
+            return Err((widen(e), device));
         }
     };
     if let Err(e) = enable(&mut device) {
         let _ = device.safe_state();
         return Err((StartError::SafeState(e), device));
     }
-    *slot = Some(Controller::new(
+    let ctl = slot.insert(Controller::new(solver, linked(config, device), u32::MAX));
+    ctl.set_overrun_limit(config.max_overruns_in_row);
+    Ok(())
+}
+
+/// [`controller_with`] through the board's roaming contact with friction
+/// ([`roaming`]): the arm's.
+#[inline(never)]
+#[allow(clippy::type_complexity)]
+pub fn roaming_controller_with<D: HapticDevice, const S: usize>(
+    config: &BoardConfig,
+    table: ForceTable<S>,
+    mut device: D,
+    slot: &mut Option<BoardController<LinkedDevice<D>, BoardRoaming, S>>,
+    enable: impl FnOnce(&mut D) -> Result<(), D::Error>,
+) -> Result<(), (StartError<D::Error>, D)> {
+    let built = solver(config, table).and_then(|mut s| {
+        let contact = roaming(config, &mut s).map_err(StartError::Contact)?;
+        Ok((s, contact))
+    });
+    let (solver, contact) = match built {
+        Ok(b) => b,
+        Err(e) => {
+            let _ = device.safe_state();
+            return Err((widen(e), device));
+        }
+    };
+    if let Err(e) = enable(&mut device) {
+        let _ = device.safe_state();
+        return Err((StartError::SafeState(e), device));
+    }
+    let ctl = slot.insert(Controller::with_contact(
         solver,
-        LinkedDevice::new(device, MAX_POSE_STEP_MM),
+        contact,
+        linked(config, device),
         u32::MAX,
     ));
+    ctl.set_overrun_limit(config.max_overruns_in_row);
     Ok(())
 }

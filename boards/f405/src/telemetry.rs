@@ -5,7 +5,7 @@
 
 use crate::config::BoardConfig;
 use mccs_firmware::drivers::as5047p::EncoderErrors;
-use mccs_firmware::{Fault, Telemetry};
+use mccs_firmware::{DeviceStatus, Fault, Telemetry};
 
 /// The board's run statistics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -22,16 +22,8 @@ pub struct BoardTelemetry {
     pub encoder: EncoderErrors,
     /// The tick (0-based) on which the safe state was entered.
     pub fault_tick: Option<u32>,
-    /// The probe as the last tick read it, in the tissue's frame (Q24 mm).
-    pub probe: [i32; 3],
-    /// The host link's force gain on the last tick (Q15).
-    pub gain: u16,
-    /// The arm's joint duties last written, Q16 (the arm variant; zero on the 1-DOF).
-    pub duties: [i32; 3],
-    /// The arm's pose flags (`mccs::arm::LIMIT_*`, `OUTSIDE`).
-    pub arm_flags: u8,
-    /// Whether the arm has been homed.
-    pub homed: bool,
+    /// What the device knows of itself: homed, at a limit, its duties.
+    pub device: DeviceStatus,
 }
 
 impl BoardTelemetry {
@@ -49,17 +41,25 @@ impl BoardTelemetry {
                 consecutive: 0,
             },
             fault_tick: None,
-            probe: [0; 3],
-            gain: mccs_firmware::link::guard::FULL,
-            duties: [0; 3],
-            arm_flags: 0,
-            homed: false,
+            device: DeviceStatus {
+                homed: false,
+                at_limit: false,
+                duties: [0; 3],
+            },
         }
     }
 
-    /// Records one tick: the controller's telemetry after it, its length and the
-    /// encoder's counters.
-    pub fn record(&mut self, run: Telemetry, us: u32, cycles: u32, encoder: EncoderErrors) {
+    /// Records one tick: the controller's telemetry after it, its length, the encoder's
+    /// counters and the device's status.
+    pub fn record(
+        &mut self,
+        run: Telemetry,
+        us: u32,
+        cycles: u32,
+        encoder: EncoderErrors,
+        device: DeviceStatus,
+    ) {
+        self.device = device;
         if self.fault_tick.is_none() && run.fault.is_some() {
             self.fault_tick = Some(run.ticks.saturating_sub(1));
         }
@@ -141,7 +141,7 @@ pub fn qemu_verdict(
     if t.run.safe_state_errors != 0 {
         return Err(QemuMismatch::SafeState);
     }
-    if !t.homed && t.duties != [0; 3] {
+    if !t.device.homed && t.device.duties != [0; 3] {
         return Err(QemuMismatch::Unhomed);
     }
     Ok(())

@@ -13,12 +13,12 @@ use embedded_hal::pwm::{ErrorKind as PwmErrorKind, ErrorType as PwmErrorType, Se
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinTx};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
 use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm, ARM};
-use haptic_f405::device::{BoardController, StartError};
+use haptic_f405::device::{BoardController, BoardRoaming, StartError};
 use haptic_f405::tissue::TISSUE;
 use haptic_f405::BOARD;
 use mccs::{Arm, ArmError, Force};
-use mccs_firmware::arm_device::{ArmFault, JointParts};
-use mccs_firmware::drivers::joint_encoder::{JointEncoder, MockEncoder};
+use mccs_firmware::arm::device::{ArmFault, JointParts};
+use mccs_firmware::arm::encoder::{JointEncoder, MockEncoder};
 use mccs_firmware::Fault;
 use std::cell::Cell;
 use std::rc::Rc;
@@ -102,7 +102,7 @@ impl InputPin for In {
 }
 
 type J = JointParts<Counter, Pwm, Out>;
-type Ctl = BoardController<LinkedArm<J, J, J, Out, In>>;
+type Ctl = BoardController<LinkedArm<J, J, J, Out, In>, BoardRoaming>;
 
 /// The board's arm on parts in memory: each joint's counter, PWM and direction, the
 /// enable and the home input.
@@ -143,13 +143,16 @@ impl Rig {
             1,
             "the driver on once the controller is built"
         );
+        let mut ctl: Ctl = slot.unwrap_or_else(|| panic!("the controller"));
+        // Full force, as the link's guard gives it once its ramp is done.
+        ctl.device_mut().set_gain(mccs_link::scale::GAIN_FULL);
         Rig {
             counter,
             pwm,
             direction,
             enable,
             home,
-            ctl: slot.unwrap_or_else(|| panic!("the controller")),
+            ctl,
         }
     }
 
@@ -283,8 +286,10 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
         ("direction B", Box::new(|r| &r.direction[1]), Fault::Write),
         ("direction C", Box::new(|r| &r.direction[2]), Fault::Write),
     ];
-    // Pressing beside the origin (joint A turned 30 counts): every joint is driven.
-    let mut counts = pressing_counts(1.0);
+    // Pressing at the origin, then joint A turned 30 counts: the proxy sticks (friction),
+    // so the force has a lateral part and every joint is driven.
+    let pressed = pressing_counts(1.0);
+    let mut counts = pressed;
     counts[0] = 30;
     for (name, part, fault) in cases {
         let mut rig = Rig::new();
@@ -298,13 +303,21 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
             rig.home.value.set(1);
             rig.ctl.tick(None);
             rig.home.value.set(0);
+            rig.set_counts(pressed);
+            for _ in 0..100 {
+                rig.ctl.tick(None);
+            }
             rig.set_counts(counts);
         } else {
             rig.home.value.set(1);
             rig.ctl.tick(None);
             rig.home.value.set(0);
+            rig.set_counts(pressed);
+            for _ in 0..100 {
+                rig.ctl.tick(None);
+            }
             rig.set_counts(counts);
-            for _ in 0..200 {
+            for _ in 0..100 {
                 rig.ctl.tick(None);
             }
             assert!(

@@ -59,7 +59,8 @@ fn the_board_constants_hold_the_parts_limits() {
             sysclk_hz: 168_000_000,
             pclk2_hz: 84_000_000,
             tim1_hz: 168_000_000,
-            tim2_hz: 84_000_000
+            tim2_hz: 84_000_000,
+            pclk1_hz: 42_000_000,
         }
     );
     // The HAL rounds the SPI divider down: 10 MHz asked of 84 MHz is 10.5 MHz, over the
@@ -373,7 +374,14 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     let mut t = BoardTelemetry::new();
     for _ in 0..ticks {
         ctl.tick(None);
-        t.record(ctl.telemetry(), 0, 0, ctl.device().inner().encoder.errors());
+        let status = ctl.device().status();
+        t.record(
+            ctl.telemetry(),
+            0,
+            0,
+            ctl.device().inner().encoder.errors(),
+            status,
+        );
     }
     assert_eq!(t.run.fault, Some(Fault::Read));
     assert_eq!(t.fault_tick, Some(fault_tick));
@@ -503,6 +511,8 @@ fn a_press_renders_an_upward_force() {
         panic!("the board's controller did not build");
     }
     let mut ctl = slot.unwrap();
+    // Full force, as the link's guard gives it once its ramp is done.
+    ctl.device_mut().set_gain(mccs_link::scale::GAIN_FULL);
     let mut last = [Force::ZERO; 3];
     for _ in 0..500 {
         last = ctl.tick(None);
@@ -617,7 +627,7 @@ fn the_board_runs_a_table_of_any_knot_count() {
             Pin(log.clone(), "enable"),
         )
         .unwrap();
-        let mut slot: Option<BoardController<_, S>> = None;
+        let mut slot: Option<BoardController<_, mccs_firmware::Glued, S>> = None;
         if device::controller_into(&BOARD, table, dev, &mut slot).is_err() {
             panic!("the board's controller did not build with {} knots", S + 1);
         }

@@ -1,5 +1,4 @@
 //! Hardware drivers on embedded-hal 1.0 traits: nothing here knows a vendor HAL.
 
 pub mod as5047p;
-pub mod joint_encoder;
 pub mod pwm_motor;

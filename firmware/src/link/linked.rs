@@ -1,47 +1,48 @@
-//! [`LinkedDevice`]: a device as the link sees it — the probe in the tissue's frame (the
-//! host's pose, reached by a bounded step per tick) and the force scaled by the link's
-//! gain ([`super::Guard`]) before it reaches the actuator.
+//! [`LinkedDevice`]: a device as the link sees it — the probe read into the tissue's
+//! frame through the host's pose ([`mccs::TissuePose`], moved toward its target at the
+//! device's slew limits every tick) and the force rendered back in the device's frame,
+//! scaled by the link's gain ([`super::Guard`]) before it reaches the actuator.
 
-use crate::device::HapticDevice;
-use mccs::{Force, Length};
+use crate::device::{DeviceStatus, HapticDevice};
+use mccs::{Force, Length, TissuePose};
+use mccs_link::scale::GAIN_FULL;
 
 /// A device with the link's pose and gain.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LinkedDevice<D> {
     device: D,
-    origin: [i32; 3],
-    target: [i32; 3],
-    max_step: i32,
+    pose: TissuePose,
     gain: u16,
     probe: [Length; 3],
+    rendered: [Force; 3],
 }
 
 impl<D> LinkedDevice<D> {
-    /// `device` at the origin, full gain; the pose moves at most `max_step_mm` per tick.
-    pub fn new(device: D, max_step_mm: f64) -> Self {
+    /// `device` with the tissue at its origin, unrotated, at zero gain until the guard
+    /// raises it; the pose moves at most `pose` allows.
+    pub fn new(device: D, pose: TissuePose) -> Self {
         Self {
             device,
-            origin: [0; 3],
-            target: [0; 3],
-            max_step: Length::saturating_from_num(max_step_mm).to_bits().max(1),
-            gain: super::guard::FULL,
+            pose,
+            gain: 0,
             probe: [Length::ZERO; 3],
+            rendered: [Force::ZERO; 3],
         }
     }
 
-    /// The tissue's origin in the device frame the pose moves toward, Q24 mm.
-    pub fn set_target(&mut self, origin: [i32; 3]) {
-        self.target = origin;
+    /// Where the tissue should lie: an origin (Q24 mm) and a unit quaternion (Q30).
+    pub fn set_target(&mut self, origin: [i32; 3], rotation: [i32; 4]) {
+        self.pose.set_target(origin, rotation);
     }
 
-    /// The origin now, Q24 mm.
-    pub fn origin(&self) -> [i32; 3] {
-        self.origin
+    /// The pose now.
+    pub fn pose(&self) -> &TissuePose {
+        &self.pose
     }
 
     /// The force gain for the ticks to come, Q15.
     pub fn set_gain(&mut self, gain: u16) {
-        self.gain = gain.min(super::guard::FULL);
+        self.gain = gain.min(GAIN_FULL);
     }
 
     /// The last probe read, in the tissue's frame.
@@ -49,9 +50,19 @@ impl<D> LinkedDevice<D> {
         self.probe
     }
 
+    /// The force last sent to the device, in its frame, the gain applied.
+    pub fn rendered(&self) -> [Force; 3] {
+        self.rendered
+    }
+
     /// The device.
     pub fn inner(&self) -> &D {
         &self.device
+    }
+
+    /// The device, to change what it holds between ticks.
+    pub fn inner_mut(&mut self) -> &mut D {
+        &mut self.device
     }
 }
 
@@ -59,25 +70,26 @@ impl<D: HapticDevice> HapticDevice for LinkedDevice<D> {
     type Error = D::Error;
 
     fn read_position(&mut self) -> Result<[Length; 3], Self::Error> {
-        for k in 0..3 {
-            let d = self.target[k].saturating_sub(self.origin[k]);
-            // (Not `clamp`, which asserts its bounds: a panic path in the tick.)
-            self.origin[k] =
-                self.origin[k].saturating_add(d.max(-self.max_step).min(self.max_step));
-        }
+        self.pose.step();
         let p = self.device.read_position()?;
-        self.probe =
-            core::array::from_fn(|k| p[k].saturating_sub(Length::from_bits(self.origin[k])));
+        self.probe = self.pose.to_tissue(p);
         Ok(self.probe)
     }
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error> {
         let g = self.gain as i64;
-        let scaled = force.map(|f| Force::from_bits(((f.to_bits() as i64 * g) >> 15) as i32));
+        let f = self.pose.to_device(force);
+        let scaled = f.map(|c| Force::from_bits(((c.to_bits() as i64 * g) >> 15) as i32));
+        self.rendered = scaled;
         self.device.write_force(scaled)
     }
 
     fn safe_state(&mut self) -> Result<(), Self::Error> {
+        self.rendered = [Force::ZERO; 3];
         self.device.safe_state()
+    }
+
+    fn status(&self) -> DeviceStatus {
+        self.device.status()
     }
 }

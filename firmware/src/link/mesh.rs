@@ -1,13 +1,14 @@
 //! The live patch's node positions for the host's visuals (`ToDevice::WatchMesh`): the
 //! tick takes a [`Mesh`] every `every` ticks (a countdown, [`MeshClock`]: no division in
 //! the tick) and posts it for the main loop, which sends it in parts of
-//! [`MESH_PART`] nodes ([`super::Session::mesh`]). At most 60 meshes a second
-//! ([`least_every`]); a mesh the main loop has not sent when the next is taken is
-//! replaced (the newest wins) and counted as dropped.
+//! [`MESH_PART`] nodes with each node's place in the surface grid
+//! ([`super::Session::mesh`]). The rate is held to the link's byte budget
+//! (`mccs_link::rates::mesh_least_every`); a mesh the main loop has not sent when the
+//! next is taken is replaced (the newest wins) and counted as dropped.
 
 use crate::Shared;
 use mccs::{Arith, Solver};
-pub use mccs_link::message::MESH_PART;
+pub use mccs_link::MESH_PART;
 
 /// The nodes' positions at one tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,16 +17,20 @@ pub struct Mesh<const N: usize> {
     pub tick: u32,
     /// The patch's free nodes (at most `N`).
     pub nodes: u16,
+    /// The patch frame's origin in the tissue's frame (`x, y`), Q24 mm.
+    pub origin: [i32; 2],
     /// Free node `k + 1`'s rest position plus its displacement at `k` (the ground's slot,
     /// node 0, is left out), patch frame, Q24 mm.
     pub positions: [[i32; 3]; N],
 }
 
 impl<const N: usize> Mesh<N> {
-    /// `solver`'s nodes at `tick`: one pass over them, saturating adds (the tick's path).
+    /// `solver`'s nodes at `tick`, the patch's origin at `origin` in the tissue's frame:
+    /// one pass over them, saturating adds (the tick's path).
     pub fn of<const E: usize, const S: usize, A: Arith>(
         solver: &Solver<N, E, S, A>,
         tick: u32,
+        origin: [i32; 2],
     ) -> Self {
         let topo = solver.topology();
         // The free nodes, 1 … (node 0 is the ground's slot).
@@ -41,19 +46,18 @@ impl<const N: usize> Mesh<N> {
         Self {
             tick,
             nodes: nodes as u16,
+            origin,
             positions,
         }
     }
 }
 
-/// The fewest ticks between two meshes at `tick_hz`: 60 meshes a second at most.
-pub const fn least_every(tick_hz: u32) -> u16 {
-    let every = tick_hz.div_ceil(60);
-    if every > u16::MAX as u32 {
-        u16::MAX
-    } else {
-        every as u16
-    }
+/// Free node `k`'s (0-based, the mesh's order) place `(i, j)` in the standard patch's
+/// `grid × grid` surface grid (`Topology::standard_patch` numbers the free nodes row
+/// by row inside the fixed ring). The main loop's, not the tick's: it divides.
+pub fn grid_place(grid: usize, k: usize) -> [u8; 2] {
+    let inner = grid.saturating_sub(2).max(1);
+    [(1 + k / inner) as u8, (1 + k % inner) as u8]
 }
 
 /// When the tick takes a mesh: every `every` ticks (0: never), by a countdown. One

@@ -1,7 +1,8 @@
-//! A replay on the device: a patch and solver built for the host's options, a path that
-//! arrives in pieces with flow control, one [`ReplayRow`] per tick computed by the same
-//! code as the host's `mccs replay --backend fixed` ([`mccs_link::replay`]). It runs in
-//! the main loop, never in the tick, and never past the samples it has received.
+//! A replay on the device ([`ReplayRun`]): a patch and solver built for the host's
+//! options, a path that arrives in pieces with flow control, one [`ReplayRow`] per tick
+//! computed by the same code as the host's `mccs replay --backend fixed`
+//! ([`mccs_link::replay`]). It runs in the main loop, never in the tick, and never past
+//! the samples it has received.
 //!
 //! Capacity: the patch of the device's topology (`NODES`, `EDGES`), its arithmetic `A`,
 //! flat tissues (a cap's window is another type: refused, naming `--cap-radius`), and
@@ -11,7 +12,8 @@ use mccs::{
     Arith, Coupling, Flat, ForceTable, Integrator, Length, Proxy, ProxyConfig, Solver,
     SolverConfig, Topology, Window, WindowConfig,
 };
-use mccs_link::message::{NakReason, ReplaySpec, SpecOption, ToHost};
+use mccs_link::replay::PathPoint;
+use mccs_link::{NakReason, ReplaySpec, SpecOption, ToHost};
 
 /// What a replay steps.
 enum Contact<const EDGES: usize> {
@@ -22,75 +24,54 @@ enum Contact<const EDGES: usize> {
     },
 }
 
-/// The solver and contact of a replay under way.
-struct Run<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> {
-    solver: Solver<NODES, EDGES, S, A>,
-    contact: Contact<EDGES>,
-}
-
-/// A device's replays.
-pub struct Replayer<
+/// A replay under way: its solver and contact, its path's samples, how far it is.
+pub struct ReplayRun<
     const NODES: usize,
     const EDGES: usize,
     const S: usize,
     A: Arith,
     const P: usize,
 > {
-    run: Option<Run<NODES, EDGES, S, A>>,
+    solver: Solver<NODES, EDGES, S, A>,
+    contact: Contact<EDGES>,
     path: [[i32; 3]; P],
     samples: u32,
     received: u32,
     done: u32,
-    narrow: bool,
+}
+
+/// The solver configuration a spec asks for.
+fn config_of(spec: &ReplaySpec) -> SolverConfig {
+    SolverConfig {
+        tick_hz: spec.tick_hz,
+        node_mass: spec.node_mass_kg,
+        spring_damping: spec.spring_damping,
+        integrator: if spec.symplectic {
+            Integrator::SymplecticDamped
+        } else {
+            Integrator::ImprovedEuler
+        },
+        coupling: Coupling {
+            stiffness: spec.coupling_stiffness,
+            damping: spec.coupling_damping,
+            max_force: spec.max_force,
+        },
+        ..SolverConfig::default()
+    }
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: usize>
-    Replayer<NODES, EDGES, S, A, P>
+    ReplayRun<NODES, EDGES, S, A, P>
 {
-    /// Idle; `narrow`: whether `A` is the narrow arithmetic (what a spec must ask for).
-    pub const fn new(narrow: bool) -> Self {
-        Self {
-            run: None,
-            path: [[0; 3]; P],
-            samples: 0,
-            received: 0,
-            done: 0,
-            narrow,
-        }
-    }
-
-    /// Whether a replay runs.
-    pub fn running(&self) -> bool {
-        self.run.is_some()
-    }
-
-    /// The first tick the device has no room for.
-    pub fn credit(&self) -> u32 {
-        self.done.saturating_add(P as u32).min(self.samples)
-    }
-
-    /// Starts a replay of `spec` on `table`; the first credit, or why not.
-    pub fn begin(&mut self, spec: &ReplaySpec, table: ForceTable<S>) -> Result<u32, NakReason> {
+    /// A replay of `spec` on `table`; `narrow`: whether `A` is the narrow arithmetic (what
+    /// a spec must ask for). Out of line: its solver is built on this frame alone.
+    #[inline(never)]
+    pub fn new(spec: &ReplaySpec, table: ForceTable<S>, narrow: bool) -> Result<Self, NakReason> {
         let option = |option, limit| NakReason::Option { option, limit };
-        if spec.narrow != self.narrow {
-            return Err(option(SpecOption::Arith, self.narrow as i32));
+        if spec.narrow != narrow {
+            return Err(option(SpecOption::Arith, narrow as i32));
         }
-        let config = SolverConfig {
-            tick_hz: spec.tick_hz,
-            node_mass: spec.node_mass_kg,
-            spring_damping: spec.spring_damping,
-            integrator: if spec.symplectic {
-                Integrator::SymplecticDamped
-            } else {
-                Integrator::ImprovedEuler
-            },
-            coupling: Coupling {
-                stiffness: spec.coupling_stiffness,
-                damping: spec.coupling_damping,
-                max_force: spec.max_force,
-            },
-            ..SolverConfig::default()
-        };
+        let config = config_of(spec);
         let grid = spec.grid as usize;
         let topo = Topology::<NODES, EDGES>::standard_patch(grid, spec.spacing_mm)
             .map_err(|_| option(SpecOption::Grid, max_grid::<NODES, EDGES>() as i32))?;
@@ -126,66 +107,72 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
                 Contact::Roaming { proxy, window }
             }
         };
-        self.run = Some(Run { solver, contact });
-        self.samples = spec.samples;
-        self.received = 0;
-        self.done = 0;
-        Ok(self.credit())
+        Ok(Self {
+            solver,
+            contact,
+            path: [[0; 3]; P],
+            samples: spec.samples,
+            received: 0,
+            done: 0,
+        })
     }
 
-    /// Samples for ticks `first …` (12 bytes each); refused out of order or past the
-    /// credit (the replay is then abandoned).
+    /// The first tick the device has no room for.
+    pub fn credit(&self) -> u32 {
+        self.done.saturating_add(P as u32).min(self.samples)
+    }
+
+    /// Samples for ticks `first …` ([`PathPoint`]s); refused out of order or past the
+    /// credit (the caller then abandons the replay).
     pub fn path(&mut self, first: u32, points: &[u8]) -> Result<(), NakReason> {
-        let n = (points.len() / 12) as u32;
-        if self.run.is_none()
-            || first != self.received
-            || !points.len().is_multiple_of(12)
-            || self.received.saturating_add(n) > self.credit()
-        {
-            self.run = None;
+        let n = (points.len() / PathPoint::BYTES) as u32;
+        let all = PathPoint::all(points);
+        let (Some(all), true) = (
+            all,
+            first == self.received && self.received.saturating_add(n) <= self.credit(),
+        ) else {
             return Err(NakReason::Order);
-        }
-        for (k, p) in points.chunks_exact(12).enumerate() {
-            let w = |i: usize| i32::from_le_bytes([p[i], p[i + 1], p[i + 2], p[i + 3]]);
-            self.path[(first as usize + k) % P] = [w(0), w(4), w(8)];
+        };
+        for (k, p) in all.enumerate() {
+            if let Some(slot) = self.path.get_mut((first as usize + k) % P) {
+                *slot = p.0;
+            }
         }
         self.received += n;
         Ok(())
     }
 
     /// One tick, if its sample has arrived: its row to `out` (then, after the last, the
-    /// end). Returns whether it ran.
-    pub fn step(&mut self, out: &mut dyn FnMut(&ToHost)) -> bool {
-        let Some(run) = self.run.as_mut() else {
-            return false;
-        };
+    /// end). Whether it ran, and whether the replay is over.
+    pub fn step(&mut self, out: &mut dyn FnMut(&ToHost)) -> (bool, bool) {
         if self.done >= self.received {
-            return false;
+            return (false, false);
         }
         let tick = self.done;
-        let probe = self.path[tick as usize % P].map(Length::from_bits);
-        let row = match &mut run.contact {
-            Contact::Glued => mccs_link::replay::glued(&mut run.solver, tick, probe),
+        let probe = self
+            .path
+            .get(tick as usize % P)
+            .copied()
+            .unwrap_or([0; 3])
+            .map(Length::from_bits);
+        let row = match &mut self.contact {
+            Contact::Glued => mccs_link::replay::glued(&mut self.solver, tick, probe),
             Contact::Roaming { proxy, window } => {
-                mccs_link::replay::roaming(&mut run.solver, proxy, window, tick, probe)
+                mccs_link::replay::roaming(&mut self.solver, proxy, window, tick, probe)
             }
         };
         out(&ToHost::ReplayRow(row));
         self.done += 1;
         if self.done == self.samples {
             out(&ToHost::ReplayEnd { ticks: self.done });
-            self.run = None;
-        } else if self.done.is_multiple_of((P as u32 / 2).max(1)) {
+            return (true, true);
+        }
+        if self.done.is_multiple_of((P as u32 / 2).max(1)) {
             out(&ToHost::ReplayCredit {
                 until: self.credit(),
             });
         }
-        true
-    }
-
-    /// Abandons a replay.
-    pub fn abort(&mut self) {
-        self.run = None;
+        (true, false)
     }
 }
 

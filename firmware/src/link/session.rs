@@ -1,79 +1,78 @@
-//! The device's side of the link, in the main loop: each decoded message handled, its
-//! answer written to the host, and what the tick must see returned as an [`Effect`] for
-//! the firmware to apply (through its mailbox and shared state: the tick never waits on
-//! the link).
+//! The device's side of the link's messages ([`Session`]): each decoded message handled
+//! in the main loop, its answer written to the host, and what the tick must see returned
+//! as an [`Effect`] for the server to apply ([`super::LinkServer`]).
 //!
-//! A tissue load is checked here before anything changes: the bytes' length and hash,
-//! the knot count, the table's own `validate`, its recorded error within the product's
-//! bound, the solver's parameter set for the live patch (its substeps). Only then is the
-//! set handed to the tick ([`Effect::Swap`]); on any refusal a `Nak` says why and the
-//! live tissue stays.
+//! A tissue load is checked before anything changes: the bytes' length and hash, the
+//! knot count, the friction, the table's own `validate`, its recorded error within the
+//! product's bound; then its stability on the live patch and its tick against the
+//! budget run in pieces ([`super::check::TissueCheck`], in the server's [`Work`]). Only
+//! then is it handed to the tick; on any refusal a `Nak` says why and the live tissue
+//! stays.
 
-use super::replayer::Replayer;
-use mccs::{Arith, ForceTable, ParamSet, RawTable, Solver, SolverConfig, TableBound, Topology};
-use mccs_link::message::{
-    HelloInfo, MeshPart, NakReason, StatusInfo, Telemetry, ToDevice, ToHost, MESH_PART,
+use super::check::{TickBudget, TissueCheck};
+use super::mesh::{grid_place, Mesh};
+use super::replayer::max_grid;
+use super::state::Snapshot;
+use super::work::Work;
+use mccs::{Arith, ForceTable, SolverConfig, TableBound};
+use mccs_link::table_bytes::{self, Assembler};
+use mccs_link::{
+    rates, ContactKind, Core, DeviceKind, Flags, Friction, HelloInfo, MeshPart, NakReason, Pose,
+    StatusInfo, Telemetry, TissueBegin, ToDevice, ToHost, MESH_PART, PROTOCOL, SCHEMA,
 };
-use mccs_link::{table_bytes, Core, PROTOCOL, SCHEMA};
 
 /// The live device, as the session describes it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Live {
+    /// What it is.
+    pub device: DeviceKind,
+    /// Its plant is simulated.
+    pub simulated: bool,
     /// The core.
     pub core: Core,
+    /// How the probe touches the tissue.
+    pub contact: ContactKind,
     /// The live patch's side, nodes.
     pub grid: usize,
     /// Its spacing, mm.
     pub spacing: f64,
-    /// The live solver's configuration (a loaded tissue is prepared with it).
+    /// The tissue's size, nodes (glued: the patch's).
+    pub tissue: [u8; 2],
+    /// The live solver's configuration (a loaded tissue is checked with it).
     pub config: SolverConfig,
+    /// Where a pose's origin may be, Q24 mm (low corner, high corner).
+    pub workspace: [[i32; 3]; 2],
+    /// The pose's slew limits.
+    pub pose_speed_mm_s: u16,
+    /// See `pose_speed_mm_s`.
+    pub pose_turn_deg_s: u16,
+    /// The link's baud rate.
+    pub baud: u32,
+    /// The tick's budget and costs.
+    pub budget: TickBudget,
+    /// Whether the device computes in the narrow arithmetic.
+    pub narrow: bool,
 }
 
-/// The tick's state, as the main loop last read it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Now {
-    /// Ticks run.
-    pub ticks: u32,
-    /// Overruns.
-    pub overruns: u32,
-    /// In the safe state after a fault.
-    pub fault: bool,
-    /// A host holds the device armed.
-    pub armed: bool,
-    /// The tissue's origin the host last set (Q24 mm).
-    pub pose: [i32; 3],
-}
-
-/// What the firmware applies after a message.
+/// What the server applies after a message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Effect<const S: usize, A: Arith> {
+pub enum Effect {
     /// Nothing.
     None,
-    /// Swap this parameter set in at the next tick; `Ack` the tissue once it is in.
-    Swap {
-        /// The set, prepared for the live patch.
-        set: ParamSet<S, A>,
-        /// The tissue's hash.
-        tissue: u32,
-    },
     /// Arm the guard.
     Arm,
     /// Disarm it.
     Disarm,
-    /// Move the tissue's origin here (Q24 mm).
-    Pose([i32; 3]),
-    /// Take a mesh every this many ticks (0: none; [`super::MeshClock::set`]).
+    /// Move the tissue here.
+    Pose(Pose),
+    /// Take a mesh every this many ticks (0: none).
     WatchMesh(u16),
 }
 
-/// A table arriving in pieces: its words as they are written.
+/// A table arriving in pieces.
 struct Load<const S: usize> {
-    header: [i32; table_bytes::HEADER_WORDS],
-    segments: [[i32; 4]; S],
-    len: u32,
-    hash: u32,
-    got: u32,
-    running_hash: u32,
+    begin: TissueBegin,
+    bytes: Assembler<S>,
 }
 
 /// The device's session.
@@ -81,6 +80,8 @@ pub struct Session<const S: usize> {
     live: Live,
     table: ForceTable<S>,
     tissue: u32,
+    friction: Friction,
+    pose: Pose,
     load: Option<Load<S>>,
     bad_frames: u32,
     watch_every: u32,
@@ -90,15 +91,23 @@ pub struct Session<const S: usize> {
     mesh_every: u32,
     last_mesh: Option<u32>,
     mesh_seq: u32,
+    dropped_mesh: u32,
 }
 
 impl<const S: usize> Session<S> {
-    /// The device `live` with its start-up tissue `table`.
-    pub fn new(live: Live, table: ForceTable<S>) -> Self {
+    /// The device `live` with its start-up tissue `table` and friction (`None`: a contact
+    /// without friction).
+    pub fn new(live: Live, table: ForceTable<S>, friction: Option<mccs::Friction>) -> Self {
+        let friction = friction.map_or(Friction { mu_s: 0, mu_k: 0 }, |f| {
+            let (s, k) = f.values();
+            Friction::new(s, k)
+        });
         Self {
             live,
             table,
             tissue: table_bytes::hash(&table),
+            friction,
+            pose: Pose::IDENTITY,
             load: None,
             bad_frames: 0,
             watch_every: 0,
@@ -108,6 +117,7 @@ impl<const S: usize> Session<S> {
             mesh_every: 0,
             last_mesh: None,
             mesh_seq: 0,
+            dropped_mesh: 0,
         }
     }
 
@@ -116,113 +126,124 @@ impl<const S: usize> Session<S> {
         (&self.table, self.tissue)
     }
 
+    /// The device as described.
+    pub fn live(&self) -> &Live {
+        &self.live
+    }
+
     /// Counts a frame the decoder dropped.
     pub fn bad_frame(&mut self) {
         self.bad_frames = self.bad_frames.saturating_add(1);
     }
 
-    /// The counters.
-    pub fn status(&self, now: Now, replaying: bool) -> StatusInfo {
+    /// The counters and state: the tick's `snap`, whether a host holds the device armed,
+    /// what the main loop works on, and the receive queue's drops.
+    pub fn status(
+        &self,
+        snap: &Snapshot,
+        armed: bool,
+        replaying: bool,
+        checking: bool,
+        rx_dropped: u32,
+    ) -> StatusInfo {
         StatusInfo {
-            ticks: now.ticks,
-            overruns: now.overruns,
+            ticks: snap.ticks,
+            overruns: snap.overruns,
             bad_frames: self.bad_frames,
             dropped_telemetry: self.dropped,
-            armed: now.armed,
-            fault: now.fault,
+            dropped_mesh: self.dropped_mesh,
+            rx_dropped,
+            armed,
+            fault: snap.fault,
             replaying,
-            pose: now.pose,
+            checking,
+            pose: self.pose,
+            gain: snap.gain,
         }
     }
 
-    /// Handles one message; answers go to `out`.
+    /// Handles one message; answers go to `out`. `armed`: the guard's state before it.
+    #[allow(clippy::too_many_arguments)]
     pub fn handle<const N: usize, const E: usize, A: Arith, const P: usize>(
         &mut self,
         msg: ToDevice<'_>,
-        now: Now,
-        replay: &mut Replayer<N, E, S, A, P>,
+        snap: &Snapshot,
+        armed: bool,
+        rx_dropped: u32,
+        work: &mut Work<N, E, S, A, P>,
         out: &mut dyn FnMut(&ToHost),
-    ) -> Effect<S, A> {
+    ) -> Effect {
+        let status = |s: &Self, armed: bool, work: &Work<N, E, S, A, P>| {
+            ToHost::Status(s.status(snap, armed, work.replaying(), work.checking(), rx_dropped))
+        };
         match msg {
-            ToDevice::Hello => {
-                out(&ToHost::Hello(self.hello::<N, E, P>()));
-                Effect::None
-            }
-            ToDevice::Status => {
-                out(&ToHost::Status(self.status(now, replay.running())));
-                Effect::None
-            }
+            ToDevice::Hello => out(&ToHost::Hello(self.hello::<N, E, P>(snap))),
+            ToDevice::Status => out(&status(self, armed, work)),
             ToDevice::Arm => {
-                out(&ToHost::Status(
-                    self.status(Now { armed: true, ..now }, replay.running()),
-                ));
-                Effect::Arm
+                out(&status(self, true, work));
+                return Effect::Arm;
             }
             ToDevice::Disarm => {
-                out(&ToHost::Status(self.status(
-                    Now {
-                        armed: false,
-                        ..now
-                    },
-                    replay.running(),
-                )));
-                Effect::Disarm
+                out(&status(self, false, work));
+                return Effect::Disarm;
             }
-            ToDevice::Pose { origin } => Effect::Pose(origin),
+            ToDevice::Keepalive => {}
+            ToDevice::Pose(p) => match self.check_pose(&p) {
+                Ok(()) => {
+                    self.pose = p;
+                    return Effect::Pose(p);
+                }
+                Err(r) => out(&ToHost::Nak(r)),
+            },
             ToDevice::Watch { every } => {
-                self.watch_every = every as u32;
-                self.next_watch = now.ticks;
-                Effect::None
+                let least =
+                    rates::telemetry_least_every(self.live.config.tick_hz as u32, self.live.baud);
+                self.watch_every = if every == 0 {
+                    0
+                } else {
+                    every.max(least) as u32
+                };
+                self.next_watch = snap.ticks;
             }
             ToDevice::WatchMesh { every } => {
-                // 60 meshes a second at most.
-                let least = super::mesh::least_every(self.live.config.tick_hz as u32);
+                let least = self.mesh_least_every::<N>();
                 let every = if every == 0 { 0 } else { every.max(least) };
                 self.mesh_every = every as u32;
                 self.last_mesh = None;
-                Effect::WatchMesh(every)
+                return Effect::WatchMesh(every);
             }
-            ToDevice::TissueBegin {
-                segments,
-                len,
-                hash,
-            } => {
-                let refuse = if replay.running() {
+            ToDevice::TissueBegin(b) => {
+                let refuse = if !matches!(work, Work::Idle) {
                     Some(NakReason::Busy)
-                } else if segments as usize != S {
+                } else if b.segments as usize != S {
                     Some(NakReason::Segments)
-                } else if len as usize != table_bytes::len(S) {
+                } else if b.len as usize != table_bytes::len(S) {
                     Some(NakReason::Length)
+                } else if b.friction.is_some_and(|f| !f.valid())
+                    || (b.friction.is_some() && self.live.contact != ContactKind::Roaming)
+                {
+                    Some(NakReason::Friction)
                 } else {
                     None
                 };
+                self.load = None;
                 match refuse {
-                    Some(r) => {
-                        self.load = None;
-                        out(&ToHost::Nak(r));
-                    }
+                    Some(r) => out(&ToHost::Nak(r)),
                     None => {
                         self.load = Some(Load {
-                            header: [0; table_bytes::HEADER_WORDS],
-                            segments: [[0; 4]; S],
-                            len,
-                            hash,
-                            got: 0,
-                            running_hash: 0x811C_9DC5,
+                            begin: b,
+                            bytes: Assembler::new(),
                         })
                     }
                 }
-                Effect::None
             }
             ToDevice::TissueChunk { offset, bytes } => {
                 let ok = match self.load.as_mut() {
                     Some(l)
-                        if offset == l.got && l.got as usize + bytes.len() <= l.len as usize =>
+                        if offset as usize == l.bytes.received()
+                            && l.bytes.received() + bytes.len() <= l.begin.len as usize =>
                     {
-                        for &b in bytes {
-                            l.put(b);
-                        }
-                        true
+                        bytes.iter().all(|&b| l.bytes.push(b))
                     }
                     _ => false,
                 };
@@ -230,94 +251,166 @@ impl<const S: usize> Session<S> {
                     self.load = None;
                     out(&ToHost::Nak(NakReason::Order));
                 }
-                Effect::None
             }
-            ToDevice::TissueCommit => match self.commit::<N, E, A>() {
-                Ok((set, tissue)) => Effect::Swap { set, tissue },
-                Err(r) => {
+            ToDevice::TissueCommit => {
+                if let Err(r) = self.commit(work) {
                     out(&ToHost::Nak(r));
-                    Effect::None
                 }
-            },
+            }
             ToDevice::ReplayBegin(spec) => {
-                if replay.running() {
-                    replay.abort();
-                }
-                match replay.begin(&spec, self.table) {
+                match work.begin_replay(&spec, self.table, self.live.narrow) {
                     Ok(until) => out(&ToHost::ReplayCredit { until }),
                     Err(r) => out(&ToHost::Nak(r)),
                 }
-                Effect::None
             }
             ToDevice::ReplayPath { first, points } => {
-                if let Err(r) = replay.path(first, points) {
+                if let Err(r) = work.replay_path(first, points) {
                     out(&ToHost::Nak(r));
                 }
-                Effect::None
             }
         }
+        Effect::None
     }
 
-    /// The tissue swapped in: the live one from now.
-    pub fn swapped(&mut self, table: ForceTable<S>, tissue: u32, out: &mut dyn FnMut(&ToHost)) {
-        self.table = table;
-        self.tissue = tissue;
-        out(&ToHost::Ack { tissue });
+    /// A pose the device takes: its origin inside the workspace, a unit quaternion.
+    fn check_pose(&self, p: &Pose) -> Result<(), NakReason> {
+        let [lo, hi] = self.live.workspace;
+        for axis in 0..3 {
+            let o = p.origin[axis];
+            if o < lo[axis] {
+                return Err(NakReason::Pose {
+                    axis: axis as u8,
+                    limit: lo[axis],
+                });
+            }
+            if o > hi[axis] {
+                return Err(NakReason::Pose {
+                    axis: axis as u8,
+                    limit: hi[axis],
+                });
+            }
+        }
+        if !mccs::tissue_pose::is_unit(p.rotation) {
+            return Err(NakReason::Rotation);
+        }
+        Ok(())
     }
 
-    /// The load checked whole: the parameter set for the live patch, or why not.
-    fn commit<const N: usize, const E: usize, A: Arith>(
+    /// The load checked whole, and its stability check started in `work`; or why not.
+    fn commit<const N: usize, const E: usize, A: Arith, const P: usize>(
         &mut self,
-    ) -> Result<(ParamSet<S, A>, u32), NakReason> {
+        work: &mut Work<N, E, S, A, P>,
+    ) -> Result<(), NakReason> {
         let l = self.load.take().ok_or(NakReason::Order)?;
-        if l.got != l.len {
+        if l.bytes.received() != l.begin.len as usize {
             return Err(NakReason::Length);
         }
-        if l.running_hash != l.hash {
+        if l.bytes.hash() != l.begin.hash {
             return Err(NakReason::Hash);
         }
-        let table = ForceTable::from_raw(l.raw());
+        let raw = l.bytes.finish().ok_or(NakReason::Length)?;
+        let table = ForceTable::from_raw(raw);
         table.validate().map_err(|_| NakReason::Table)?;
         match table.max_error() {
             Some(e) if e.within(&TableBound::PRODUCT) => {}
             _ => return Err(NakReason::Bound),
         }
-        let topo = Topology::<N, E>::standard_patch(self.live.grid, self.live.spacing)
-            .map_err(|_| NakReason::Solver)?;
-        let set = Solver::<N, E, S, A>::prepare_for(&topo, table, &self.live.config)
-            .map_err(|_| NakReason::Solver)?;
-        Ok((set, l.hash))
+        let friction = match l.begin.friction {
+            Some(f) => {
+                let (s, k) = f.values();
+                Some(mccs::Friction::new(s, k).map_err(|_| NakReason::Friction)?)
+            }
+            None => None,
+        };
+        let check = TissueCheck::new(
+            self.live.grid,
+            self.live.spacing,
+            table,
+            &self.live.config,
+            friction,
+            l.begin.hash,
+            self.live.budget,
+            l.begin.substeps,
+        )?;
+        work.begin_check(check)
     }
 
-    fn hello<const N: usize, const E: usize, const P: usize>(&self) -> HelloInfo {
+    /// The tissue `table` (hash `tissue`, friction `friction` or the live one's) is the
+    /// live one from now: `Ack`.
+    pub fn swapped(
+        &mut self,
+        table: ForceTable<S>,
+        tissue: u32,
+        friction: Option<mccs::Friction>,
+        out: &mut dyn FnMut(&ToHost),
+    ) {
+        self.table = table;
+        self.tissue = tissue;
+        if let Some(f) = friction {
+            let (s, k) = f.values();
+            self.friction = Friction::new(s, k);
+        }
+        out(&ToHost::Ack { tissue });
+    }
+
+    fn mesh_least_every<const N: usize>(&self) -> u16 {
+        let nodes = self.live.grid.saturating_sub(2).pow(2).min(N);
+        rates::mesh_least_every(self.live.config.tick_hz as u32, self.live.baud, nodes)
+    }
+
+    fn hello<const N: usize, const E: usize, const P: usize>(&self, snap: &Snapshot) -> HelloInfo {
+        let l = &self.live;
+        let tick_hz = l.config.tick_hz as u32;
         HelloInfo {
             protocol: PROTOCOL,
             schema: SCHEMA,
-            core: self.live.core,
-            tick_hz: self.live.config.tick_hz as u32,
-            grid: self.live.grid as u8,
-            max_grid: super::replayer::max_grid::<N, E>() as u8,
-            tissue_w: self.live.grid as u8,
-            tissue_h: self.live.grid as u8,
+            device: l.device,
+            simulated: l.simulated,
+            core: l.core,
+            tick_hz,
+            contact: l.contact,
+            grid: l.grid as u8,
+            max_grid: max_grid::<N, E>() as u8,
+            spacing: mccs_link::scale::mm_bits(l.spacing),
+            tissue_w: l.tissue[0],
+            tissue_h: l.tissue[1],
             knots: S as u16 + 1,
             tissue: self.tissue,
+            friction: self.friction,
+            substeps: snap.substeps,
+            solver: mccs_link::SolverInfo {
+                node_mass_kg: l.config.node_mass,
+                spring_damping: l.config.spring_damping,
+                node_damping: l.config.node_damping,
+                coupling_stiffness: l.config.coupling.stiffness,
+                coupling_damping: l.config.coupling.damping,
+                symplectic: l.config.integrator == mccs::Integrator::SymplecticDamped,
+                max_substeps: l.config.max_substeps.min(u16::MAX as u32) as u16,
+            },
             path_capacity: P as u32,
+            force_clamp: mccs_link::scale::newton_bits(l.config.coupling.max_force),
+            workspace: l.workspace,
+            pose_speed_mm_s: l.pose_speed_mm_s,
+            pose_turn_deg_s: l.pose_turn_deg_s,
+            baud: l.baud,
+            telemetry_least_every: rates::telemetry_least_every(tick_hz, l.baud),
+            mesh_least_every: self.mesh_least_every::<N>(),
+            tick_budget: l.budget.tick,
+            substep_cost: l.budget.per_substep,
+            tick_base_cost: l.budget.base,
         }
     }
 
-    /// Live telemetry at tick `tick` (the probe and force as the tick left them), if one
-    /// is due: every `Watch` period, numbered; a due one the main loop missed, and one
-    /// `send` could not take (it returns false), is counted as dropped.
+    /// Live telemetry of the tick `snap`, if one is due: every `Watch` period, numbered;
+    /// a due one the main loop missed, and one `send` could not take (it returns false),
+    /// is counted as dropped. `checking`: a tissue check runs.
     pub fn telemetry(
         &mut self,
-        tick: u32,
-        probe: [i32; 3],
-        force: [i32; 3],
-        gain: u16,
-        flags: u8,
+        snap: &Snapshot,
+        checking: bool,
         send: &mut dyn FnMut(&ToHost) -> bool,
     ) {
-        let every = self.watch_every;
+        let (every, tick) = (self.watch_every, snap.ticks);
         if every == 0 || tick < self.next_watch {
             return;
         }
@@ -329,10 +422,14 @@ impl<const S: usize> Session<S> {
         let msg = ToHost::Telemetry(Telemetry {
             seq: self.seq,
             tick,
-            probe,
-            force,
-            gain,
-            flags,
+            probe: snap.probe,
+            force: snap.force,
+            gain: snap.gain,
+            flags: snap.flags.with(Flags::CHECKING, checking),
+            fault: snap.fault,
+            duties: snap.duties,
+            proxy: snap.proxy,
+            window: snap.window,
             dropped: self.dropped,
         });
         self.seq = self.seq.wrapping_add(1);
@@ -340,18 +437,12 @@ impl<const S: usize> Session<S> {
             self.dropped = self.dropped.saturating_add(1);
         }
     }
-}
 
-impl<const S: usize> Session<S> {
-    /// Sends a mesh the tick took, in parts of [`MESH_PART`] nodes (`send` returns false
-    /// when it could not take one: the mesh is counted as dropped). Meshes the tick took
-    /// but the main loop never sent (the gap in their ticks) are counted as dropped and
-    /// their numbers skipped.
-    pub fn mesh<const N: usize>(
-        &mut self,
-        m: &super::Mesh<N>,
-        send: &mut dyn FnMut(&ToHost) -> bool,
-    ) {
+    /// Sends a mesh the tick took, in parts of [`MESH_PART`] nodes with their places in
+    /// the surface grid (`send` returns false when it could not take one: the mesh is
+    /// counted as dropped). Meshes the tick took but the main loop never sent (the gap
+    /// in their ticks) are counted as dropped and their numbers skipped.
+    pub fn mesh<const N: usize>(&mut self, m: &Mesh<N>, send: &mut dyn FnMut(&ToHost) -> bool) {
         let every = self.mesh_every;
         if every == 0 {
             return;
@@ -359,50 +450,32 @@ impl<const S: usize> Session<S> {
         if let Some(last) = self.last_mesh {
             let missed = (m.tick.saturating_sub(last) / every).saturating_sub(1);
             self.mesh_seq = self.mesh_seq.wrapping_add(missed);
-            self.dropped = self.dropped.saturating_add(missed);
+            self.dropped_mesh = self.dropped_mesh.saturating_add(missed);
         }
         self.last_mesh = Some(m.tick);
         let nodes = (m.nodes as usize).min(N);
         let mut sent = true;
         for first in (0..nodes).step_by(MESH_PART) {
-            let mut positions = [[0i32; 3]; MESH_PART];
-            let part = m.positions.get(first..nodes).unwrap_or(&[]);
-            for (p, q) in positions.iter_mut().zip(part) {
-                *p = *q;
-            }
-            sent &= send(&ToHost::Mesh(MeshPart {
+            let mut part = MeshPart {
                 seq: self.mesh_seq,
                 tick: m.tick,
                 first: first as u16,
                 nodes: nodes as u16,
-                positions,
-            }));
+                origin: m.origin,
+                ..MeshPart::default()
+            };
+            let src = m.positions.get(first..nodes).unwrap_or(&[]);
+            for (k, (p, q)) in part.positions.iter_mut().zip(src).enumerate() {
+                *p = *q;
+                if let Some(g) = part.grid.get_mut(k) {
+                    *g = grid_place(self.live.grid, first + k);
+                }
+            }
+            sent &= send(&ToHost::Mesh(part));
         }
         if !sent {
-            self.dropped = self.dropped.saturating_add(1);
+            self.dropped_mesh = self.dropped_mesh.saturating_add(1);
         }
         self.mesh_seq = self.mesh_seq.wrapping_add(1);
-    }
-}
-
-impl<const S: usize> Load<S> {
-    /// The next byte.
-    fn put(&mut self, b: u8) {
-        let i = self.got as usize;
-        let (word, shift) = (i / 4, 8 * (i % 4));
-        let slot = if word < table_bytes::HEADER_WORDS {
-            &mut self.header[word]
-        } else {
-            let k = word - table_bytes::HEADER_WORDS;
-            &mut self.segments[k / 4][k % 4]
-        };
-        *slot |= (b as i32) << shift;
-        self.running_hash = (self.running_hash ^ b as u32).wrapping_mul(0x0100_0193);
-        self.got += 1;
-    }
-
-    /// The table the words hold.
-    fn raw(&self) -> RawTable<S> {
-        table_bytes::from_words(&self.header, self.segments)
     }
 }

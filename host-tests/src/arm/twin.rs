@@ -101,48 +101,10 @@ impl ArmTwin {
     }
 
     /// Joint angles (rad) that put the probe at `p` (device frame, mm), on the arm's
-    /// working branch, the elbow bent forward (`0 < B + C < 180°`: the other branch
-    /// reaches the same point with the elbow below the line from shoulder to tip): of
-    /// the solutions (the base's yaw or its opposite with the reach negated, each with
-    /// the elbow's two places) the one on that branch within the joints' ranges nearest
-    /// the home pose; `None` out of reach.
+    /// working branch within the joints' ranges: the one inverse kinematics of the
+    /// project (`mccs::arm::inverse`, held to this twin's forward kinematics by the
+    /// tests); `None` out of reach.
     pub fn ik(&self, p: [f64; 3]) -> Option<[f64; 3]> {
-        let s = &self.spec;
-        let (lb, lc) = (s.upper_arm_mm, s.forearm_mm);
-        let z = p[2] - s.base_height_mm;
-        let reach = p[0].hypot(p[1]);
-        let home: [f64; 3] = std::array::from_fn(|k| s.joints[k].home_angle_deg.to_radians());
-        let within = |t: &[f64; 3]| {
-            (0..3).all(|k| {
-                let j = &s.joints[k];
-                let d = t[k].to_degrees();
-                d >= j.min_angle_deg - 1e-6 && d <= j.max_angle_deg + 1e-6
-            })
-        };
-        let mut best: Option<([f64; 3], f64)> = None;
-        for (a, r) in [(p[1].atan2(p[0]), reach), ((-p[1]).atan2(-p[0]), -reach)] {
-            let d2 = r * r + z * z;
-            let d = d2.sqrt();
-            if d > lb + lc || d < (lb - lc).abs() || d == 0.0 {
-                continue;
-            }
-            // The elbow: on the circle of radius Lb about the shoulder and Lc about the tip.
-            let along = (lb * lb - lc * lc + d2) / (2.0 * d);
-            let h = (lb * lb - along * along).max(0.0).sqrt();
-            let (ur, uz) = (r / d, z / d);
-            for side in [1.0, -1.0] {
-                let er = along * ur - side * h * uz;
-                let ez = along * uz + side * h * ur;
-                let t = [a, er.atan2(ez), (r - er).atan2(-(z - ez))];
-                let branch = (t[1] + t[2]).sin() > 0.0;
-                let dist: f64 = (0..3).map(|k| (t[k] - home[k]).abs()).sum::<f64>()
-                    + if within(&t) { 0.0 } else { 1e3 }
-                    + if branch { 0.0 } else { 1e6 };
-                if best.is_none_or(|(_, b)| dist < b) {
-                    best = Some((t, dist));
-                }
-            }
-        }
-        best.map(|(t, _)| t)
+        mccs::arm::inverse::angles(&self.spec, p)
     }
 }

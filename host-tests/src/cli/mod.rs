@@ -14,6 +14,7 @@ mod curve;
 mod demo;
 mod fit;
 mod link;
+mod link_script;
 mod patch;
 mod patch_args;
 mod progress;

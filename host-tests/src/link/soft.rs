@@ -1,163 +1,256 @@
-//! A device in software: the firmware's own link session, replayer and guard
-//! (`mccs_firmware::link`) behind a unix socket, its ticks counted from the clock
-//! (1 kHz). Its live patch stays at rest: its telemetry reads a probe at rest, its mesh
-//! the patch's rest positions. What it answers
-//! is what the firmware answers, so the CLI's tests run against it where QEMU would be
-//! too slow; the tests against the board firmware in QEMU are `tests/link/qemu.rs`.
+//! A device in software: the arm board's own link server, session, guard and tick
+//! (`mccs_firmware::link`, the board's `BoardConfig` and roaming contact) on a simulated
+//! probe that palpates the tissue over and over (the demo's palpation, 4 s a round), at
+//! 1 kHz of the host's clock, behind a unix socket or a TCP port. What it answers is
+//! what the board answers — the same code — so the CLI's and the client's tests run
+//! against it where QEMU would be too slow (the tests against the board firmware in QEMU
+//! are `tests/link/qemu.rs`).
 
-use mccs::{ForceTable64, Solver, SolverConfig, Topology, Wide};
-use mccs_firmware::link::{Effect, Guard, Live, Mesh, Now, Replayer, Session};
-use mccs_link::frame::parse;
-use mccs_link::{encode, Core, Decoder, ToDevice, ToHost, MAX_FRAME};
+use haptic_f405::device::{linked, roaming, BoardRoaming, EDGES, NODES, SPACING_MM};
+use haptic_f405::BOARD;
+use mccs::{Force, ForceTable64, Length, Solver, Topology, Wide};
+use mccs_firmware::link::{
+    Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Live, Session, Work,
+};
+use mccs_firmware::{Controller, HapticDevice, ProbePath};
+use mccs_link::{ContactKind, Core, DeviceKind};
+use std::collections::VecDeque;
 use std::io::{Read, Write};
-use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// The board's capacity: the N = 8 patch.
-const NODES: usize = mccs::topology::standard_capacity(8).0;
-const EDGES: usize = mccs::topology::standard_capacity(8).1;
-/// Buffered path samples.
+/// Path samples a replay buffers (the board's).
 pub const PATH: usize = 128;
+/// The palpation's ticks, a round.
+const ROUND: u32 = 4000;
 
-/// Serves connections on `socket` (a new unix socket) one after another in a thread, as
-/// one device with `table` live on the standard 5 × 5 patch (its state kept from one
-/// connection to the next); returns once it listens.
-pub fn serve(socket: &Path, table: ForceTable64) -> std::io::Result<std::thread::JoinHandle<()>> {
-    let _ = std::fs::remove_file(socket);
-    let listener = UnixListener::bind(socket)?;
-    Ok(std::thread::spawn(move || {
-        let live = Live {
-            core: Core::M4f,
-            grid: 5,
-            spacing: 2.5,
-            config: SolverConfig::default(),
-        };
-        let rest = Topology::standard_patch(5, 2.5)
-            .ok()
-            .and_then(|t| Solver::new(t, table, &live.config).ok());
-        let Some(rest) = rest else { return };
-        let mut device = Device {
-            rest: Box::new(rest),
-            mesh_every: 0,
-            session: Session::<64>::new(live, table),
-            replayer: Box::new(Replayer::new(false)),
-            guard: Guard::at_rate(1000),
-            pose: [0; 3],
-            start: Instant::now(),
-        };
-        for stream in listener.incoming() {
-            match stream {
-                Ok(s) => run(s, &mut device),
-                Err(_) => return,
-            }
-        }
-    }))
+/// The soft device's probe: the demo's palpation, over and over.
+struct Palpating {
+    path: ProbePath<9>,
+    tick: u32,
 }
 
-/// The device's state.
-struct Device {
-    /// The live patch, at rest.
-    rest: Box<Solver<NODES, EDGES, 64, Wide>>,
-    /// Ticks between meshes (0: none).
-    mesh_every: u32,
-    session: Session<64>,
-    replayer: Box<Replayer<NODES, EDGES, 64, Wide, PATH>>,
-    guard: Guard,
-    pose: [i32; 3],
-    start: Instant,
+impl HapticDevice for Palpating {
+    type Error = core::convert::Infallible;
+    fn read_position(&mut self) -> Result<[Length; 3], Self::Error> {
+        let p = self.path.at(self.tick % ROUND);
+        self.tick = self.tick.wrapping_add(1);
+        Ok(p)
+    }
+    fn write_force(&mut self, _force: [Force; 3]) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    fn safe_state(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
 }
 
-fn run(mut stream: UnixStream, d: &mut Device) {
-    let Device {
-        rest,
-        mesh_every,
-        session,
-        replayer,
-        guard,
-        pose,
-        start,
-    } = d;
-    let mut decoder = Decoder::new();
-    let _ = stream.set_read_timeout(Some(Duration::from_millis(1)));
-    let mut out: Vec<u8> = Vec::new();
-    let mut buf = [0u8; 512];
-    let mut last_tick = start.elapsed().as_millis() as u32;
-    loop {
-        let tick = start.elapsed().as_millis() as u32;
-        let n = match stream.read(&mut buf) {
-            Ok(0) => return,
-            Ok(n) => n,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                0
-            }
-            Err(_) => return,
-        };
-        let mut send = |m: &ToHost| {
-            let mut f = [0u8; MAX_FRAME];
-            if let Ok(bytes) = encode(m, &mut f) {
-                out.extend_from_slice(bytes);
-            }
-        };
-        for &b in &buf[..n] {
-            match decoder.push(b) {
-                Some(Ok(payload)) => match parse::<ToDevice>(payload) {
-                    Ok(msg) => {
-                        guard.frame(tick);
-                        let now = Now {
-                            ticks: tick,
-                            overruns: 0,
-                            fault: false,
-                            armed: guard.armed(),
-                            pose: *pose,
-                        };
-                        match session.handle(msg, now, replayer, &mut send) {
-                            Effect::Arm => guard.arm(tick),
-                            Effect::Disarm => guard.disarm(),
-                            Effect::Swap { set, tissue } => {
-                                session.swapped(*set.table(), tissue, &mut send)
-                            }
-                            Effect::Pose(p) => *pose = p,
-                            Effect::WatchMesh(every) => *mesh_every = every as u32,
-                            Effect::None => {}
-                        }
-                    }
-                    Err(_) => session.bad_frame(),
-                },
-                Some(Err(_)) => session.bad_frame(),
-                None => {}
-            }
-        }
-        for _ in 0..32 {
-            if !replayer.step(&mut send) {
-                break;
-            }
-        }
-        for t in last_tick..=tick {
-            let gain = guard.gain(t);
-            let flags = if guard.armed() { 4 } else { 0 };
-            session.telemetry(t, [0; 3], [0; 3], gain, flags, &mut |m| {
-                send(m);
-                true
-            });
-            if *mesh_every != 0 && t % *mesh_every == 0 {
-                session.mesh(&Mesh::of(rest, t), &mut |m| {
-                    send(m);
-                    true
-                });
-            }
-        }
-        last_tick = tick + 1;
-        if !out.is_empty() {
-            if stream.write_all(&out).is_err() {
-                return;
-            }
-            out.clear();
+type SoftController = Controller<LinkedDevice<Palpating>, NODES, EDGES, 64, Wide, BoardRoaming>;
+
+/// A byte stream to one host.
+trait Stream: Read + Write + Send {}
+impl<T: Read + Write + Send> Stream for T {}
+
+/// Where the soft device listens.
+enum Listener {
+    #[cfg(unix)]
+    Unix(std::os::unix::net::UnixListener),
+    Tcp(std::net::TcpListener),
+}
+
+impl Listener {
+    fn accept(&self) -> Option<Box<dyn Stream>> {
+        match self {
+            #[cfg(unix)]
+            Listener::Unix(l) => l.accept().ok().map(|(s, _)| {
+                let _ = s.set_nonblocking(true);
+                Box::new(s) as Box<dyn Stream>
+            }),
+            Listener::Tcp(l) => l.accept().ok().map(|(s, _)| {
+                let _ = s.set_nonblocking(true);
+                let _ = s.set_nodelay(true);
+                Box::new(s) as Box<dyn Stream>
+            }),
         }
     }
+}
+
+/// A soft device running in a thread until [`SoftDevice::stop`] or drop.
+pub struct SoftDevice {
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+    addr: String,
+}
+
+impl SoftDevice {
+    /// Its address (`unix:PATH` or `tcp:HOST:PORT`).
+    pub fn addr(&self) -> &str {
+        &self.addr
+    }
+
+    /// Stops it.
+    pub fn stop(mut self) {
+        self.halt();
+    }
+
+    fn halt(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for SoftDevice {
+    fn drop(&mut self) {
+        self.halt();
+    }
+}
+
+/// Serves hosts on `socket` (a new unix socket) one after another, as one device with
+/// `table` live (its state kept from one connection to the next); returns once it
+/// listens. It stops with the test process.
+#[cfg(unix)]
+pub fn serve(socket: &Path, table: ForceTable64) -> std::io::Result<SoftDevice> {
+    let _ = std::fs::remove_file(socket);
+    let l = std::os::unix::net::UnixListener::bind(socket)?;
+    l.set_nonblocking(true)?;
+    spawn(
+        Listener::Unix(l),
+        table,
+        format!("unix:{}", socket.display()),
+    )
+}
+
+/// Serves hosts on TCP `host:port` (port 0: any free port; the address says which).
+pub fn serve_tcp(host_port: &str, table: ForceTable64) -> std::io::Result<SoftDevice> {
+    let l = std::net::TcpListener::bind(host_port)?;
+    l.set_nonblocking(true)?;
+    let addr = format!("tcp:{}", l.local_addr()?);
+    spawn(Listener::Tcp(l), table, addr)
+}
+
+fn spawn(listener: Listener, table: ForceTable64, addr: String) -> std::io::Result<SoftDevice> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let s = stop.clone();
+    let thread = std::thread::Builder::new()
+        .name("mccs-soft-device".into())
+        .spawn(move || run(listener, table, &s))?;
+    Ok(SoftDevice {
+        stop,
+        thread: Some(thread),
+        addr,
+    })
+}
+
+/// The device as its hello describes it: the arm board, simulated.
+fn live() -> Live {
+    Live {
+        device: DeviceKind::Arm,
+        simulated: true,
+        core: Core::M4f,
+        contact: ContactKind::Roaming,
+        grid: BOARD.grid,
+        spacing: SPACING_MM,
+        tissue: BOARD.tissue_nodes.map(|n| n as u8),
+        config: BOARD.solver(),
+        workspace: BOARD.workspace_q24(),
+        pose_speed_mm_s: BOARD.pose_speed_mm_s,
+        pose_turn_deg_s: BOARD.pose_turn_deg_s,
+        baud: BOARD.baud,
+        budget: BOARD.budget(),
+        narrow: false,
+    }
+}
+
+fn controller(table: ForceTable64) -> Option<Box<SoftController>> {
+    let topo = Topology::standard_patch(BOARD.grid, SPACING_MM).ok()?;
+    let mut solver = Solver::new(topo, table, &BOARD.solver()).ok()?;
+    let contact = roaming(&BOARD, &mut solver).ok()?;
+    let device = Palpating {
+        path: mccs_firmware::palpation_path(BOARD.tick_hz).ok()?,
+        tick: 0,
+    };
+    let mut c = Controller::with_contact(solver, contact, linked(&BOARD, device), u32::MAX);
+    c.set_overrun_limit(BOARD.max_overruns_in_row);
+    Some(Box::new(c))
+}
+
+fn run(listener: Listener, table: ForceTable64, stop: &AtomicBool) {
+    let Some(mut ctl) = controller(table) else {
+        return;
+    };
+    let state: LinkState<NODES, 64, Wide> = LinkState::new(Guard::new(GuardTimes::at_rate(
+        BOARD.tick_hz,
+        BOARD.ramp_ms,
+    )));
+    let mut work: Box<Work<NODES, EDGES, 64, Wide, PATH>> = Box::default();
+    let friction = mccs::Friction::new(BOARD.mu_s, BOARD.mu_k).ok();
+    let session = Session::new(live(), table, friction);
+    let mut server = LinkServer::new(&state, &mut work, session, BOARD.check_steps_per_poll);
+    let start = Instant::now();
+    let mut ticks: u64 = 0;
+    let mut stream: Option<Box<dyn Stream>> = None;
+    let mut rx: VecDeque<u8> = VecDeque::new();
+    let mut buf = [0u8; 4096];
+    while !stop.load(Ordering::SeqCst) {
+        if stream.is_none() {
+            stream = listener.accept();
+            rx.clear();
+        }
+        if let Some(s) = stream.as_mut() {
+            match s.read(&mut buf) {
+                Ok(0) => stream = None,
+                Ok(n) => rx.extend(&buf[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(_) => stream = None,
+            }
+        }
+        // The ticks due by the host's clock (at most 100 at once, after a stall).
+        let due = (start.elapsed().as_micros() as u64 * BOARD.tick_hz as u64) / 1_000_000;
+        let mut ran = 0;
+        while ticks < due && ran < 100 {
+            state.run_tick(&mut ctl);
+            ctl.note_on_time();
+            ticks += 1;
+            ran += 1;
+        }
+        if ticks < due {
+            ticks = due;
+        }
+        let mut out: Vec<u8> = Vec::new();
+        let busy = server.poll(&mut || rx.pop_front(), 0, &mut |frame| {
+            out.extend_from_slice(frame);
+            true
+        });
+        if let Some(s) = stream.as_mut() {
+            if !out.is_empty() && write_all(s, &out).is_err() {
+                stream = None;
+            }
+        }
+        if !busy && rx.is_empty() {
+            std::thread::sleep(Duration::from_micros(200));
+        }
+    }
+}
+
+/// Writes all of `bytes` to a non-blocking stream.
+fn write_all(s: &mut Box<dyn Stream>, mut bytes: &[u8]) -> std::io::Result<()> {
+    let deadline = Instant::now() + Duration::from_secs(2);
+    while !bytes.is_empty() {
+        match s.write(bytes) {
+            Ok(0) => return Err(std::io::ErrorKind::WriteZero.into()),
+            Ok(n) => bytes = &bytes[n..],
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                if Instant::now() > deadline {
+                    return Err(e);
+                }
+                std::thread::sleep(Duration::from_micros(100));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    s.flush()
 }

@@ -37,7 +37,7 @@ pub(crate) fn mccs_ok(args: &[&str]) -> Output {
     out
 }
 
-fn root() -> PathBuf {
+pub(crate) fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 

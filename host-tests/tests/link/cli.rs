@@ -1,19 +1,20 @@
-//! `mccs link` against the device in software (the firmware's own session and
-//! replayer): each subcommand's line, a load acknowledged by its hash and a refusal in
-//! one line, a replay that prints `mccs replay --backend fixed`'s CSV byte for byte, a
-//! replay beyond the device named by its option.
+//! `mccs link` against the device in software (the arm board's own link server and tick
+//! on a simulated palpating probe): each subcommand's line, a load acknowledged by its
+//! hash and a refusal in one line, a replay that prints `mccs replay --backend fixed`'s
+//! CSV byte for byte, the mesh and telemetry streams, and `mccs link script` holding the
+//! device armed across its steps.
 
 use crate::cli::{mccs, mccs_ok};
 use mccs::{ForceTable64, Params};
+use mccs_host::link::soft::SoftDevice;
 use std::path::PathBuf;
 
 /// A soft device with Table 2 live, on a fresh socket.
-fn device(name: &str) -> String {
+fn device(name: &str) -> SoftDevice {
     let dir = std::env::temp_dir().join(format!("mccs-link-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let socket: PathBuf = dir.join(format!("{name}.sock"));
-    mccs_host::link::soft::serve(&socket, ForceTable64::new(&Params::TABLE2).unwrap()).unwrap();
-    format!("unix:{}", socket.display())
+    mccs_host::link::soft::serve(&socket, ForceTable64::new(&Params::TABLE2).unwrap()).unwrap()
 }
 
 fn line(out: &std::process::Output) -> String {
@@ -23,39 +24,46 @@ fn line(out: &std::process::Output) -> String {
         .to_string()
 }
 
+fn hash_of(file: &str) -> u32 {
+    let p = mccs_host::paramfile::read(&crate::cli::root().join(file)).unwrap();
+    mccs_link::table_bytes::hash(&ForceTable64::new(&p).unwrap())
+}
+
 #[test]
 fn hello_status_arm_pose_and_load() {
-    let addr = device("basics");
+    let dev = device("basics");
+    let addr = dev.addr().to_string();
     let hello = line(&mccs_ok(&["link", "--connect", &addr, "hello"]));
-    let t2 = mccs_link::table_bytes::hash(&ForceTable64::new(&Params::TABLE2).unwrap());
-    assert_eq!(
-        hello,
-        format!(
-            "protocol={} schema={:08x} core=m4f tick_hz=1000 grid=5 tissue=5x5 knots=65 tissue_hash={t2:08x}",
-            mccs_link::PROTOCOL,
-            mccs_link::SCHEMA
-        )
-    );
+    let t2 = hash_of("params/table2.toml");
+    for field in [
+        format!("protocol={} schema={:08x}", mccs_link::PROTOCOL, mccs_link::SCHEMA),
+        "device=arm simulated=1 core=m4f tick_hz=1000 contact=roaming grid=8 tissue=64x64".into(),
+        format!("knots=65 tissue_hash={t2:08x} friction=0.6,0.4"),
+        "force_clamp_n=3 workspace_mm=-50,-50,-40..50,50,40 pose_limits=200mm/s,180deg/s baud=1000000".into(),
+    ] {
+        assert!(hello.contains(&field), "{field} not in {hello}");
+    }
     let status = line(&mccs_ok(&["link", "--connect", &addr, "status"]));
     assert!(
-        status.starts_with("ticks=") && status.ends_with("armed=0 fault=0 pose=0,0,0"),
+        status.starts_with("ticks=") && status.contains("armed=0 fault=none"),
         "{status}"
     );
     assert!(line(&mccs_ok(&["link", "--connect", &addr, "arm"])).contains("armed=1"));
     assert!(line(&mccs_ok(&["link", "--connect", &addr, "disarm"])).contains("armed=0"));
-    assert_eq!(
-        line(&mccs_ok(&[
-            "link",
-            "--connect",
-            &addr,
-            "pose",
-            "--origin",
-            "1,-2.5,0"
-        ])),
-        "pose origin=1,-2.5,0"
-    );
-    assert!(line(&mccs_ok(&["link", "--connect", &addr, "status"])).ends_with("pose=1,-2.5,0"));
-    // A load: the device acknowledges the tissue by its hash, and says it after.
+    let pose = line(&mccs_ok(&[
+        "link",
+        "--connect",
+        &addr,
+        "pose",
+        "--origin",
+        "1,-2.5,0",
+        "--rotation",
+        "0,15,0",
+    ]));
+    assert_eq!(pose, "pose origin=1,-2.5,0 rotation=0.000,15.000,0.000");
+    assert!(line(&mccs_ok(&["link", "--connect", &addr, "status"]))
+        .contains("pose=1,-2.5,0 rotation_deg=0.000,15.000,0.000"));
+    // A load: acknowledged by the tissue's hash, which hello says after; with friction.
     let ack = line(&mccs_ok(&[
         "link",
         "--connect",
@@ -63,29 +71,59 @@ fn hello_status_arm_pose_and_load() {
         "load",
         "--params",
         "params/table2-stiffer.toml",
+        "--friction",
+        "0.5,0.3",
     ]));
-    let stiffer = mccs_host::paramfile::read(std::path::Path::new("../params/table2-stiffer.toml"))
-        .or_else(|_| mccs_host::paramfile::read(std::path::Path::new("params/table2-stiffer.toml")))
-        .unwrap();
-    let hash = mccs_link::table_bytes::hash(&ForceTable64::new(&stiffer).unwrap());
+    let hash = hash_of("params/table2-stiffer.toml");
     assert_eq!(ack, format!("ack tissue={hash:08x}"));
-    assert!(line(&mccs_ok(&["link", "--connect", &addr, "hello"]))
-        .ends_with(&format!("tissue_hash={hash:08x}")));
-    // A tissue the device's patch cannot run at its tick: refused in one line, kept.
+    let hello = line(&mccs_ok(&["link", "--connect", &addr, "hello"]));
+    assert!(
+        hello.contains(&format!("tissue_hash={hash:08x} friction=0.5,0.3")),
+        "{hello}"
+    );
+    // The same table as a .bin (`mccs table --format bin`) loads the same.
+    let bin = std::env::temp_dir().join(format!("mccs-link-{}-t2.bin", std::process::id()));
+    mccs_ok(&[
+        "table",
+        "--params",
+        "params/table2.toml",
+        "--format",
+        "bin",
+        "--out",
+        bin.to_str().unwrap(),
+    ]);
+    let ack = line(&mccs_ok(&[
+        "link",
+        "--connect",
+        &addr,
+        "load",
+        "--params",
+        bin.to_str().unwrap(),
+    ]));
+    assert_eq!(ack, format!("ack tissue={t2:08x}"));
+    // A tissue ten times stiffer: its tick passes the device's budget, one line.
+    let stiff = std::env::temp_dir().join(format!("mccs-link-{}-stiff.toml", std::process::id()));
+    let text = std::fs::read_to_string(crate::cli::root().join("params/table2.toml")).unwrap();
+    std::fs::write(
+        &stiff,
+        text.replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e6"),
+    )
+    .unwrap();
     let out = mccs(&[
         "link",
         "--connect",
         &addr,
         "load",
         "--params",
-        "params/steep-kink.toml",
+        stiff.to_str().unwrap(),
     ]);
     crate::cli::assert_one_line_error(
         &out,
-        &["the device refused: the device's solver refused the tissue on its patch"],
+        &["the device refused: the tissue's tick would pass the device's instruction budget: it needs"],
     );
-    assert!(line(&mccs_ok(&["link", "--connect", &addr, "hello"]))
-        .ends_with(&format!("tissue_hash={hash:08x}")));
+    // A pose outside the workspace.
+    let out = mccs(&["link", "--connect", &addr, "pose", "--origin", "0,0,60"]);
+    crate::cli::assert_one_line_error(&out, &["the device refused: the pose's origin is outside the device's workspace: z passes 40 mm"]);
     // Bad arguments, before the device is reached.
     for (args, needle) in [
         (
@@ -104,10 +142,14 @@ fn hello_status_arm_pose_and_load() {
                 "load",
                 "--params",
                 "params/table2.toml",
-                "--knots",
-                "129",
+                "--friction",
+                "0.2,0.5",
             ][..],
-            "--knots: the device takes 65 knots (got 129)",
+            "--friction: mu_s and mu_k must be within",
+        ),
+        (
+            &["link", "--connect", "unix:/nonexistent/mccs.sock", "hello"][..],
+            "--connect: unix:/nonexistent/mccs.sock: ",
         ),
     ] {
         crate::cli::assert_one_line_error(&mccs(args), &[needle]);
@@ -116,7 +158,8 @@ fn hello_status_arm_pose_and_load() {
 
 #[test]
 fn a_link_replay_prints_the_hosts_fixed_replay() {
-    let addr = device("replay");
+    let dev = device("replay");
+    let addr = dev.addr().to_string();
     for extra in [
         &[][..],
         &["--tissue", "64,64", "--friction", "0.6,0.4"][..],
@@ -141,7 +184,7 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
             "fixed",
         ];
         host.extend_from_slice(extra);
-        let mut dev = vec![
+        let mut link = vec![
             "link",
             "--connect",
             &addr,
@@ -149,9 +192,9 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
             "--probe",
             "params/palpation.csv",
         ];
-        dev.extend_from_slice(extra);
+        link.extend_from_slice(extra);
         let h = mccs_ok(&host).stdout;
-        let d = mccs_ok(&dev).stdout;
+        let d = mccs_ok(&link).stdout;
         assert!(h.len() > 100_000);
         assert!(
             h == d,
@@ -169,10 +212,10 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
         ),
         (
             &["--tissue", "64,64", "--cap-radius", "300"][..],
-            "--cap-radius: the device roams flat tissues only",
+            "--cap-radius: ",
         ),
     ] {
-        let mut dev = vec![
+        let mut link = vec![
             "link",
             "--connect",
             &addr,
@@ -180,40 +223,32 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
             "--probe",
             "params/palpation.csv",
         ];
-        dev.extend_from_slice(extra);
-        crate::cli::assert_one_line_error(&mccs(&dev), &[needle]);
+        link.extend_from_slice(extra);
+        crate::cli::assert_one_line_error(&mccs(&link), &[needle]);
     }
 }
 
 /// A device of another schema is refused by the host, in one line naming both.
 #[test]
 fn a_device_of_another_schema_is_refused() {
-    use mccs_link::message::{Core, HelloInfo, ToHost};
     use std::io::{Read, Write};
     let dir = std::env::temp_dir().join(format!("mccs-link-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let socket = dir.join("foreign.sock");
     let _ = std::fs::remove_file(&socket);
     let listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    // A hello of protocol 2 (its bytes as that protocol framed them): a variant index,
+    // protocol, schema, and more this client will not parse past the first two fields.
+    let real = dev_hello();
     std::thread::spawn(move || {
         let (mut s, _) = listener.accept().unwrap();
         let mut b = [0u8; 64];
         let _ = s.read(&mut b);
-        let hello = ToHost::Hello(HelloInfo {
-            protocol: 1,
-            schema: 0x1234_5678,
-            core: Core::M4f,
-            tick_hz: 1000,
-            grid: 5,
-            max_grid: 8,
-            tissue_w: 5,
-            tissue_h: 5,
-            knots: 65,
-            tissue: 0,
-            path_capacity: 64,
-        });
+        let mut hello = real;
+        hello.protocol = 2;
+        hello.schema = 0x1234_5678;
         let mut f = [0u8; mccs_link::MAX_FRAME];
-        let frame = mccs_link::encode(&hello, &mut f).unwrap();
+        let frame = mccs_link::encode(&mccs_link::ToHost::Hello(hello), &mut f).unwrap();
         s.write_all(frame).unwrap();
         std::thread::sleep(std::time::Duration::from_millis(500));
     });
@@ -226,30 +261,129 @@ fn a_device_of_another_schema_is_refused() {
     crate::cli::assert_one_line_error(
         &out,
         &[&format!(
-            "the device speaks protocol 1 schema 12345678, this mccs protocol {} schema {:08x}",
+            "the device speaks protocol 2 schema 12345678, this client protocol {} schema {:08x}",
             mccs_link::PROTOCOL,
             mccs_link::SCHEMA
         )],
     );
 }
 
-/// `mccs link mesh`: every free node of the device's patch once per mesh, at its rest
-/// position on the soft device (its patch at rest), meshes at least 17 ticks apart (60 a
-/// second at most), numbered without gaps on an idle link; arguments out of range refused.
+/// A hello as the soft device sends it.
+fn dev_hello() -> mccs_link::HelloInfo {
+    let dev = device("hello");
+    mccs_client::Device::open(dev.addr()).unwrap().info().hello
+}
+
+/// `mccs link mesh`: every free node once per mesh in its grid place, meshes at least the
+/// byte budget's period apart, numbered without gaps on an idle link; arguments out of
+/// range refused.
 #[test]
 fn mesh_streams_every_free_node_of_the_patch() {
-    let addr = device("mesh");
-    let (meshes, worst, _) = super::mesh_run(&addr, "0.4", 5);
-    assert!(
-        worst < 1e-6,
-        "the soft device's patch at rest: {worst} mm off"
-    );
-    assert!(meshes.len() >= 5, "{} meshes in 0.4 s", meshes.len());
-    let seqs: Vec<u32> = meshes.keys().copied().collect();
-    for w in seqs.windows(2) {
-        assert_eq!(w[1], w[0] + 1, "a gap on an idle link");
-    }
-    let bad = mccs(&["link", "--connect", &addr, "mesh", "--every", "0"]);
+    let dev = device("mesh");
+    let least = mccs_link::rates::mesh_least_every(1000, 1_000_000, 36) as u32;
+    let (meshes, _, _) = super::mesh_run(dev.addr(), "0.5", 8, least);
+    assert!(meshes.len() >= 10, "{} meshes in 0.5 s", meshes.len());
+    let bad = mccs(&["link", "--connect", dev.addr(), "mesh", "--every", "0"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).starts_with("mccs: --every: "));
+}
+
+/// `mccs link script`: one session through a scene — hello, a load, armed across steps
+/// (the gain full throughout, no fade), the pose moved, the telemetry as one CSV with its
+/// header once, rows during a load — and a bad line or a refusal as exit 2 with its line.
+#[test]
+fn a_script_holds_the_device_armed_as_long_as_it_says() {
+    let dev = device("script");
+    let dir = std::env::temp_dir().join(format!("mccs-link-{}", std::process::id()));
+    let script = dir.join("scene.txt");
+    std::fs::write(
+        &script,
+        format!(
+            "# a scene\nhello\ntelemetry on every=10\narm\nwait 1.5\nload {}/params/table2-stiffer.toml friction=0.5,0.4\npose 5,0,0,0,10,0   # tilted\nmesh on\nwait 1\nstatus\ndisarm\n",
+            crate::cli::root().display()
+        ),
+    )
+    .unwrap();
+    let out = mccs_ok(&[
+        "link",
+        "--connect",
+        dev.addr(),
+        "script",
+        script.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let steps: Vec<&str> = text.lines().filter(|l| l.starts_with("# ")).collect();
+    assert!(steps[0].starts_with("# protocol=3 "), "{steps:?}");
+    assert_eq!(steps[1], "# telemetry every=10");
+    assert!(steps[2].contains("armed=1"), "{steps:?}");
+    assert_eq!(steps[3], "# waited 1.5");
+    assert_eq!(
+        steps[4],
+        format!("# ack tissue={:08x}", hash_of("params/table2-stiffer.toml"))
+    );
+    assert_eq!(steps[5], "# pose origin=5,0,0 rotation=0.000,10.000,0.000");
+    assert!(
+        steps.iter().any(|l| l.starts_with("# mesh seq=")),
+        "{steps:?}"
+    );
+    assert!(steps
+        .iter()
+        .any(|l| l.contains("armed=1") && l.starts_with("# ticks=")));
+    assert!(steps.last().unwrap().contains("armed=0"));
+    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with("# ")).collect();
+    assert!(rows[0].starts_with("t_s,seq,tick,"), "{}", rows[0]);
+    assert_eq!(
+        rows.iter().filter(|l| l.starts_with("t_s,")).count(),
+        1,
+        "one header"
+    );
+    let gain_col = rows[0].split(',').position(|c| c == "gain").unwrap();
+    let armed_col = rows[0].split(',').position(|c| c == "armed").unwrap();
+    // From the arm on, armed in every row until the disarm, and no gap over 50 ms.
+    let mut t_last = None;
+    let mut armed_rows = 0;
+    for r in &rows[1..] {
+        let v: Vec<&str> = r.split(',').collect();
+        if v[armed_col] == "1" {
+            armed_rows += 1;
+        }
+        let t: f64 = v[0].parse().unwrap();
+        if let Some(l) = t_last {
+            assert!(t - l < 0.05, "a gap of {} s at {t}", t - l);
+        }
+        t_last = Some(t);
+        let _ = v[gain_col];
+    }
+    assert!(armed_rows > 150, "{armed_rows} armed rows");
+    // A bad line: exit 2 naming it, before the device is reached.
+    std::fs::write(&script, "hello\narm\nwiat 1\n").unwrap();
+    let out = mccs(&[
+        "link",
+        "--connect",
+        dev.addr(),
+        "script",
+        script.to_str().unwrap(),
+    ]);
+    crate::cli::assert_one_line_error(
+        &out,
+        &[&format!("{}:3: unknown step 'wiat'", script.display())],
+    );
+    // A refusal: exit 2 naming its line, after a disarm.
+    std::fs::write(&script, "arm\npose 0,0,90\nwait 1\n").unwrap();
+    let out = mccs(&[
+        "link",
+        "--connect",
+        dev.addr(),
+        "script",
+        script.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!("{}:2: ", script.display()))
+            && err.contains("outside the device's workspace"),
+        "{err}"
+    );
+    assert!(line(&mccs_ok(&["link", "--connect", dev.addr(), "status"])).contains("armed=0"));
 }

@@ -1,10 +1,11 @@
 //! The codec: the CRC's check value, every message round-trips through a frame, no
 //! corruption of a frame is taken for a message, the decoder finds the next frame after
-//! any garbage, and the schema's text moves with the messages' encoding (golden bytes).
+//! any garbage, the schema is derived from every message, and docs/protocol.md's example
+//! frames are these messages' bytes (`MCCS_UPDATE_PROTOCOL=1` rewrites them).
 
-use mccs_link::frame::parse;
-use mccs_link::message::*;
-use mccs_link::{crc::crc32, encode, Decoder, FrameError, MAX_FRAME, MAX_PAYLOAD, SCHEMA};
+use super::messages::{covers_nak, covers_to_device, covers_to_host, naks, to_device, to_host};
+use mccs_link::crc::crc32;
+use mccs_link::*;
 use proptest::prelude::*;
 
 #[test]
@@ -13,118 +14,7 @@ fn the_crc_is_crc_32() {
     assert_eq!(crc32(b""), 0);
 }
 
-/// One of every message, with every field away from its default.
-fn every_message() -> (Vec<ToDevice<'static>>, Vec<ToHost>) {
-    static BYTES: [u8; 5] = [1, 0, 2, 0xFF, 0];
-    let spec = ReplaySpec {
-        grid: 5,
-        spacing_mm: 2.5,
-        tick_hz: 1000.0,
-        node_mass_kg: 0.005,
-        spring_damping: 1.0,
-        coupling_stiffness: 1.0,
-        coupling_damping: 0.5,
-        max_force: 10.0,
-        symplectic: true,
-        narrow: false,
-        samples: 7401,
-        start: [-15.0, 0.4],
-        roaming: Some(RoamSpec {
-            tissue_w: 64,
-            tissue_h: 63,
-            mu_s: 0.6,
-            mu_k: 0.4,
-            probe_radius: 0.5,
-            cap_radius: Some(300.0),
-        }),
-    };
-    let to_device = vec![
-        ToDevice::Hello,
-        ToDevice::Status,
-        ToDevice::Arm,
-        ToDevice::Disarm,
-        ToDevice::Pose {
-            origin: [1, -2, 3 << 24],
-        },
-        ToDevice::TissueBegin {
-            segments: 64,
-            len: 1112,
-            hash: 0xDEAD_BEEF,
-        },
-        ToDevice::TissueChunk {
-            offset: 200,
-            bytes: &BYTES,
-        },
-        ToDevice::TissueCommit,
-        ToDevice::Watch { every: 10 },
-        ToDevice::ReplayBegin(spec),
-        ToDevice::ReplayPath {
-            first: 16,
-            points: &BYTES,
-        },
-        ToDevice::WatchMesh { every: 17 },
-    ];
-    let to_host = vec![
-        ToHost::Hello(HelloInfo {
-            protocol: 1,
-            schema: SCHEMA,
-            core: Core::M4f,
-            tick_hz: 1000,
-            grid: 8,
-            max_grid: 8,
-            tissue_w: 8,
-            tissue_h: 8,
-            knots: 65,
-            tissue: 0x1234_5678,
-            path_capacity: 256,
-        }),
-        ToHost::Ack { tissue: 7 },
-        ToHost::Nak(NakReason::Option {
-            option: SpecOption::Grid,
-            limit: 8,
-        }),
-        ToHost::Status(StatusInfo {
-            ticks: 1,
-            overruns: 2,
-            bad_frames: 3,
-            dropped_telemetry: 4,
-            armed: true,
-            fault: true,
-            replaying: true,
-            pose: [1, -2, 3],
-        }),
-        ToHost::Telemetry(Telemetry {
-            seq: 1,
-            tick: 2,
-            probe: [3, -4, 5],
-            force: [-6, 7, 8],
-            gain: 32768,
-            flags: 5,
-            dropped: 9,
-        }),
-        ToHost::ReplayRow(ReplayRow {
-            tick: 1,
-            force: [i32::MIN, i32::MAX, 0],
-            point: [1, 2, 3],
-            origin: [-4, 5],
-            max_disp: [6, 7, -8],
-            flags: 7,
-            shifts: 22,
-        }),
-        ToHost::ReplayCredit { until: 256 },
-        ToHost::ReplayEnd { ticks: 7401 },
-        // The largest mesh part: every position at its longest encoding.
-        ToHost::Mesh(MeshPart {
-            seq: u32::MAX,
-            tick: u32::MAX,
-            first: u16::MAX,
-            nodes: u16::MAX,
-            positions: [[i32::MIN; 3]; mccs_link::MESH_PART],
-        }),
-    ];
-    (to_device, to_host)
-}
-
+/// A message's frame.
 fn frame_of<T: serde::Serialize>(msg: &T) -> Vec<u8> {
     let mut out = [0u8; MAX_FRAME];
     encode(msg, &mut out).expect("fits a frame").to_vec()
@@ -140,9 +30,12 @@ fn decode_all(bytes: &[u8]) -> Vec<Result<Vec<u8>, FrameError>> {
 }
 
 #[test]
-fn every_message_round_trips_through_one_frame() {
-    let (dev, host) = every_message();
-    for m in &dev {
+fn every_message_is_in_the_examples_and_round_trips_through_one_frame() {
+    let dev = to_device();
+    let host = to_host();
+    let mut seen = [false; 13];
+    for (_, m) in &dev {
+        seen[covers_to_device(m)] = true;
         let f = frame_of(m);
         assert!(
             f.len() <= MAX_FRAME && !f[..f.len() - 1].contains(&0),
@@ -150,32 +43,101 @@ fn every_message_round_trips_through_one_frame() {
         );
         let out = decode_all(&f);
         assert_eq!(out.len(), 1);
-        let payload = out[0].clone().unwrap();
-        assert_eq!(&parse::<ToDevice>(&payload).unwrap(), m);
+        assert_eq!(&parse::<ToDevice>(out[0].as_ref().unwrap()).unwrap(), m);
     }
-    for m in &host {
+    assert!(
+        seen.iter().all(|&s| s),
+        "a message to the device without an example"
+    );
+    let mut seen = [false; 9];
+    for (_, m) in &host {
+        seen[covers_to_host(m)] = true;
         let out = decode_all(&frame_of(m));
         assert_eq!(&parse::<ToHost>(out[0].as_ref().unwrap()).unwrap(), m);
     }
+    assert!(
+        seen.iter().all(|&s| s),
+        "a message to the host without an example"
+    );
+    let mut seen = [false; 15];
+    for (_, r) in naks() {
+        seen[covers_nak(&r)] = true;
+    }
+    assert!(seen.iter().all(|&s| s), "a refusal without an example");
+    // The largest hello fits a frame with room.
+    let hello = frame_of(&host[0].1);
+    assert!(hello.len() < MAX_FRAME, "hello: {} bytes", hello.len());
 }
 
-/// The golden bytes: a message's encoding changed without the schema's text (and so its
-/// hash) fails here. Update both together (link/src/schema.rs).
+/// The example frame of every message, as docs/protocol.md shows them: `NAME: hex … 00`.
+fn example_lines() -> Vec<String> {
+    let hex = |f: Vec<u8>| {
+        f.iter()
+            .map(|b| format!("{b:02x}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut out: Vec<String> = to_device()
+        .into_iter()
+        .map(|(n, m)| format!("{n}: {}", hex(frame_of(&m))))
+        .collect();
+    out.extend(to_host().into_iter().map(|(n, m)| {
+        let name = if n.starts_with("NakReason::") {
+            format!("ToHost::Nak({n})")
+        } else {
+            n.to_string()
+        };
+        format!("{name}: {}", hex(frame_of(&m)))
+    }));
+    out
+}
+
+/// docs/protocol.md shows every message's frame as these bytes, and the schema's hash;
+/// a change to a message fails here until the page moves with it.
 #[test]
-fn the_schema_moves_with_the_encoding() {
-    let (dev, host) = every_message();
-    let mut all = Vec::new();
-    for m in &dev {
-        all.extend(postcard::to_allocvec(m).unwrap());
+fn the_protocol_page_shows_every_messages_frame() {
+    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md"));
+    let page = std::fs::read_to_string(path).unwrap();
+    let lines = example_lines();
+    let begin = "<!-- frames: generated by host-tests/tests/link/codec.rs -->";
+    let end = "<!-- /frames -->";
+    let (Some(a), Some(b)) = (page.find(begin), page.find(end)) else {
+        panic!("docs/protocol.md: no {begin} … {end} block")
+    };
+    let block = format!("{begin}\n```text\n{}\n```\n", lines.join("\n"));
+    if std::env::var("MCCS_UPDATE_PROTOCOL").as_deref() == Ok("1") {
+        let new = format!("{}{block}{}", &page[..a], &page[b..]);
+        std::fs::write(path, new).unwrap();
+        return;
     }
-    for m in &host {
-        all.extend(postcard::to_allocvec(m).unwrap());
-    }
-    let golden = mccs_link::schema::fnv1a(&all);
     assert_eq!(
-        (SCHEMA, golden),
-        (0x094e_6f70, 0x6556_82d7),
-        "schema {SCHEMA:#010x}, encoding {golden:#010x}"
+        &page[a..b],
+        block,
+        "docs/protocol.md's frames are not the messages' (MCCS_UPDATE_PROTOCOL=1 cargo test -p mccs-host --test host link::codec rewrites them)"
+    );
+    for (what, value) in [
+        ("PROTOCOL", format!("{PROTOCOL}")),
+        ("SCHEMA", format!("{SCHEMA:08x}")),
+    ] {
+        assert!(
+            page.contains(&format!("`{what}` = `{value}`")),
+            "the page lacks `{what}` = `{value}`"
+        );
+    }
+}
+
+/// The schema's hash is derived from the types: it is not a number written by hand,
+/// and it is what the handshake carries.
+#[test]
+fn the_schema_hash_is_derived_from_the_messages() {
+    let mut h = mccs_link::fnv::Fnv1a::new();
+    h.update(&mccs_link::schema::TO_DEVICE_KEY.to_bytes());
+    h.update(&mccs_link::schema::TO_HOST_KEY.to_bytes());
+    assert_eq!(h.value(), SCHEMA);
+    assert_ne!(
+        mccs_link::schema::TO_DEVICE_KEY.to_bytes(),
+        postcard_schema::key::Key::for_path::<ToHost>("mccs/ToDevice").to_bytes(),
+        "the key depends on the type"
     );
 }
 
@@ -184,10 +146,9 @@ fn the_schema_moves_with_the_encoding() {
 /// overlong frames too; the next valid frame is taken.
 #[test]
 fn no_corruption_of_a_frame_is_a_message() {
-    let (dev, _) = every_message();
     let next = frame_of(&ToDevice::Status);
     let mut corruptions = 0;
-    for m in &dev {
+    for (_, m) in &to_device() {
         let f = frame_of(m);
         for i in 0..f.len() {
             for v in 0..=255u8 {
@@ -201,8 +162,6 @@ fn no_corruption_of_a_frame_is_a_message() {
                 bad.extend_from_slice(&next);
                 bad.extend_from_slice(&next);
                 let out = decode_all(&bad);
-                // The corrupted frame (perhaps split in two by a new 0x00): never Ok with
-                // a message other than the original; the valid frame after it, taken.
                 let (last, rest) = out.split_last().unwrap();
                 assert_eq!(
                     parse::<ToDevice>(last.as_ref().unwrap()),
@@ -218,16 +177,16 @@ fn no_corruption_of_a_frame_is_a_message() {
                 corruptions += 1;
             }
         }
-        // Truncated: every prefix, delimited.
         for n in 1..f.len() - 1 {
             let mut t = f[..n].to_vec();
             t.push(0);
-            let out = decode_all(&t);
-            assert!(out.iter().all(|r| r.is_err()), "{m:?} cut at {n}");
+            assert!(
+                decode_all(&t).iter().all(|r| r.is_err()),
+                "{m:?} cut at {n}"
+            );
         }
     }
     assert!(corruptions > 10_000);
-    // Overlong: more bytes than a frame before a delimiter, then a valid frame.
     let mut long = vec![1u8; MAX_FRAME + 10];
     long.push(0);
     long.extend_from_slice(&next);
@@ -237,7 +196,6 @@ fn no_corruption_of_a_frame_is_a_message() {
         parse::<ToDevice>(out[1].as_ref().unwrap()),
         Ok(ToDevice::Status)
     );
-    // A message with bytes left over after it is not a message.
     let mut payload = postcard::to_allocvec(&ToDevice::Arm).unwrap();
     payload.push(0x01);
     assert_eq!(parse::<ToDevice>(&payload), Err(FrameError::Message));
@@ -257,6 +215,54 @@ fn a_message_too_large_for_a_frame_is_refused_when_encoded() {
         )
         .err(),
         Some(FrameError::TooLarge)
+    );
+    // The largest chunk and path a host sends fit.
+    let chunk = [0xFFu8; TISSUE_CHUNK];
+    assert!(encode(
+        &ToDevice::TissueChunk {
+            offset: u32::MAX,
+            bytes: &chunk
+        },
+        &mut out
+    )
+    .is_ok());
+    let points = [0xFFu8; 12 * replay::PathPoint::PER_FRAME];
+    assert!(encode(
+        &ToDevice::ReplayPath {
+            first: u32::MAX,
+            points: &points
+        },
+        &mut out
+    )
+    .is_ok());
+}
+
+#[test]
+fn a_tissue_file_holds_the_bytes_a_load_carries() {
+    let t = mccs_client::Tissue::from_params(&mccs::Params::TABLE2).unwrap();
+    let bin = t.to_bin();
+    let f = tissue_file::TissueFile::parse(&bin).unwrap();
+    assert_eq!((f.segments, f.hash, f.bytes), (64, t.hash(), t.bytes()));
+    assert_eq!(f.bytes.len(), table_bytes::len(64));
+    let mut bad = bin.clone();
+    bad[40] ^= 1;
+    assert_eq!(
+        tissue_file::TissueFile::parse(&bad),
+        Err(tissue_file::TissueFileError::Hash)
+    );
+    assert_eq!(
+        tissue_file::TissueFile::parse(&bin[..19]),
+        Err(tissue_file::TissueFileError::NotATissue)
+    );
+    assert_eq!(
+        tissue_file::TissueFile::parse(&bin[..bin.len() - 4]),
+        Err(tissue_file::TissueFileError::Length)
+    );
+    let mut later = bin.clone();
+    later[10] = 1;
+    assert_eq!(
+        tissue_file::TissueFile::parse(&later),
+        Err(tissue_file::TissueFileError::Version)
     );
 }
 
@@ -286,5 +292,17 @@ proptest! {
         });
         let out = decode_all(&frame_of(&row));
         prop_assert_eq!(parse::<ToHost>(out[0].as_ref().unwrap()).unwrap(), row);
+    }
+
+    /// A table's words round-trip through its bytes, fed whole or a byte at a time.
+    #[test]
+    fn table_bytes_round_trip(words in proptest::collection::vec(any::<i32>(), table_bytes::HEADER_WORDS + 4 * 16)) {
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        let raw = table_bytes::read::<16>(&bytes).unwrap();
+        let t = mccs::ForceTable::<16>::from_raw(raw);
+        let mut back = vec![0u8; table_bytes::len(16)];
+        prop_assert_eq!(table_bytes::write(&t, &mut back), bytes.len());
+        prop_assert_eq!(&back, &bytes);
+        prop_assert_eq!(table_bytes::hash(&t), table_bytes::hash_bytes(&bytes));
     }
 }

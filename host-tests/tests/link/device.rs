@@ -1,341 +1,764 @@
-//! The device's side of the link on the host: the guard's fade, the pose's bounded step,
-//! a tissue load checked whole (every refusal keeps the live tissue), and a replay on
-//! the device's solver equal, row for row, to `mccs replay --backend fixed`.
+//! The device's side of the link (`mccs_firmware::link`) on the host, tick by tick: the
+//! guard's ramp and fade, the pose's slew and frames, what the server answers and when,
+//! every refusal with its reason, the tissue check in slices and its budget, the byte
+//! budget of the streams, the run of overruns, and replays equal to the host's.
 
-use mccs::{Force, ForceTable64, Length, Params, SolverConfig, Wide};
-use mccs_firmware::link::{guard, Effect, Guard, LinkedDevice, Live, Now, Replayer, Session};
-use mccs_firmware::HapticDevice;
-use mccs_host::replay::{probe_bits, Engine, Replay, RoamRow, Roaming, Row};
-use mccs_host::roam::{Friction, Shape, Tissue};
+use super::rig::{Rig, P};
+use haptic_f405::device::{EDGES, NODES};
+use haptic_f405::BOARD;
+use mccs::{Force, ForceTable64, Length, Params, SolverConfig, TissuePose};
+use mccs_client::Tissue;
+use mccs_firmware::link::{Guard, GuardTimes};
+use mccs_host::replay::{Engine, Replay, RoamRow, Roaming, Row};
+use mccs_host::roam::{Friction, Shape, Tissue as RoamTissue};
 use mccs_host::trajectory;
-use mccs_link::message::*;
-use mccs_link::table_bytes;
+use mccs_link::replay::PathPoint;
+use mccs_link::scale::{self, GAIN_FULL};
+use mccs_link::*;
 
-/// The board's capacity: the N = 8 patch.
-const N: usize = mccs::topology::standard_capacity(8).0;
-const E: usize = mccs::topology::standard_capacity(8).1;
-const P: usize = 64;
+fn table2() -> ForceTable64 {
+    ForceTable64::new(&Params::TABLE2).unwrap()
+}
 
-fn live() -> Live {
-    Live {
-        core: Core::M4f,
-        grid: 5,
-        spacing: 2.5,
-        config: SolverConfig::default(),
-    }
+fn params(name: &str) -> Params {
+    mccs_host::paramfile::read(std::path::Path::new(&format!(
+        "{}/../params/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )))
+    .unwrap()
 }
 
 #[test]
-fn an_armed_hosts_silence_fades_the_force_within_120_ms() {
-    let mut g = Guard::at_rate(1000);
-    // Standalone: full force, however long the silence.
-    assert_eq!(g.gain(1_000_000), guard::FULL);
-    g.arm(10);
-    let mut zero_at = None;
-    for t in 10..400 {
-        if t < 60 {
-            g.frame(t);
-        }
-        let gain = g.gain(t);
-        if t <= 159 {
-            assert_eq!(gain, guard::FULL, "tick {t}");
-        }
-        if gain == 0 && zero_at.is_none() {
-            zero_at = Some(t);
-        }
+fn force_comes_on_gently_and_an_armed_hosts_silence_fades_it() {
+    // 1 kHz: a 100-tick timeout, a 20-tick fade, a 500-tick ramp.
+    let mut g = Guard::new(GuardTimes::at_rate(1000, 500));
+    // Standalone, the probe in contact from the start: no force until it leaves.
+    for t in 0..300 {
+        assert_eq!(g.gain(t, true), 0, "tick {t}");
     }
-    let zero_at = zero_at.expect("never zero");
-    // Silent from tick 59: the force is zero within 120 ticks (100 + the 20-tick fade).
+    // Out of contact: the ramp, never a step of more than a 500th.
+    let mut last = 0;
+    let mut full_at = None;
+    for t in 300..1000 {
+        let k = g.gain(t, t > 310);
+        assert!(
+            k >= last && k - last <= GAIN_FULL / 500 + 1,
+            "tick {t}: {last} -> {k}"
+        );
+        if k == GAIN_FULL && full_at.is_none() {
+            full_at = Some(t);
+        }
+        last = k;
+    }
+    let full_after = full_at.unwrap() - 300;
     assert!(
-        zero_at - 59 <= 120,
-        "zero {} ticks after the last frame",
-        zero_at - 59
+        (490..500).contains(&full_after),
+        "full force {full_after} ticks after release"
+    );
+    // Armed, frames until tick 2000, then silence: zero within 120 ticks, disarmed.
+    g.arm(1000);
+    for t in 1000..2000 {
+        g.frame(t);
+        assert_eq!(g.gain(t, true), GAIN_FULL);
+    }
+    let zero_at = (2000..3000).find(|&t| g.gain(t, true) == 0).unwrap();
+    assert!(
+        zero_at - 1999 <= 120,
+        "faded after {} ticks",
+        zero_at - 1999
     );
     assert!(!g.armed());
-    // A frame alone does not re-arm; Arm does.
-    g.frame(500);
-    assert_eq!(g.gain(501), 0);
-    g.arm(502);
-    assert_eq!(g.gain(503), guard::FULL);
+    // A frame alone does not re-arm; Arm does, from zero, after the probe leaves.
+    g.frame(3000);
+    assert_eq!(g.gain(3001, false), 0);
+    g.arm(3002);
+    assert_eq!(g.gain(3003, true), 0, "in contact: the ramp waits");
+    assert!(g.gain(3004, false) > 0);
+    // Disarm: zero at once.
     g.disarm();
-    assert_eq!(g.gain(504), 0);
+    assert_eq!(g.gain(3005, false), 0);
 }
 
-/// A device that records what it was asked to render.
-#[derive(Default)]
-struct Probe {
-    at: [Length; 3],
-    written: Vec<[Force; 3]>,
-}
-
-impl HapticDevice for Probe {
-    type Error = ();
-    fn read_position(&mut self) -> Result<[Length; 3], ()> {
-        Ok(self.at)
-    }
-    fn write_force(&mut self, f: [Force; 3]) -> Result<(), ()> {
-        self.written.push(f);
-        Ok(())
-    }
-    fn safe_state(&mut self) -> Result<(), ()> {
-        Ok(())
-    }
+/// `q` (Q30) as a rotation matrix, in f64.
+fn matrix(q: [i32; 4]) -> [[f64; 3]; 3] {
+    let [w, x, y, z] = q.map(|c| scale::to_f64(c, scale::QUAT_FRAC));
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
 }
 
 #[test]
-fn the_pose_moves_by_a_bounded_step_and_the_gain_keeps_the_force_s_sign() {
-    let mut d = LinkedDevice::new(Probe::default(), 0.01);
-    d.set_target([
-        Length::from_num(1.0).to_bits(),
-        0,
-        Length::from_num(-0.025).to_bits(),
-    ]);
-    let mut last = 0.0;
-    for tick in 1..=150 {
-        let p = d.read_position().unwrap();
-        let x = -p[0].to_num::<f64>();
-        assert!(
-            x - last <= 0.01 + 1e-7,
-            "tick {tick}: a step of {}",
-            x - last
-        );
-        last = x;
-    }
-    assert_eq!(
-        d.origin()[0],
-        Length::from_num(1.0).to_bits(),
-        "reached after 100 ticks"
-    );
-    assert_eq!(d.origin()[2], Length::from_num(-0.025).to_bits());
-    for gain in [0u16, 1, 16384, 32767, 32768] {
-        d.set_gain(gain);
-        let f = [
-            Force::from_num(-1.5),
-            Force::from_num(2.0),
-            Force::from_bits(-1),
-        ];
-        d.write_force(f).unwrap();
-        let w = *d.inner().written.last().unwrap();
+fn the_pose_moves_at_its_limits_and_maps_the_probe_and_the_force() {
+    let mut pose = TissuePose::new(200.0, 180.0, 1000.0);
+    let target = Pose::from_mm_deg([20.0, -10.0, 5.0], [30.0, -20.0, 45.0]);
+    pose.set_target(target.origin, target.rotation);
+    let step = 200.0 / 1000.0;
+    let turn = (180.0f64 / 1000.0).to_radians();
+    let (mut o, mut q) = (pose.origin(), pose.rotation());
+    let mut ticks = 0;
+    while !pose.settled() {
+        pose.step();
+        ticks += 1;
+        assert!(ticks < 2000, "never settled");
+        let (o2, q2) = (pose.origin(), pose.rotation());
         for k in 0..3 {
-            assert!(
-                w[k].to_bits().signum() * f[k].to_bits().signum() >= 0,
-                "sign flipped"
-            );
-            assert!(w[k].abs() <= f[k].abs());
+            assert!((scale::mm(o2[k]) - scale::mm(o[k])).abs() <= step + 1e-6);
+        }
+        // The rotation between two ticks: 2 acos |q·q'|.
+        let norm = |q: [i32; 4]| {
+            q.iter()
+                .map(|&c| scale::to_f64(c, 30).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let dot: f64 = (0..4)
+            .map(|k| scale::to_f64(q[k], 30) * scale::to_f64(q2[k], 30))
+            .sum::<f64>()
+            / (norm(q) * norm(q2));
+        let angle = 2.0 * dot.abs().min(1.0).acos();
+        assert!(angle <= turn * 1.001 + 1e-6, "tick {ticks}: {angle} rad");
+        let n2: f64 = q2.iter().map(|&c| scale::to_f64(c, 30).powi(2)).sum();
+        assert!((n2 - 1.0).abs() < 1e-8, "|q|² = {n2}");
+        (o, q) = (o2, q2);
+    }
+    // 30 mm at 0.2 mm a tick; the rotation's angle (about 62°) at 0.18° a tick.
+    assert!((340..=360).contains(&ticks), "{ticks} ticks");
+    // The probe into the tissue's frame and the force back, against f64.
+    let r = matrix(pose.rotation());
+    let origin = pose.origin().map(scale::mm);
+    for p in [[0.0, 0.0, 0.0], [12.5, -3.25, 7.0], [-40.0, 60.0, -20.0]] {
+        let got = pose
+            .to_tissue(p.map(Length::from_num))
+            .map(|c| c.to_num::<f64>());
+        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+        for i in 0..3 {
+            let want: f64 = (0..3).map(|j| r[j][i] * d[j]).sum();
+            assert!((got[i] - want).abs() < 1e-5, "{p:?}: {got:?}");
+        }
+        let f = [1.5, -0.25, 2.0];
+        let fd = pose
+            .to_device(f.map(Force::from_num))
+            .map(|c| c.to_num::<f64>());
+        for i in 0..3 {
+            let want: f64 = (0..3).map(|j| r[i][j] * f[j]).sum();
+            assert!((fd[i] - want).abs() < 1e-5, "{fd:?}");
         }
     }
 }
 
-/// Sends a table to a session as a host does; the answers and the effect of the commit.
-fn load(
-    s: &mut Session<64>,
-    table: &ForceTable64,
-    corrupt: impl Fn(&mut Vec<u8>, &mut u32),
-) -> (Vec<ToHost>, Option<Effect<64, Wide>>) {
-    let mut bytes = vec![0u8; table_bytes::len(64)];
-    table_bytes::write(table, &mut bytes);
-    let mut hash = table_bytes::hash(table);
-    corrupt(&mut bytes, &mut hash);
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    let mut out = Vec::new();
-    let mut send = |m: &ToHost| out.push(*m);
-    let now = Now::default();
-    s.handle(
-        ToDevice::TissueBegin {
-            segments: 64,
-            len: bytes.len() as u32,
-            hash,
-        },
-        now,
-        &mut r,
-        &mut send,
-    );
-    for (i, c) in bytes.chunks(200).enumerate() {
-        s.handle(
-            ToDevice::TissueChunk {
-                offset: (i * 200) as u32,
-                bytes: c,
-            },
-            now,
-            &mut r,
-            &mut send,
-        );
+/// Sends `t` to the rig as a host does, proposing `substeps` (0: none); the answer.
+fn load<C: mccs_firmware::Contact<NODES, EDGES, 64, mccs::Wide>>(
+    rig: &mut Rig<C>,
+    t: &Tissue,
+    substeps: u16,
+    hash: u32,
+) -> ToHost {
+    rig.send(&ToDevice::TissueBegin(TissueBegin {
+        segments: t.segments(),
+        len: t.bytes().len() as u32,
+        hash,
+        friction: t.friction(),
+        substeps,
+    }));
+    for (i, c) in t.bytes().chunks(TISSUE_CHUNK).enumerate() {
+        rig.send(&ToDevice::TissueChunk {
+            offset: (i * TISSUE_CHUNK) as u32,
+            bytes: c,
+        });
     }
-    let e = s.handle(ToDevice::TissueCommit, now, &mut r, &mut send);
-    (out, Some(e))
+    rig.send(&ToDevice::TissueCommit);
+    rig.wait(20_000, |m| matches!(m, ToHost::Ack { .. }))
 }
 
 #[test]
-fn a_tissue_is_checked_whole_before_the_tick_sees_it() {
-    let t2 = ForceTable64::new(&Params::TABLE2).unwrap();
-    let mut s = Session::<64>::new(live(), t2);
-    let old = s.tissue().1;
-    let stiffer = ForceTable64::new(
-        &mccs_host::paramfile::read(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../params/table2-stiffer.toml"
-        )))
-        .unwrap(),
-    )
-    .unwrap();
-    // A good load: the set for the live patch, named by its hash.
-    let (out, e) = load(&mut s, &stiffer, |_, _| {});
-    assert!(out.is_empty(), "{out:?}");
-    match e {
-        Some(Effect::Swap { tissue, set }) => {
-            assert_eq!(tissue, table_bytes::hash(&stiffer));
-            assert_eq!(set.table().raw(), stiffer.raw());
+fn hello_says_what_the_device_is_its_limits_and_its_rates() {
+    let mut rig = Rig::roaming(table2());
+    let ToHost::Hello(h) = rig.ask(&ToDevice::Hello, 5, |m| matches!(m, ToHost::Hello(_))) else {
+        unreachable!()
+    };
+    assert_eq!((h.protocol, h.schema), (PROTOCOL, SCHEMA));
+    assert_eq!(
+        (h.device, h.contact),
+        (DeviceKind::Arm, ContactKind::Roaming)
+    );
+    assert_eq!((h.tissue_w, h.tissue_h), (64, 64));
+    assert_eq!(h.knots, 65);
+    assert_eq!(scale::newtons(h.force_clamp), BOARD.max_force);
+    assert_eq!(h.workspace, BOARD.workspace_q24());
+    assert_eq!((h.pose_speed_mm_s, h.pose_turn_deg_s), (200, 180));
+    assert_eq!(h.baud, 1_000_000);
+    assert_eq!(h.friction, mccs_link::Friction::new(0.6, 0.4));
+    assert_eq!(
+        h.telemetry_least_every,
+        rates::telemetry_least_every(1000, 1_000_000)
+    );
+    assert_eq!(
+        h.mesh_least_every,
+        rates::mesh_least_every(1000, 1_000_000, 36)
+    );
+    assert_eq!(h.tick_budget, BOARD.tick_budget);
+    let mut glued = Rig::glued(table2());
+    let ToHost::Hello(h) = glued.ask(&ToDevice::Hello, 5, |m| matches!(m, ToHost::Hello(_))) else {
+        unreachable!()
+    };
+    assert_eq!(
+        (h.device, h.contact),
+        (DeviceKind::OneDof, ContactKind::Glued)
+    );
+    assert_eq!((h.tissue_w, h.tissue_h), (8, 8), "glued: the patch alone");
+}
+
+#[test]
+fn a_tissue_is_checked_in_slices_and_acknowledged_once_the_tick_runs_it() {
+    let mut rig = Rig::roaming(table2());
+    let stiffer = Tissue::from_params(&params("table2-stiffer.toml")).unwrap();
+    rig.send(&ToDevice::Watch { every: 1 });
+    rig.step();
+    rig.out.clear();
+    // Searching (no proposal): the check runs a slice a poll, hello and status are
+    // answered meanwhile, and the telemetry says a check runs.
+    rig.send(&ToDevice::TissueBegin(TissueBegin {
+        segments: 64,
+        len: stiffer.bytes().len() as u32,
+        hash: stiffer.hash(),
+        friction: None,
+        substeps: 0,
+    }));
+    for (i, c) in stiffer.bytes().chunks(TISSUE_CHUNK).enumerate() {
+        rig.send(&ToDevice::TissueChunk {
+            offset: (i * TISSUE_CHUNK) as u32,
+            bytes: c,
+        });
+    }
+    rig.send(&ToDevice::TissueCommit);
+    rig.step();
+    let mut polls = 0;
+    let mut answered = 0;
+    let mut checking = 0;
+    let ack = loop {
+        rig.send(&ToDevice::Status);
+        rig.step();
+        polls += 1;
+        assert!(polls < 5000, "no ack");
+        if let Some(a) = rig
+            .out
+            .iter()
+            .find(|m| matches!(m, ToHost::Ack { .. } | ToHost::Nak(_)))
+        {
+            break *a;
+        }
+        answered += rig
+            .out
+            .iter()
+            .filter(|m| matches!(m, ToHost::Status(_)))
+            .count();
+        checking += rig
+            .out
+            .iter()
+            .filter(|m| matches!(m, ToHost::Telemetry(t) if t.flags.contains(Flags::CHECKING)))
+            .count();
+        rig.out.clear();
+    };
+    assert!(
+        checking * 4 >= polls,
+        "{checking} samples say a check runs, in {polls} polls"
+    );
+    assert_eq!(
+        ack,
+        ToHost::Ack {
+            tissue: stiffer.hash()
+        }
+    );
+    // Ten runs of 1,536 steps, a slice of check_steps_per_poll a poll; a status each.
+    let slices = (10 * 1536u32).div_ceil(BOARD.check_steps_per_poll);
+    assert!(
+        polls as u32 >= slices / 2 && polls as u32 <= slices + 10,
+        "{polls} polls, {slices} slices"
+    );
+    assert!(
+        answered + 1 >= polls,
+        "{answered} statuses in {polls} polls"
+    );
+    assert_eq!(rig.ctl.telemetry().swaps, 1);
+    // The ack names the tissue the tick runs, and hello says so.
+    let ToHost::Hello(h) = rig.ask(&ToDevice::Hello, 5, |m| matches!(m, ToHost::Hello(_))) else {
+        unreachable!()
+    };
+    assert_eq!(h.tissue, stiffer.hash());
+}
+
+#[test]
+fn a_hosts_proposed_substeps_are_checked_in_two_runs() {
+    for name in ["table2.toml", "table2-stiffer.toml"] {
+        let mut rig = Rig::roaming(table2());
+        let t = Tissue::from_params(&params(name)).unwrap();
+        let topo = mccs::Topology::<NODES, EDGES>::standard_patch(8, 2.5).unwrap();
+        let table = ForceTable64::from_raw(table_bytes::read::<64>(t.bytes()).unwrap());
+        let n =
+            mccs::Solver::<NODES, EDGES, 64>::substeps_for(&topo, &table, &BOARD.solver()).unwrap();
+        let before = rig.ctl.telemetry().ticks;
+        assert_eq!(
+            load(&mut rig, &t, n as u16, t.hash()),
+            ToHost::Ack { tissue: t.hash() },
+            "{name}"
+        );
+        // Two runs of 1,536 steps at most, a slice a tick here.
+        let ticks = rig.ctl.telemetry().ticks - before;
+        assert!(
+            ticks <= 2 * 1536 / BOARD.check_steps_per_poll + 5,
+            "{name}: {ticks} ticks"
+        );
+        assert_eq!(rig.ctl.solver().substeps(), n, "{name}");
+        // Fewer than the bound allows: refused, the live tissue kept.
+        if n > 1 {
+            let r = load(&mut rig, &t, (n - 1) as u16, t.hash());
+            assert_eq!(
+                r,
+                ToHost::Nak(NakReason::Stability {
+                    substeps: (n - 1) as u16
+                }),
+                "{name}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_device_refuses_what_it_cannot_run_with_its_reason() {
+    let mut rig = Rig::roaming(table2());
+    let good = Tissue::from_params(&Params::TABLE2).unwrap();
+    let live = rig.server.session().tissue().1;
+    // The bytes' hash, a table that breaks its own check, one over the bound.
+    assert_eq!(
+        load(&mut rig, &good, 0, good.hash() ^ 1),
+        ToHost::Nak(NakReason::Hash)
+    );
+    let mut raw = *table2().raw();
+    raw.strain_hi = raw.strain_lo;
+    let broken = Tissue::of_table(&ForceTable64::from_raw(raw));
+    assert_eq!(
+        load(&mut rig, &broken, 0, broken.hash()),
+        ToHost::Nak(NakReason::Table)
+    );
+    let mut raw = *table2().raw();
+    raw.err_force_ppb = u32::MAX;
+    let over = Tissue::of_table(&ForceTable64::from_raw(raw));
+    assert_eq!(
+        load(&mut rig, &over, 0, over.hash()),
+        ToHost::Nak(NakReason::Bound)
+    );
+    // A spring ten times stiffer: its tick would pass the budget, with the figures.
+    let mut stiff = Params::TABLE2;
+    stiff.cone.shear_modulus *= 10.0;
+    let stiff = Tissue::from_params(&stiff).unwrap();
+    match load(&mut rig, &stiff, 0, stiff.hash()) {
+        ToHost::Nak(NakReason::Budget {
+            substeps,
+            instructions,
+            budget,
+        }) => {
+            assert_eq!(budget, BOARD.tick_budget);
+            assert!(
+                substeps as u32 > BOARD.budget().most_substeps(),
+                "{substeps}"
+            );
+            assert_eq!(instructions, BOARD.budget().cost(substeps as u32));
         }
         other => panic!("{other:?}"),
     }
-    // Refusals: each a Nak with its reason, the live tissue unchanged.
-    let refused =
-        |s: &mut Session<64>, table: &ForceTable64, corrupt: &dyn Fn(&mut Vec<u8>, &mut u32)| {
-            let (out, e) = load(s, table, corrupt);
-            assert_eq!(e, Some(Effect::None));
-            assert_eq!(s.tissue().1, old);
-            match out.last() {
-                Some(ToHost::Nak(r)) => *r,
-                other => panic!("{other:?}"),
-            }
-        };
-    assert_eq!(
-        refused(&mut s, &stiffer, &|b, _| b[100] ^= 1),
-        NakReason::Hash
-    );
-    assert_eq!(refused(&mut s, &stiffer, &|_, h| *h ^= 1), NakReason::Hash);
-    // A table that breaks its own invariants (its hash made to match).
-    let broken = |b: &mut Vec<u8>, h: &mut u32| {
-        b[8..12].copy_from_slice(&3u32.to_le_bytes()); // index_pre: not a power of two
-        *h = table_bytes::hash_bytes(b);
+    // Friction out of range.
+    let slippery = good.clone().with_friction(0.5, 0.5).unwrap();
+    let mut begin = TissueBegin {
+        segments: 64,
+        len: good.bytes().len() as u32,
+        hash: good.hash(),
+        friction: Some(mccs_link::Friction {
+            mu_s: 1 << 16,
+            mu_k: 3 << 16,
+        }),
+        substeps: 0,
     };
-    assert_eq!(refused(&mut s, &stiffer, &broken), NakReason::Table);
-    // A table with no measured error, or over the bound.
-    let law = mccs::Law::new(&Params::TABLE2).unwrap();
-    let unmeasured = ForceTable64::one_placement_unmeasured(&law, -0.5, 0.95).unwrap();
-    assert_eq!(refused(&mut s, &unmeasured, &|_, _| {}), NakReason::Bound);
-    // A tissue the live patch cannot run at its tick (its substeps).
-    let stiff = ForceTable64::new(
-        &mccs_host::paramfile::read(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../params/steep-kink.toml"
-        )))
-        .unwrap(),
-    )
-    .unwrap();
-    assert_eq!(refused(&mut s, &stiff, &|_, _| {}), NakReason::Solver);
-    // Pieces out of order; a commit without a begin.
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    let mut out = Vec::new();
-    let mut send = |m: &ToHost| out.push(*m);
-    s.handle(
-        ToDevice::TissueBegin {
-            segments: 64,
-            len: 1112,
-            hash: 0,
-        },
-        Now::default(),
-        &mut r,
-        &mut send,
+    let r = rig.ask(&ToDevice::TissueBegin(begin), 3, |_| false);
+    assert_eq!(r, ToHost::Nak(NakReason::Friction));
+    // Another knot count, another length; a chunk out of order; a commit alone.
+    begin.friction = None;
+    let r = rig.ask(
+        &ToDevice::TissueBegin(TissueBegin {
+            segments: 32,
+            ..begin
+        }),
+        3,
+        |_| false,
     );
-    s.handle(
-        ToDevice::TissueChunk {
-            offset: 4,
+    assert_eq!(r, ToHost::Nak(NakReason::Segments));
+    let r = rig.ask(
+        &ToDevice::TissueBegin(TissueBegin { len: 12, ..begin }),
+        3,
+        |_| false,
+    );
+    assert_eq!(r, ToHost::Nak(NakReason::Length));
+    rig.send(&ToDevice::TissueBegin(begin));
+    let r = rig.ask(
+        &ToDevice::TissueChunk {
+            offset: 200,
             bytes: &[0; 4],
         },
-        Now::default(),
-        &mut r,
-        &mut send,
+        3,
+        |_| false,
     );
-    s.handle(ToDevice::TissueCommit, Now::default(), &mut r, &mut send);
-    s.handle(
-        ToDevice::TissueBegin {
-            segments: 32,
-            len: 1112,
-            hash: 0,
-        },
-        Now::default(),
-        &mut r,
-        &mut send,
-    );
+    assert_eq!(r, ToHost::Nak(NakReason::Order));
+    let r = rig.ask(&ToDevice::TissueCommit, 3, |_| false);
+    assert_eq!(r, ToHost::Nak(NakReason::Order));
+    // Nothing changed; a good one with friction goes in.
+    assert_eq!(rig.server.session().tissue().1, live);
+    assert_eq!(rig.ctl.telemetry().swaps, 0);
     assert_eq!(
-        out,
-        vec![
-            ToHost::Nak(NakReason::Order),
-            ToHost::Nak(NakReason::Order),
-            ToHost::Nak(NakReason::Segments)
-        ]
+        load(&mut rig, &slippery, 0, slippery.hash()),
+        ToHost::Ack {
+            tissue: slippery.hash()
+        }
     );
-    assert_eq!(s.tissue().1, old);
+    let ToHost::Hello(h) = rig.ask(&ToDevice::Hello, 5, |m| matches!(m, ToHost::Hello(_))) else {
+        unreachable!()
+    };
+    assert_eq!(h.friction, mccs_link::Friction::new(0.5, 0.5));
+    // A glued device has no friction to take.
+    let mut glued = Rig::glued(table2());
+    let r = glued.ask(
+        &ToDevice::TissueBegin(TissueBegin {
+            friction: Some(mccs_link::Friction::new(0.5, 0.4)),
+            ..begin
+        }),
+        3,
+        |_| false,
+    );
+    assert_eq!(r, ToHost::Nak(NakReason::Friction));
 }
 
-/// Runs a replay through a session as `mccs link replay` drives it: the spec, the path
-/// in pieces within the credit, the rows back.
-fn device_replay(spec: ReplaySpec, samples: &[[f64; 3]], table: ForceTable64) -> Vec<ReplayRow> {
-    let mut s = Session::<64>::new(live(), table);
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    let mut rows = Vec::new();
-    let mut credit = 0;
-    let mut sent = 0usize;
-    let handle = |s: &mut Session<64>,
-                  r: &mut Replayer<N, E, 64, Wide, P>,
-                  m: ToDevice,
-                  rows: &mut Vec<ReplayRow>,
-                  credit: &mut u32| {
-        s.handle(m, Now::default(), r, &mut |h: &ToHost| match h {
-            ToHost::ReplayCredit { until } => *credit = *until,
-            ToHost::Nak(n) => panic!("{n:?}"),
-            _ => {}
-        });
-        let _ = rows;
-    };
-    handle(
-        &mut s,
-        &mut r,
-        ToDevice::ReplayBegin(spec),
-        &mut rows,
-        &mut credit,
+#[test]
+fn a_pose_outside_the_workspace_or_not_a_rotation_is_refused() {
+    let mut rig = Rig::roaming(table2());
+    let [lo, hi] = BOARD.workspace_mm;
+    let r = rig.ask(
+        &ToDevice::Pose(Pose::from_mm_deg([hi[0] + 1.0, 0.0, 0.0], [0.0; 3])),
+        3,
+        |_| false,
     );
-    let bits: Vec<u8> = samples
+    assert_eq!(
+        r,
+        ToHost::Nak(NakReason::Pose {
+            axis: 0,
+            limit: scale::mm_bits(hi[0])
+        })
+    );
+    let r = rig.ask(
+        &ToDevice::Pose(Pose::from_mm_deg([0.0, 0.0, lo[2] - 0.5], [0.0; 3])),
+        3,
+        |_| false,
+    );
+    assert_eq!(
+        r,
+        ToHost::Nak(NakReason::Pose {
+            axis: 2,
+            limit: scale::mm_bits(lo[2])
+        })
+    );
+    let mut bad = Pose::IDENTITY;
+    bad.rotation[1] = 1 << 29;
+    let r = rig.ask(&ToDevice::Pose(bad), 3, |_| false);
+    assert_eq!(r, ToHost::Nak(NakReason::Rotation));
+    let ok = Pose::from_mm_deg([10.0, -5.0, 2.0], [0.0, 15.0, 0.0]);
+    rig.send(&ToDevice::Pose(ok));
+    let ToHost::Status(s) = rig.ask(&ToDevice::Status, 3, |m| matches!(m, ToHost::Status(_)))
+    else {
+        unreachable!()
+    };
+    assert_eq!(s.pose, ok);
+}
+
+#[test]
+fn a_pose_change_never_jumps_the_force_by_more_than_the_clamp() {
+    let mut rig = Rig::roaming(table2());
+    // Out of contact until the gain is full, then pressed 1 mm in.
+    for _ in 0..600 {
+        rig.step();
+    }
+    rig.probe().at = [0.0, 0.4, -1.0];
+    for _ in 0..300 {
+        rig.step();
+    }
+    let clamp = Force::from_num(BOARD.max_force).to_bits() as i64;
+    let mut last = rig.ctl.device().rendered();
+    assert!(last[2] > Force::ZERO, "{last:?}");
+    // The tissue thrown 40 mm sideways and tilted 60°: slewed, the force never jumps.
+    rig.send(&ToDevice::Pose(Pose::from_mm_deg(
+        [40.0, 0.0, 0.0],
+        [60.0, 0.0, 0.0],
+    )));
+    let mut worst = 0i64;
+    for _ in 0..1500 {
+        rig.step();
+        let now = rig.ctl.device().rendered();
+        let d2: i64 = (0..3)
+            .map(|k| (now[k].to_bits() as i64 - last[k].to_bits() as i64).pow(2))
+            .sum();
+        worst = worst.max(d2);
+        last = now;
+    }
+    let worst = (worst as f64).sqrt();
+    assert!(
+        worst <= clamp as f64,
+        "a jump of {} N",
+        worst / (1u32 << 20) as f64
+    );
+    println!(
+        "LINK case=pose_step worst_force_step_n={:.4}",
+        worst / (1u32 << 20) as f64
+    );
+}
+
+#[test]
+fn a_run_of_overruns_ends_in_the_safe_state() {
+    let mut rig = Rig::roaming(table2());
+    for _ in 0..BOARD.max_overruns_in_row - 1 {
+        rig.tick();
+        rig.ctl.note_overrun();
+    }
+    rig.tick();
+    rig.ctl.note_on_time();
+    assert_eq!(rig.ctl.telemetry().fault, None, "nine, then one on time");
+    for _ in 0..BOARD.max_overruns_in_row {
+        rig.tick();
+        rig.ctl.note_overrun();
+    }
+    assert_eq!(
+        rig.ctl.telemetry().fault,
+        Some(mccs_firmware::Fault::Overruns)
+    );
+    rig.step();
+    let ToHost::Status(s) = rig.ask(&ToDevice::Status, 3, |m| matches!(m, ToHost::Status(_)))
+    else {
+        unreachable!()
+    };
+    assert_eq!(s.fault, FaultReason::Overruns);
+    assert_eq!(rig.ctl.device().rendered(), [Force::ZERO; 3]);
+}
+
+#[test]
+fn telemetry_is_held_to_the_byte_budget_and_its_gaps_are_the_drops() {
+    let mut rig = Rig::roaming(table2());
+    rig.send(&ToDevice::Watch { every: 1 });
+    let least = rates::telemetry_least_every(1000, BOARD.baud) as u32;
+    let mut got = Vec::new();
+    // The main loop polls at irregular ticks: some due samples are missed.
+    for t in 0..2000u32 {
+        rig.tick();
+        if t % 7 == 0 || t % 11 == 0 {
+            rig.poll();
+        }
+    }
+    for m in &rig.out {
+        if let ToHost::Telemetry(t) = m {
+            got.push(*t);
+        }
+    }
+    let span = got.last().unwrap().tick - got[0].tick;
+    assert!(
+        got.len() as u32 <= span / least + 1,
+        "{} samples in {span} ticks: over one every {least}",
+        got.len()
+    );
+    assert!(got.windows(2).all(|w| w[1].seq > w[0].seq));
+    let last = got.last().unwrap();
+    let gaps: u32 = got.windows(2).map(|w| w[1].seq - w[0].seq - 1).sum::<u32>() + got[0].seq;
+    assert_eq!(gaps, last.dropped);
+    assert!(last.dropped > 0);
+    // The largest telemetry frame is what the budget counts.
+    let worst = ToHost::Telemetry(Telemetry {
+        seq: u32::MAX,
+        tick: u32::MAX,
+        probe: [i32::MIN; 3],
+        force: [i32::MIN; 3],
+        gain: u16::MAX,
+        flags: Flags(u16::MAX),
+        fault: FaultReason::Overruns,
+        duties: [i32::MIN; 3],
+        proxy: [i32::MIN; 3],
+        window: [i32::MIN; 2],
+        dropped: u32::MAX,
+    });
+    let mut buf = [0u8; MAX_FRAME];
+    assert_eq!(
+        encode(&worst, &mut buf).unwrap().len() as u32,
+        rates::TELEMETRY_FRAME_MAX
+    );
+}
+
+#[test]
+fn the_mesh_has_every_free_node_in_its_grid_place_within_the_byte_budget() {
+    let mut rig = Rig::roaming(table2());
+    rig.send(&ToDevice::WatchMesh { every: 1 });
+    let least = rates::mesh_least_every(1000, BOARD.baud, 36) as u32;
+    for _ in 0..300 {
+        rig.step();
+    }
+    let parts: Vec<MeshPart> = rig
+        .out
         .iter()
-        .flat_map(|p| {
-            probe_bits(*p)
-                .into_iter()
-                .flat_map(|c| c.to_bits().to_le_bytes())
+        .filter_map(|m| match m {
+            ToHost::Mesh(p) => Some(*p),
+            _ => None,
         })
         .collect();
+    let starts: Vec<&MeshPart> = parts.iter().filter(|p| p.first == 0).collect();
+    let span = starts.last().unwrap().tick - starts[0].tick;
+    assert!(
+        starts.len() as u32 <= span / least + 1,
+        "{} meshes in {span} ticks",
+        starts.len()
+    );
+    assert!(
+        starts.len() as u32 >= 300 / least - 1,
+        "{} meshes",
+        starts.len()
+    );
+    // Each mesh: 36 free nodes in parts of 12, each node in its place of the 8 × 8 grid
+    // at its rest position (the probe is above the tissue) plus the window's origin.
+    let topo = mccs::Topology::<NODES, EDGES>::standard_patch(8, 2.5).unwrap();
+    for p in parts.iter().filter(|p| p.seq == starts[1].seq) {
+        assert_eq!(p.nodes, 36);
+        for k in 0..MESH_PART.min(36 - p.first as usize) {
+            let node = p.first as usize + k;
+            let [i, j] = p.grid[k];
+            assert_eq!((i as usize, j as usize), (1 + node / 6, 1 + node % 6));
+            let rest = topo.rest_q24(node + 1).unwrap();
+            for c in 0..3 {
+                assert!((p.positions[k][c] - rest[c]).abs() < 1 << 12, "node {node}");
+            }
+        }
+    }
+    // The largest part's frame is what the budget counts.
+    let worst = ToHost::Mesh(MeshPart {
+        seq: u32::MAX,
+        tick: u32::MAX,
+        first: u16::MAX,
+        nodes: u16::MAX,
+        origin: [i32::MIN; 2],
+        grid: [[u8::MAX; 2]; MESH_PART],
+        positions: [[i32::MIN; 3]; MESH_PART],
+    });
+    let mut buf = [0u8; MAX_FRAME];
+    assert_eq!(
+        encode(&worst, &mut buf).unwrap().len() as u32,
+        rates::MESH_PART_FRAME_MAX
+    );
+}
+
+#[test]
+fn friction_reaches_the_hand_and_the_flags_say_so() {
+    let mut rig = Rig::roaming(table2());
+    rig.send(&ToDevice::Watch { every: 1 });
+    // Above the tissue until the ramp is done, pressed 1.5 mm in, then a slide along x.
+    for _ in 0..600 {
+        rig.step();
+    }
+    for k in 0..300 {
+        rig.probe().at = [-15.0, 0.4, 5.0 - 6.5 * (k as f64 / 300.0)];
+        rig.step();
+    }
+    for k in 0..1500 {
+        rig.probe().at = [-15.0 + 30.0 * (k as f64 / 1500.0), 0.4, -1.5];
+        rig.step();
+    }
+    let samples: Vec<Telemetry> = rig
+        .out
+        .iter()
+        .filter_map(|m| match m {
+            ToHost::Telemetry(t) => Some(*t),
+            _ => None,
+        })
+        .collect();
+    let slipping: Vec<&Telemetry> = samples
+        .iter()
+        .filter(|t| t.flags.contains(Flags::SLIPPING) && t.flags.contains(Flags::CONTACT))
+        .collect();
+    assert!(slipping.len() > 50, "{} slipping samples", slipping.len());
+    let ratio = |t: &Telemetry| {
+        let f = t.force.map(scale::newtons);
+        f[0].hypot(f[1]) / f[2].abs()
+    };
+    let mean = slipping.iter().map(|t| ratio(t)).sum::<f64>() / slipping.len() as f64;
+    assert!(
+        (mean - BOARD.mu_k).abs() <= 0.1 * BOARD.mu_k,
+        "lateral/normal {mean}, mu_k {}",
+        BOARD.mu_k
+    );
+    assert!(samples.iter().all(|t| t.flags.contains(Flags::HOMED)));
+    println!(
+        "LINK case=friction_host slipping_samples={} lateral_over_normal={mean:.4} mu_k={}",
+        slipping.len(),
+        BOARD.mu_k
+    );
+}
+
+/// Runs a replay through the rig as `mccs link replay` drives it.
+fn device_replay(
+    rig: &mut Rig<haptic_f405::device::BoardRoaming>,
+    spec: ReplaySpec,
+    samples: &[[f64; 3]],
+) -> Vec<ReplayRow> {
+    let ToHost::ReplayCredit { mut until } = rig.ask(&ToDevice::ReplayBegin(spec), 5, |m| {
+        matches!(m, ToHost::ReplayCredit { .. })
+    }) else {
+        panic!("refused")
+    };
+    let mut rows = Vec::new();
+    let mut sent = 0usize;
     let mut ended = false;
+    let mut polls = 0;
     while !ended {
-        while sent < samples.len() && (sent as u32) < credit {
-            let n = (credit as usize - sent).min(16).min(samples.len() - sent);
-            let chunk = &bits[12 * sent..12 * (sent + n)];
-            handle(
-                &mut s,
-                &mut r,
-                ToDevice::ReplayPath {
-                    first: sent as u32,
-                    points: chunk,
-                },
-                &mut rows,
-                &mut credit,
-            );
+        while sent < samples.len() && (sent as u32) < until {
+            let n = (until as usize - sent)
+                .min(PathPoint::PER_FRAME)
+                .min(samples.len() - sent);
+            let points: Vec<u8> = samples[sent..sent + n]
+                .iter()
+                .flat_map(|p| {
+                    PathPoint(mccs_client::replay::probe_bits(*p).map(|c| c.to_bits())).to_bytes()
+                })
+                .collect();
+            rig.send(&ToDevice::ReplayPath {
+                first: sent as u32,
+                points: &points,
+            });
             sent += n;
         }
-        let ran = r.step(&mut |h: &ToHost| match h {
-            ToHost::ReplayRow(row) => rows.push(*row),
-            ToHost::ReplayCredit { until } => credit = *until,
-            ToHost::ReplayEnd { ticks } => {
-                assert_eq!(*ticks as usize, samples.len());
-                ended = true;
+        rig.poll();
+        polls += 1;
+        assert!(polls < 100_000, "stalled at {}", rows.len());
+        for m in rig.out.drain(..) {
+            match m {
+                ToHost::ReplayRow(r) => rows.push(r),
+                ToHost::ReplayCredit { until: u } => until = u,
+                ToHost::ReplayEnd { .. } => ended = true,
+                ToHost::Nak(n) => panic!("{n:?}"),
+                _ => {}
             }
-            other => panic!("{other:?}"),
-        });
-        assert!(
-            ran || ended,
-            "stalled at {} of {}",
-            rows.len(),
-            samples.len()
-        );
+        }
     }
     rows
 }
@@ -361,7 +784,7 @@ fn spec(samples: u32, start: [f64; 3], roaming: Option<RoamSpec>) -> ReplaySpec 
 
 #[test]
 fn a_replay_on_the_device_is_the_hosts_fixed_replay() {
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
+    let table = table2();
     let traj = trajectory::read(std::path::Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../params/palpation.csv"
@@ -375,15 +798,16 @@ fn a_replay_on_the_device_is_the_hosts_fixed_replay() {
         config: SolverConfig::default(),
         engine: Engine::Wide,
     };
+    let mut rig = Rig::roaming(table);
     // Glued.
     let mut host = Vec::new();
     replay
         .run_with(&Params::TABLE2, Some(&table), &traj, |r: Row| host.push(r))
         .unwrap();
     let dev = device_replay(
+        &mut rig,
         spec(samples.len() as u32, samples[0], None),
         &samples,
-        table,
     );
     assert_eq!(dev.len(), host.len());
     for ((h, d), (t, p)) in host.iter().zip(&dev).zip(&ticks) {
@@ -391,7 +815,7 @@ fn a_replay_on_the_device_is_the_hosts_fixed_replay() {
     }
     // Roaming with friction on a 64 × 64 tissue.
     let roaming = Roaming {
-        tissue: Tissue::new(64, 64, 2.5, Shape::Flat).unwrap(),
+        tissue: RoamTissue::new(64, 64, 2.5, Shape::Flat).unwrap(),
         friction: Friction::new(0.6, 0.4).unwrap(),
         probe_radius: 0.0,
     };
@@ -414,9 +838,9 @@ fn a_replay_on_the_device_is_the_hosts_fixed_replay() {
         cap_radius: None,
     };
     let dev = device_replay(
+        &mut rig,
         spec(samples.len() as u32, samples[0], Some(roam)),
         &samples,
-        table,
     );
     assert_eq!(dev.len(), host.len());
     let mut shifts = 0;
@@ -429,10 +853,7 @@ fn a_replay_on_the_device_is_the_hosts_fixed_replay() {
 
 #[test]
 fn a_replay_beyond_the_device_is_refused_naming_the_option() {
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    let mut s = Session::<64>::new(live(), table);
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    let mut naks = Vec::new();
+    let mut rig = Rig::roaming(table2());
     let cases = [
         (
             ReplaySpec {
@@ -468,159 +889,68 @@ fn a_replay_beyond_the_device_is_refused_naming_the_option() {
         ),
     ];
     for (spec, option, limit) in cases {
-        s.handle(
-            ToDevice::ReplayBegin(spec),
-            Now::default(),
-            &mut r,
-            &mut |h: &ToHost| naks.push(*h),
-        );
-        assert_eq!(
-            naks.pop(),
-            Some(ToHost::Nak(NakReason::Option { option, limit }))
-        );
-        assert!(!r.running());
+        let r = rig.ask(&ToDevice::ReplayBegin(spec), 3, |_| false);
+        assert_eq!(r, ToHost::Nak(NakReason::Option { option, limit }));
     }
-    // A path past the credit abandons the replay.
-    s.handle(
-        ToDevice::ReplayBegin(spec(1000, [0.0; 3], None)),
-        Now::default(),
-        &mut r,
-        &mut |h: &ToHost| naks.push(*h),
-    );
-    assert_eq!(naks.pop(), Some(ToHost::ReplayCredit { until: P as u32 }));
-    let too_many = vec![0u8; 12 * (P + 1)];
-    s.handle(
-        ToDevice::ReplayPath {
-            first: 0,
-            points: &too_many,
+    // A path out of order, or past the credit, abandons the replay.
+    let r = rig.ask(&ToDevice::ReplayBegin(spec(1000, [0.0; 3], None)), 3, |m| {
+        matches!(m, ToHost::ReplayCredit { .. })
+    });
+    assert_eq!(r, ToHost::ReplayCredit { until: P as u32 });
+    let chunk = [0u8; 12 * PathPoint::PER_FRAME];
+    let r = rig.ask(
+        &ToDevice::ReplayPath {
+            first: 5,
+            points: &chunk,
         },
-        Now::default(),
-        &mut r,
-        &mut |h: &ToHost| naks.push(*h),
+        3,
+        |_| false,
     );
-    assert_eq!(naks.pop(), Some(ToHost::Nak(NakReason::Order)));
-    assert!(!r.running());
+    assert_eq!(r, ToHost::Nak(NakReason::Order));
+    let mut run = mccs_firmware::link::ReplayRun::<NODES, EDGES, 64, mccs::Wide, P>::new(
+        &spec(1000, [0.0; 3], None),
+        table2(),
+        false,
+    )
+    .unwrap();
+    for k in 0..P / PathPoint::PER_FRAME {
+        run.path((k * PathPoint::PER_FRAME) as u32, &chunk).unwrap();
+    }
+    assert_eq!(
+        run.path(P as u32, &chunk),
+        Err(NakReason::Order),
+        "past the credit"
+    );
+    let ToHost::Status(s) = rig.ask(&ToDevice::Status, 3, |m| matches!(m, ToHost::Status(_)))
+    else {
+        unreachable!()
+    };
+    assert!(!s.replaying);
 }
 
 #[test]
-fn telemetry_gaps_are_the_drops() {
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    let mut s = Session::<64>::new(live(), table);
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    s.handle(
-        ToDevice::Watch { every: 10 },
-        Now::default(),
-        &mut r,
-        &mut |_| {},
-    );
-    let mut got = Vec::new();
-    let mut refuse = false;
-    // The main loop looks at irregular ticks; the link refuses some messages.
-    for tick in [0u32, 5, 10, 35, 40, 41, 77, 80, 200, 210] {
-        refuse = !refuse && tick == 80;
-        s.telemetry(tick, [0; 3], [0; 3], guard::FULL, 0, &mut |m: &ToHost| {
-            if refuse {
-                return false;
-            }
-            if let ToHost::Telemetry(t) = m {
-                got.push(*t);
-            }
-            true
-        });
-    }
-    let last = got.last().unwrap();
-    let gaps: u32 = got.windows(2).map(|w| w[1].seq - w[0].seq - 1).sum::<u32>() + got[0].seq;
-    assert_eq!(gaps, last.dropped, "{got:?}");
-    assert!(last.dropped > 0);
-}
-
-/// The mesh for the visuals: at most 60 a second, every free node once per mesh in parts
-/// of 12 (rest position plus displacement), the tick's countdown due exactly every
-/// `every` ticks, and a mesh the main loop never sent counted as dropped.
-#[test]
-fn the_mesh_is_every_free_node_at_most_60_times_a_second() {
-    use mccs_firmware::link::{Mesh, MeshClock};
-    let table = ForceTable64::new(&Params::TABLE2).unwrap();
-    let mut s = Session::<64>::new(live(), table);
-    let mut r = Replayer::<N, E, 64, Wide, P>::new(false);
-    // Asked for every tick at 1 kHz: held to 17 ticks (58.8 a second).
-    let effect = s.handle(
-        ToDevice::WatchMesh { every: 1 },
-        Now::default(),
-        &mut r,
-        &mut |_| {},
-    );
-    assert_eq!(effect, Effect::WatchMesh(17));
-    let clock = MeshClock::new();
-    assert!(!(0..100).any(|_| clock.due()), "never before it is set");
-    clock.set(17);
-    let at: Vec<u32> = (0..100u32).filter(|_| clock.due()).collect();
-    assert_eq!(at, vec![0, 17, 34, 51, 68, 85]);
-    // A displaced node: rest plus displacement, in its place among the parts.
-    let topo = mccs::Topology::<N, E>::standard_patch(5, 2.5).unwrap();
-    let mut solver = mccs::Solver::new(topo, table, &SolverConfig::default()).unwrap();
-    let shift = [Length::from_num(0.25), Length::ZERO, Length::from_num(-1)];
-    solver.set_state(14, shift, [mccs::Velocity::ZERO; 3]);
-    let mesh = Mesh::of(&solver, 34);
-    let free = solver.topology().node_count() - 1;
-    assert_eq!(mesh.nodes as usize, free);
-    let mut parts = Vec::new();
-    s.mesh(&mesh, &mut |m: &ToHost| {
-        if let ToHost::Mesh(p) = m {
-            parts.push(*p);
-        }
-        true
-    });
-    assert_eq!(parts.len(), free.div_ceil(12));
-    let mut seen = vec![None; free];
-    for p in &parts {
-        assert_eq!((p.tick, p.nodes, p.seq), (34, free as u16, 0));
-        for (k, pos) in p.positions.iter().enumerate() {
-            let node = p.first as usize + k;
-            if node < free {
-                seen[node] = Some(*pos);
-            } else {
-                assert_eq!(*pos, [0; 3], "past the nodes: zero");
-            }
+fn a_flood_of_garbage_is_counted_and_never_stalls_the_tick_or_the_link() {
+    let mut rig = Rig::roaming(table2());
+    let mut garbage = Vec::new();
+    for k in 0..20_000u32 {
+        garbage.push((k.wrapping_mul(2_654_435_761) >> 24) as u8 | 1);
+        if k % 97 == 0 {
+            garbage.push(0);
         }
     }
-    for (k, pos) in seen.iter().enumerate() {
-        let pos = pos.expect("every free node once");
-        let rest = solver.topology().rest_q24(k + 1).unwrap();
-        let u = if k + 1 == 14 {
-            shift.map(|x| x.to_bits())
-        } else {
-            [0; 3]
-        };
-        assert_eq!(pos, [0, 1, 2].map(|j| rest[j] + u[j]), "node {k}");
+    garbage.push(0);
+    rig.send_raw(&garbage);
+    let mut polls = 0;
+    while rig.queued() > 0 {
+        rig.step();
+        polls += 1;
     }
-    // The next mesh the main loop sees is two periods on: one was never sent.
-    let mut seqs = Vec::new();
-    s.mesh(&Mesh::of(&solver, 34 + 2 * 17), &mut |m: &ToHost| {
-        if let ToHost::Mesh(p) = m {
-            seqs.push(p.seq);
-        }
-        true
-    });
-    assert!(seqs.iter().all(|&q| q == 2), "{seqs:?}");
-    let mut dropped = 0;
-    s.handle(ToDevice::Status, Now::default(), &mut r, &mut |m| {
-        if let ToHost::Status(st) = m {
-            dropped = st.dropped_telemetry;
-        }
-    });
-    assert_eq!(dropped, 1);
-    // Off: no mesh.
-    s.handle(
-        ToDevice::WatchMesh { every: 0 },
-        Now::default(),
-        &mut r,
-        &mut |_| {},
-    );
-    let mut any = false;
-    s.mesh(&mesh, &mut |_| {
-        any = true;
-        true
-    });
-    assert!(!any);
+    // At most 512 bytes a poll: the tick ran between them.
+    assert!(polls >= garbage.len() / 512, "{polls} polls");
+    let ToHost::Status(s) = rig.ask(&ToDevice::Status, 3, |m| matches!(m, ToHost::Status(_)))
+    else {
+        unreachable!()
+    };
+    assert!(s.bad_frames > 100, "{} bad frames", s.bad_frames);
+    assert_eq!(s.ticks as usize, polls + 1);
 }

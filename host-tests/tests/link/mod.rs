@@ -4,15 +4,17 @@
 mod cli;
 mod codec;
 mod device;
+mod messages;
 mod qemu;
+mod rig;
 
 /// `mccs link --connect ADDR mesh --seconds S --every 1` on a device whose live patch is
 /// the standard one of `grid`: each mesh by its `seq`, as its tick and its nodes in
-/// order, the farthest any node was from its rest position (mm), and the free nodes.
-/// Held here, for every device: one mesh, one tick; every mesh but the last (which the
-/// run's end may cut) has every free node once, in order; meshes at least 17 ticks apart
-/// (60 a second at most, at 1 kHz).
-fn mesh_run(addr: &str, seconds: &str, grid: usize) -> (Meshes, f64, usize) {
+/// order, the deepest any node was (mm, its `z`), and the free nodes. Held here, for
+/// every device: one mesh, one tick; every mesh but the last (which the run's end may
+/// cut) has every free node once, in order, each in its place of the surface grid;
+/// meshes at least `least_every` ticks apart (the link's byte budget).
+fn mesh_run(addr: &str, seconds: &str, grid: usize, least_every: u32) -> (Meshes, f64, usize) {
     let out = crate::cli::mccs_ok(&[
         "link",
         "--connect",
@@ -24,19 +26,21 @@ fn mesh_run(addr: &str, seconds: &str, grid: usize) -> (Meshes, f64, usize) {
         "1",
     ]);
     let csv = String::from_utf8(out.stdout).unwrap();
-    let topo = mccs::Topology::<37, 214>::standard_patch(grid, 2.5).unwrap();
-    let free = topo.node_count() - 1;
+    let inner = grid - 2;
+    let free = inner * inner;
     let mut meshes = Meshes::default();
-    let mut worst = 0.0f64;
+    let mut deepest = 0.0f64;
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("seq,tick,node,x_mm,y_mm,z_mm"));
+    assert_eq!(lines.next(), Some("seq,tick,node,i,j,x_mm,y_mm,z_mm"));
     for l in lines {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
         let (seq, tick, node) = (v[0] as u32, v[1] as u32, v[2] as usize);
-        let rest = topo.rest(node as u16 + 1).unwrap();
-        for k in 0..3 {
-            worst = worst.max((v[3 + k] - rest[k]).abs());
-        }
+        assert_eq!(
+            (v[3] as usize, v[4] as usize),
+            (1 + node / inner, 1 + node % inner),
+            "{l}"
+        );
+        deepest = deepest.min(v[7]);
         let e = meshes.entry(seq).or_insert((tick, Vec::new()));
         assert_eq!(e.0, tick, "{l}: one mesh, one tick");
         e.1.push(node);
@@ -50,10 +54,10 @@ fn mesh_run(addr: &str, seconds: &str, grid: usize) -> (Meshes, f64, usize) {
     }
     let ticks: Vec<u32> = meshes.values().map(|(t, _)| *t).collect();
     assert!(
-        ticks.windows(2).all(|w| w[1] - w[0] >= 17),
-        "over 60 a second: {ticks:?}"
+        ticks.windows(2).all(|w| w[1] - w[0] >= least_every),
+        "closer than {least_every} ticks: {ticks:?}"
     );
-    (meshes, worst, free)
+    (meshes, -deepest, free)
 }
 
 /// Meshes by `seq`: their tick and their nodes.

@@ -1,20 +1,25 @@
-//! The board firmware in QEMU behind `mccs link` (`scripts/qemu-link.sh`): it answers
-//! `hello` within 50 ticks, takes a tissue and replays a path with roaming and friction
-//! exactly as the host's fixed replay does, drops every corrupted frame (counted) and
-//! keeps its tissue and pose, refuses bad tissues with their reason and no overrun, fades
-//! the force of a silent armed host to zero within 120 ticks, and streams telemetry whose
-//! gaps are its drops. The figures go out as `LINK` lines (docs/link.md).
+//! The board firmware in QEMU behind the scene's library (`scripts/qemu-link.sh`): the
+//! trainer's loop on the simulated arm board — hello within 50 ticks, armed 10 s on
+//! keepalives at full gain, a tissue swapped mid-press without a telemetry gap over 50
+//! ticks, a tissue over the tick budget refused, a pose moved and tilted with the force
+//! along the tilted surface, friction reaching the hand, a replay equal to the host's,
+//! corrupted frames counted, silence faded, the mesh — then the 1-DOF board's live path
+//! on its simulated lever, and a board whose ticks overrun ending in its safe state.
+//! Each scenario runs its steps by name (a failure names its step); figures go out as
+//! `LINK` lines (docs/link.md).
 //!
-//! QEMU takes a while to start and run: the test command runs this test in its own stage
-//! (`MCCS_LINK_QEMU=1`); `cargo test` alone skips it, saying so.
+//! QEMU takes a while to start and run: the test command runs these in their own stage
+//! (`MCCS_LINK_QEMU=1`); `cargo test` alone skips them, saying so.
 
-use crate::cli::mccs_ok;
-use mccs::{ForceTable64, Params};
-use mccs_host::link::{Addr, Link};
-use mccs_link::message::*;
-use mccs_link::{encode, table_bytes, MAX_FRAME};
-use std::path::Path;
+use crate::cli::{mccs_ok, root};
+use mccs_client::{Device, Options, TelemetrySample, Tissue};
+use mccs_link::{
+    encode, parse, scale, Decoder, FaultReason, Flags, NakReason, Pose, ToDevice, ToHost, MAX_FRAME,
+};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
 /// QEMU, stopped with the test.
@@ -30,16 +35,27 @@ impl Drop for Qemu {
     }
 }
 
-fn root() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+/// Whether this run holds the QEMU tests (else: skipped, said).
+fn wanted() -> bool {
+    let on = std::env::var("MCCS_LINK_QEMU").as_deref() == Ok("1");
+    if !on {
+        eprintln!("skipped: the board firmware in QEMU runs in the test command's link-qemu stage (MCCS_LINK_QEMU=1)");
+    }
+    on
 }
 
-fn start(socket: &Path) -> Qemu {
+/// `scripts/qemu-link.sh ARGS SOCKET`, its log in target/qemu/link-NAME.log; its address
+/// once the socket is there.
+fn start(name: &str, args: &[&str]) -> (Qemu, String) {
     use std::os::unix::process::CommandExt;
-    let log = std::fs::File::create(root().join("target/qemu/link-firmware.log")).unwrap();
+    let socket = std::env::temp_dir().join(format!("mccs-qemu-{name}-{}.sock", std::process::id()));
+    let _ = std::fs::remove_file(&socket);
+    std::fs::create_dir_all(root().join("target/qemu")).unwrap();
+    let log = std::fs::File::create(root().join(format!("target/qemu/link-{name}.log"))).unwrap();
     let child = Command::new("bash")
         .arg(root().join("scripts/qemu-link.sh"))
-        .arg(socket)
+        .args(args)
+        .arg(&socket)
         .current_dir(root())
         .stdin(Stdio::null())
         .stdout(log)
@@ -48,329 +64,526 @@ fn start(socket: &Path) -> Qemu {
         .spawn()
         .expect("scripts/qemu-link.sh");
     let qemu = Qemu(child);
-    let deadline = Instant::now() + Duration::from_secs(240);
+    let deadline = Instant::now() + Duration::from_secs(300);
     while !socket.exists() {
-        assert!(Instant::now() < deadline, "QEMU's socket never appeared");
+        assert!(
+            Instant::now() < deadline,
+            "{name}: QEMU's socket never appeared"
+        );
         std::thread::sleep(Duration::from_millis(100));
     }
-    qemu
+    (qemu, format!("unix:{}", socket.display()))
 }
 
-fn ask(link: &mut Link, msg: &ToDevice, want: impl Fn(&ToHost) -> bool) -> ToHost {
-    link.send(msg).unwrap();
-    let deadline = Instant::now() + Duration::from_secs(30);
-    loop {
-        match link.recv(deadline).unwrap() {
-            Some(m) if want(&m) => return m,
-            Some(_) => {}
-            None => panic!("no answer to {msg:?}"),
+/// A session, with time for QEMU to boot (bytes before the USART is on are lost: hello
+/// again every 200 ms).
+fn open(addr: &str) -> Device {
+    Device::open_with(
+        addr,
+        Options {
+            hello_timeout: Duration::from_secs(120),
+            ..Options::default()
+        },
+    )
+    .unwrap()
+}
+
+/// Runs step `name`; its failure names it.
+fn step<T>(scenario: &str, name: &str, f: impl FnOnce() -> T) -> T {
+    eprintln!("LINK step={scenario}/{name} …");
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(v) => {
+            println!("LINK step={scenario}/{name} ok");
+            v
+        }
+        Err(e) => {
+            let why = e
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            panic!("{scenario}: step '{name}' failed: {why}");
         }
     }
 }
 
-fn status(link: &mut Link) -> StatusInfo {
-    match ask(link, &ToDevice::Status, |m| matches!(m, ToHost::Status(_))) {
-        ToHost::Status(s) => s,
-        _ => unreachable!(),
-    }
-}
-
-fn hello(link: &mut Link) -> HelloInfo {
-    match ask(link, &ToDevice::Hello, |m| matches!(m, ToHost::Hello(_))) {
-        ToHost::Hello(h) => h,
-        _ => unreachable!(),
-    }
-}
-
-/// Waits for the firmware to listen: bytes that reach QEMU's USART before the firmware
-/// enables it are dropped, and a loaded host runs QEMU slowly (a first `Status` sent
-/// at once went unanswered in CI). Says `Hello` every 200 ms, as `mccs link` does.
-fn ready(link: &mut Link) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while Instant::now() < deadline {
-        link.send(&ToDevice::Hello).unwrap();
-        let until = Instant::now() + Duration::from_millis(200);
-        while let Some(m) = link.recv(until).unwrap() {
-            if matches!(m, ToHost::Hello(_)) {
-                return;
+/// The telemetry samples of `rx` until `until` says stop (or `limit` passes).
+fn collect(
+    rx: &Receiver<TelemetrySample>,
+    limit: Duration,
+    mut until: impl FnMut(&[TelemetrySample]) -> bool,
+) -> Vec<TelemetrySample> {
+    let end = Instant::now() + limit;
+    let mut got = Vec::new();
+    while Instant::now() < end {
+        if let Ok(t) = rx.recv_timeout(Duration::from_millis(50)) {
+            got.push(t);
+            if until(&got) {
+                break;
             }
         }
     }
-    panic!("the firmware never answered hello");
+    got
 }
 
-fn frame(msg: &ToDevice) -> Vec<u8> {
-    let mut f = [0u8; MAX_FRAME];
-    encode(msg, &mut f).unwrap().to_vec()
-}
-
-/// Sends a table's bytes (perhaps altered) one chunk at a time (each followed by a
-/// status, as `mccs link load` does) and commits; the first refusal or the answer to the
-/// commit (the load's other answers, up to a status, read and dropped).
-fn load(link: &mut Link, bytes: &[u8], hash: u32) -> ToHost {
-    let mut answers = Vec::new();
-    let until_status = |link: &mut Link, msg: &ToDevice, answers: &mut Vec<ToHost>| {
-        link.send(msg).unwrap();
-        link.send(&ToDevice::Status).unwrap();
-        let deadline = Instant::now() + Duration::from_secs(30);
-        loop {
-            match link.recv(deadline).unwrap() {
-                Some(ToHost::Status(_)) => return,
-                Some(m @ (ToHost::Ack { .. } | ToHost::Nak(_))) => answers.push(m),
-                Some(_) => {}
-                None => panic!("no status after {msg:?}"),
-            }
-        }
-    };
-    let begin = ToDevice::TissueBegin {
-        segments: 64,
-        len: bytes.len() as u32,
-        hash,
-    };
-    until_status(link, &begin, &mut answers);
-    for (i, c) in bytes.chunks(200).enumerate() {
-        let chunk = ToDevice::TissueChunk {
-            offset: (i * 200) as u32,
-            bytes: c,
-        };
-        until_status(link, &chunk, &mut answers);
-    }
-    until_status(link, &ToDevice::TissueCommit, &mut answers);
-    // A swap is acknowledged once the tick has taken it: wait for it.
-    if answers.is_empty() {
-        answers.push(ask(link, &ToDevice::Status, |m| {
-            matches!(m, ToHost::Ack { .. } | ToHost::Nak(_))
-        }));
-    }
-    answers[0]
+fn params(name: &str) -> PathBuf {
+    root().join("params").join(name)
 }
 
 #[test]
-fn the_board_firmware_in_qemu_serves_the_link() {
-    if std::env::var("MCCS_LINK_QEMU").as_deref() != Ok("1") {
-        eprintln!("skipped: the board firmware in QEMU runs in the test command's link-qemu stage (MCCS_LINK_QEMU=1)");
+fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
+    if !wanted() {
         return;
     }
-    let socket = std::env::temp_dir().join(format!("mccs-qemu-link-{}.sock", std::process::id()));
-    let _qemu = start(&socket);
-    let addr = format!("unix:{}", socket.display());
-    let mut link = Link::connect(&Addr::parse(&addr).unwrap()).unwrap();
-    ready(&mut link);
-
-    // Hello within 50 ticks: the ticks between a status before and one after.
-    let s0 = status(&mut link);
-    let h = hello(&mut link);
-    let s1 = status(&mut link);
-    assert!(
-        s1.ticks - s0.ticks <= 50,
-        "hello took {} ticks",
-        s1.ticks - s0.ticks
-    );
-    assert_eq!(
-        (h.protocol, h.schema, h.knots),
-        (mccs_link::PROTOCOL, mccs_link::SCHEMA, 65)
-    );
-    println!("LINK case=hello round_trip_ticks={}", s1.ticks - s0.ticks);
-    // QEMU's socket takes one client at a time: the CLI's, now.
-    drop(link);
-
-    // A tissue, then a roaming replay with friction: the host's fixed replay, exactly.
-    let stiffer = "params/table2-stiffer.toml";
-    let t0 = Instant::now();
-    let ack = String::from_utf8(
-        mccs_ok(&["link", "--connect", &addr, "load", "--params", stiffer]).stdout,
-    )
-    .unwrap();
-    let load_s = t0.elapsed().as_secs_f64();
-    let p = mccs_host::paramfile::read(&root().join(stiffer)).unwrap();
-    let hash = table_bytes::hash(&ForceTable64::new(&p).unwrap());
-    assert_eq!(ack.trim(), format!("ack tissue={hash:08x}"));
-    let args = [
-        "--probe",
-        "params/stroke.csv",
-        "--tissue",
-        "64,64",
-        "--friction",
-        "0.6,0.4",
-    ];
-    let t0 = Instant::now();
-    let dev = mccs_ok(&[&["link", "--connect", &addr, "replay"][..], &args].concat()).stdout;
-    let replay_s = t0.elapsed().as_secs_f64();
-    let host = mccs_ok(
-        &[
-            &["replay", "--params", stiffer, "--backend", "fixed"][..],
-            &args,
-        ]
-        .concat(),
-    )
-    .stdout;
-    assert!(
-        dev == host,
-        "the device's replay differs from the host's fixed replay"
-    );
-    let rows = dev.iter().filter(|&&b| b == b'\n').count() - 1;
-    println!(
-        "LINK case=replay rows={rows} seconds={replay_s:.1} rows_per_s={:.0} load_seconds={load_s:.2}",
-        rows as f64 / replay_s
-    );
-
-    let mut link = Link::connect(&Addr::parse(&addr).unwrap()).unwrap();
-    hello(&mut link);
-
-    // Every byte of a valid frame corrupted in turn, a truncated and an overlong frame,
-    // random bytes: each dropped and counted; the tissue and pose unchanged; the next
-    // valid frame taken.
-    let pose = ToDevice::Pose {
-        origin: [1 << 24, -(2 << 24), 0],
-    };
-    link.send(&pose).unwrap();
-    let before = status(&mut link);
-    assert_eq!(before.pose, [1 << 24, -(2 << 24), 0]);
-    let good = frame(&ToDevice::Pose {
-        origin: [5 << 24, 5 << 24, 5 << 24],
+    let s = "arm";
+    let (_qemu, addr) = start("arm-sim", &["--sim"]);
+    let device = open(&addr);
+    let telemetry = device.telemetry_stream();
+    step(s, "hello within 50 ticks", || {
+        let before = device.status().unwrap().raw.ticks;
+        let h = device.hello().unwrap().hello;
+        let after = device.status().unwrap().raw.ticks;
+        assert!(after - before <= 50, "hello took {} ticks", after - before);
+        assert_eq!(
+            (h.device, h.contact, h.simulated),
+            (
+                mccs_link::DeviceKind::Arm,
+                mccs_link::ContactKind::Roaming,
+                true
+            )
+        );
+        assert_eq!(
+            (h.protocol, h.schema, h.knots),
+            (mccs_link::PROTOCOL, mccs_link::SCHEMA, 65)
+        );
+        println!("LINK case=hello round_trip_ticks={}", after - before);
     });
-    let mut sent_bad = 0;
-    for i in 0..good.len() - 1 {
-        let mut bad = good.clone();
-        bad[i] ^= 0x10;
-        if bad[i] == 0 {
-            bad[i] = 0x55;
+    step(s, "armed 10 s on keepalives at full gain", || {
+        device.watch(10).unwrap();
+        let armed = device.arm_held().unwrap();
+        assert!(armed.raw.armed);
+        // The ramp: full gain once the probe has left the tissue and 500 ticks passed.
+        let up = collect(&telemetry, Duration::from_secs(20), |g| {
+            g.last().unwrap().gain >= 1.0
+        });
+        assert!(
+            up.last().unwrap().gain >= 1.0,
+            "the gain never reached full"
+        );
+        let start = Instant::now();
+        let held = collect(&telemetry, Duration::from_secs(10), |_| false);
+        assert!(start.elapsed() >= Duration::from_secs(9));
+        let low = held
+            .iter()
+            .filter(|t| t.gain < 1.0 || !t.flags.contains(Flags::ARMED))
+            .count();
+        assert_eq!(low, 0, "{low} samples below full gain or disarmed in 10 s");
+        let ticks = held.last().unwrap().tick - held[0].tick;
+        println!(
+            "LINK case=armed seconds=10 samples={} ticks={ticks} below_full_gain=0",
+            held.len()
+        );
+    });
+    step(
+        s,
+        "a tissue loaded mid-press without a telemetry gap over 50 ticks",
+        || {
+            // Wait for a press (contact), then load the stiffer tissue while the stream runs.
+            collect(&telemetry, Duration::from_secs(10), |g| {
+                g.last().unwrap().flags.contains(Flags::CONTACT)
+            });
+            let stiffer = Tissue::from_param_file(&params("table2-stiffer.toml")).unwrap();
+            let t0 = Instant::now();
+            let hash = std::thread::scope(|sc| {
+                let load = sc.spawn(|| device.load_tissue(&stiffer));
+                let during = collect(&telemetry, Duration::from_secs(30), |_| load.is_finished());
+                let hash = load.join().unwrap().unwrap();
+                let gap = during
+                    .windows(2)
+                    .map(|w| w[1].tick - w[0].tick)
+                    .max()
+                    .unwrap_or(0);
+                let checking = during
+                    .iter()
+                    .filter(|t| t.flags.contains(Flags::CHECKING))
+                    .count();
+                let contact = during
+                    .iter()
+                    .filter(|t| t.flags.contains(Flags::CONTACT))
+                    .count();
+                assert!(gap <= 50, "a telemetry gap of {gap} ticks during the load");
+                assert!(
+                    during.iter().all(|t| t.gain >= 1.0),
+                    "the force faded during the load"
+                );
+                println!(
+                "LINK case=load_mid_press seconds={:.2} samples={} largest_gap_ticks={gap} checking_samples={checking} contact_samples={contact}",
+                t0.elapsed().as_secs_f64(),
+                during.len()
+            );
+                hash
+            });
+            assert_eq!(hash, stiffer.hash());
+            assert_eq!(device.hello().unwrap().hello.tissue, hash);
+        },
+    );
+    step(
+        s,
+        "hello and status answered within 50 ticks while the device searches",
+        || {
+            // No proposal: the device's own search (ten runs), a slice at a time.
+            let t2 = Tissue::from_param_file(&params("table2.toml")).unwrap();
+            std::thread::scope(|sc| {
+                let load =
+                    sc.spawn(|| device.load_tissue_proposing(&t2, mccs_client::Proposal::None));
+                let (mut worst, mut asked, mut checking) = (0, 0, 0);
+                while !load.is_finished() {
+                    let a = device.status().unwrap().raw;
+                    let h = device.hello().unwrap();
+                    let b = device.status().unwrap().raw;
+                    if a.checking && b.checking {
+                        worst = worst.max(b.ticks - a.ticks);
+                        checking += 1;
+                    }
+                    asked += 1;
+                    let _ = h;
+                }
+                assert_eq!(load.join().unwrap().unwrap(), t2.hash());
+                assert!(checking >= 3, "{checking} rounds during the check");
+                assert!(
+                    worst <= 50,
+                    "status, hello, status took {worst} ticks during the check"
+                );
+                println!("LINK case=answers_during_search rounds={asked} during_check={checking} worst_ticks={worst}");
+            });
+        },
+    );
+    step(s, "a tissue over the tick budget refused", || {
+        let mut stiff = mccs::Params::TABLE2;
+        stiff.cone.shear_modulus *= 10.0;
+        let e = device
+            .load_tissue(&Tissue::from_params(&stiff).unwrap())
+            .unwrap_err();
+        match e.refusal() {
+            Some(NakReason::Budget {
+                substeps,
+                instructions,
+                budget,
+            }) => {
+                println!("LINK case=over_budget substeps={substeps} instructions={instructions} budget={budget}");
+                assert!(instructions > budget);
+            }
+            other => panic!("{other:?}: {e}"),
         }
-        link.send_raw(&bad).unwrap();
-        sent_bad += 1;
-    }
-    link.send_raw(&good[..good.len() / 2]).unwrap();
-    link.send_raw(&[0]).unwrap();
-    link.send_raw(&vec![7u8; 400]).unwrap();
-    link.send_raw(&[0]).unwrap();
-    let noise: Vec<u8> = (0..2000u32)
-        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8 | 1)
-        .collect();
-    link.send_raw(&noise).unwrap();
-    link.send_raw(&[0]).unwrap();
-    sent_bad += 3;
-    let after = status(&mut link);
-    assert!(
-        after.bad_frames - before.bad_frames >= sent_bad,
-        "{} bad frames counted of {sent_bad}",
-        after.bad_frames - before.bad_frames
+        let over = device
+            .load_tissue(&Tissue::from_param_file(&params("table2.toml")).unwrap())
+            .unwrap();
+        assert_eq!(device.hello().unwrap().hello.tissue, over);
+    });
+    step(s, "friction reaches the hand", || {
+        // Over the palpation's slides (at depth), slipping: lateral over normal is mu_k.
+        let round = collect(&telemetry, Duration::from_secs(8), |g| g.len() > 500);
+        let (mu_s, mu_k) = device.info().friction();
+        let slipping: Vec<&TelemetrySample> = round
+            .iter()
+            .filter(|t| t.flags.contains(Flags::SLIPPING) && t.force_n[2] > 0.2)
+            .collect();
+        assert!(slipping.len() > 20, "{} slipping samples", slipping.len());
+        let ratio: f64 = slipping
+            .iter()
+            .map(|t| t.force_n[0].hypot(t.force_n[1]) / t.force_n[2])
+            .sum::<f64>()
+            / slipping.len() as f64;
+        assert!(
+            (ratio - mu_k).abs() <= 0.1 * mu_k,
+            "lateral/normal {ratio:.3} against mu_k {mu_k}"
+        );
+        println!("LINK case=friction slipping_samples={} lateral_over_normal={ratio:.4} mu_k={mu_k} mu_s={mu_s}", slipping.len());
+    });
+    step(
+        s,
+        "the pose moved and tilted, the force along the tilted surface",
+        || {
+            let tilt = 20.0f64;
+            device
+                .set_pose(Pose::from_mm_deg([5.0, 0.0, 0.0], [tilt, 0.0, 0.0]))
+                .unwrap();
+            // 20° at 180°/s: settled within 200 ticks; then a round of the palpation.
+            let round = collect(&telemetry, Duration::from_secs(8), |g| g.len() > 500);
+            let n = [0.0, -tilt.to_radians().sin(), tilt.to_radians().cos()];
+            let (mu_s, _) = device.info().friction();
+            let pressed: Vec<&TelemetrySample> = round[60..]
+                .iter()
+                .filter(|t| {
+                    t.flags.contains(Flags::CONTACT)
+                        && t.force_n.iter().map(|f| f * f).sum::<f64>().sqrt() > 0.2
+                })
+                .collect();
+            assert!(pressed.len() > 20, "{} pressed samples", pressed.len());
+            let mut worst = 0.0f64;
+            let mut off_vertical = 0.0f64;
+            for t in &pressed {
+                let f = t.force_n;
+                let along: f64 = (0..3).map(|k| f[k] * n[k]).sum();
+                assert!(along > 0.0, "a force into the surface: {f:?}");
+                let across = (0..3)
+                    .map(|k| (f[k] - along * n[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                worst = worst.max(across / along);
+                off_vertical += (f[2] / f.iter().map(|x| x * x).sum::<f64>().sqrt())
+                    .acos()
+                    .to_degrees();
+            }
+            // Within the tilted surface's friction cone (the proxy sticks within mu_s).
+            assert!(
+                worst <= mu_s * 1.05,
+                "across/along {worst:.3} past mu_s {mu_s}"
+            );
+            let off = off_vertical / pressed.len() as f64;
+            println!("LINK case=tilt degrees={tilt} pressed_samples={} worst_across_over_along={worst:.3} mean_off_vertical_deg={off:.1}", pressed.len());
+            assert!(
+                off > 5.0,
+                "the force stayed vertical ({off:.1}°): it does not follow the tilt"
+            );
+            device.set_pose(Pose::IDENTITY).unwrap();
+        },
     );
-    assert_eq!(
-        after.pose, before.pose,
-        "a corrupted frame moved the tissue"
-    );
-    assert_eq!(
-        hello(&mut link).tissue,
-        hash,
-        "a corrupted frame changed the tissue"
-    );
-    println!(
-        "LINK case=corruption frames={sent_bad} counted={}",
-        after.bad_frames - before.bad_frames
-    );
+    step(s, "corrupted frames counted, nothing changed", || {
+        let before = device.status().unwrap().raw;
+        let good = {
+            let mut f = [0u8; MAX_FRAME];
+            encode(
+                &ToDevice::Pose(Pose::from_mm_deg([30.0, 30.0, 30.0], [0.0; 3])),
+                &mut f,
+            )
+            .unwrap()
+            .to_vec()
+        };
+        let mut sent = 0;
+        for i in 0..good.len() - 1 {
+            let mut bad = good.clone();
+            bad[i] ^= 0x10;
+            if bad[i] == 0 {
+                bad[i] = 0x55;
+            }
+            device.send_raw(&bad).unwrap();
+            sent += 1;
+        }
+        device.send_raw(&[7u8; 400]).unwrap();
+        device.send_raw(&[0]).unwrap();
+        sent += 1;
+        let after = device.status().unwrap().raw;
+        assert!(
+            after.bad_frames - before.bad_frames >= sent,
+            "{} counted of {sent}",
+            after.bad_frames - before.bad_frames
+        );
+        assert_eq!(
+            after.pose, before.pose,
+            "a corrupted frame moved the tissue"
+        );
+        println!(
+            "LINK case=corruption frames={sent} counted={}",
+            after.bad_frames - before.bad_frames
+        );
+    });
+    step(s, "the mesh in its grid, within the byte budget", || {
+        device.watch_mesh(1).unwrap();
+        let mut seqs = Vec::new();
+        let end = Instant::now() + Duration::from_secs(2);
+        while Instant::now() < end {
+            if let Some(m) = device.mesh().filter(|m| seqs.last() != Some(&m.seq)) {
+                assert_eq!(m.nodes.len(), 36);
+                assert_eq!(m.triangles().len(), 2 * 5 * 5);
+                seqs.push(m.seq);
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        device.watch_mesh(0).unwrap();
+        assert!(seqs.len() >= 5, "{} meshes in 2 s", seqs.len());
+        println!(
+            "LINK case=mesh meshes={} least_every={}",
+            seqs.len(),
+            device.info().hello.mesh_least_every
+        );
+    });
+    drop(device);
+    step(s, "a replay equals the host's fixed replay", || {
+        let args = [
+            "--probe",
+            "params/stroke.csv",
+            "--tissue",
+            "64,64",
+            "--friction",
+            "0.6,0.4",
+        ];
+        let t0 = Instant::now();
+        let dev = mccs_ok(&[&["link", "--connect", &addr, "replay"][..], &args].concat()).stdout;
+        let secs = t0.elapsed().as_secs_f64();
+        let host = mccs_ok(
+            &[
+                &[
+                    "replay",
+                    "--params",
+                    "params/table2.toml",
+                    "--backend",
+                    "fixed",
+                ][..],
+                &args,
+            ]
+            .concat(),
+        )
+        .stdout;
+        assert!(
+            dev == host,
+            "the device's replay differs from the host's fixed replay"
+        );
+        let rows = dev.iter().filter(|&&b| b == b'\n').count() - 1;
+        println!(
+            "LINK case=replay rows={rows} seconds={secs:.1} rows_per_s={:.0}",
+            rows as f64 / secs
+        );
+    });
+    step(s, "silence fades the force within 120 ticks", || {
+        silence(&addr)
+    });
+}
 
-    // Bad tissues: refused with their reason, the old one kept, no overrun.
-    let table = ForceTable64::new(&p).unwrap();
-    let mut bytes = vec![0u8; table_bytes::len(64)];
-    table_bytes::write(&table, &mut bytes);
-    let law = mccs::Law::new(&Params::TABLE2).unwrap();
-    let unmeasured = ForceTable64::one_placement_unmeasured(&law, -0.5, 0.95).unwrap();
-    let mut over = vec![0u8; table_bytes::len(64)];
-    table_bytes::write(&unmeasured, &mut over);
-    let kink = mccs_host::paramfile::read(&root().join("params/steep-kink.toml")).unwrap();
-    let foreign = ForceTable64::new(&kink).unwrap();
-    let mut foreign_bytes = vec![0u8; table_bytes::len(64)];
-    table_bytes::write(&foreign, &mut foreign_bytes);
-    let cases: [(&[u8], u32, NakReason); 4] = [
-        (&over, table_bytes::hash(&unmeasured), NakReason::Bound),
-        (
-            &foreign_bytes,
-            table_bytes::hash(&foreign),
-            NakReason::Solver,
-        ),
-        (&bytes[..bytes.len() - 4], hash, NakReason::Length),
-        (&bytes, hash ^ 1, NakReason::Hash),
-    ];
-    for (b, h, reason) in cases {
-        assert_eq!(load(&mut link, b, h), ToHost::Nak(reason));
-    }
-    assert_eq!(
-        hello(&mut link).tissue,
-        hash,
-        "a refused tissue replaced the old"
-    );
-    assert_eq!(status(&mut link).overruns, 0);
-
-    // Armed, then silent: the force's gain is zero within 120 ticks of the last frame;
-    // `Arm` resumes it.
-    link.send(&ToDevice::Watch { every: 1 }).unwrap();
-    let armed = match ask(&mut link, &ToDevice::Arm, |m| {
-        matches!(m, ToHost::Status(_))
-    }) {
-        ToHost::Status(s) => s.ticks,
-        _ => unreachable!(),
+/// A raw session: `Watch` every tick and `Arm`, frames for 300 ms, then silence with the
+/// connection open: the gain reaches zero within 120 ticks of the last frame.
+fn silence(addr: &str) {
+    let path = addr.strip_prefix("unix:").unwrap();
+    let mut s = std::os::unix::net::UnixStream::connect(Path::new(path)).unwrap();
+    s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
+    let send = |s: &mut std::os::unix::net::UnixStream, m: &ToDevice| {
+        let mut f = [0u8; MAX_FRAME];
+        s.write_all(encode(m, &mut f).unwrap()).unwrap();
     };
+    let mut decoder = Decoder::new();
+    let mut recv = |s: &mut std::os::unix::net::UnixStream| -> Vec<ToHost> {
+        let mut b = [0u8; 4096];
+        let n = s.read(&mut b).unwrap_or(0);
+        let mut out = Vec::new();
+        for &x in &b[..n] {
+            if let Some(Ok(p)) = decoder.push(x) {
+                if let Ok(m) = parse::<ToHost>(p) {
+                    out.push(m);
+                }
+            }
+        }
+        out
+    };
+    send(&mut s, &ToDevice::Watch { every: 1 });
+    send(&mut s, &ToDevice::Arm);
+    let mut last_tick = 0;
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_millis(300) {
+        send(&mut s, &ToDevice::Keepalive);
+        for m in recv(&mut s) {
+            if let ToHost::Telemetry(t) = m {
+                last_tick = t.tick;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // Silent from here: the last frame reached the device at or after `last_tick`.
     let deadline = Instant::now() + Duration::from_secs(20);
-    // (A telemetry's `tick` counts the ticks run: the tick it describes is `tick − 1`;
-    // the status's `ticks` is the count when the frame was taken.)
     let zero_at = loop {
-        match link.recv(deadline).unwrap() {
-            Some(ToHost::Telemetry(t)) if t.tick > armed && t.gain == 0 => break t.tick - 1,
-            Some(_) => {}
-            None => panic!("the gain never reached zero"),
+        assert!(Instant::now() < deadline, "the gain never reached zero");
+        let found = recv(&mut s).into_iter().find_map(|m| match m {
+            ToHost::Telemetry(t)
+                if t.tick > last_tick && t.gain == 0 && !t.flags.contains(Flags::ARMED) =>
+            {
+                Some(t.tick)
+            }
+            _ => None,
+        });
+        if let Some(t) = found {
+            break t;
         }
     };
     assert!(
-        zero_at - armed <= 120,
+        zero_at - last_tick <= 120,
         "zero {} ticks after the last frame",
-        zero_at - armed
+        zero_at - last_tick
     );
-    println!("LINK case=silence zero_after_ticks={}", zero_at - armed);
-    link.send(&ToDevice::Arm).unwrap();
-    let resumed = loop {
-        match link.recv(deadline).unwrap() {
-            Some(ToHost::Telemetry(t)) if t.gain == 32768 => break true,
-            Some(_) => {}
-            None => break false,
-        }
-    };
-    assert!(resumed, "Arm did not resume the force");
-    link.send(&ToDevice::Disarm).unwrap();
+    println!("LINK case=silence zero_after_ticks={}", zero_at - last_tick);
+}
 
-    // Live telemetry for 2 s of the host's clock: no overrun; the sequence's gaps are the
-    // drops the device counted.
-    link.send(&ToDevice::Watch { every: 1 }).unwrap();
-    let end = Instant::now() + Duration::from_secs(2);
-    let mut got: Vec<Telemetry> = Vec::new();
-    while let Some(m) = link.recv(end).unwrap() {
-        if let ToHost::Telemetry(t) = m {
-            got.push(t);
-        }
+#[test]
+fn the_simulated_lever_board_in_qemu_presses_the_tissue() {
+    if !wanted() {
+        return;
     }
-    link.send(&ToDevice::Watch { every: 0 }).unwrap();
-    let first = got.first().expect("no telemetry");
-    let last = got.last().unwrap();
-    let gaps: u32 = got.windows(2).map(|w| w[1].seq - w[0].seq - 1).sum();
-    assert_eq!(gaps, last.dropped - first.dropped, "gaps against drops");
-    assert_eq!(status(&mut link).overruns, 0);
-    println!(
-        "LINK case=telemetry messages={} ticks={} dropped={}",
-        got.len(),
-        last.tick - first.tick,
-        last.dropped - first.dropped
-    );
+    let s = "1dof";
+    let (_qemu, addr) = start("one-dof-sim", &["--sim", "--one-dof"]);
+    let device = open(&addr);
+    step(s, "hello says a glued 1-DOF device", || {
+        let h = device.info().hello;
+        assert_eq!(
+            (h.device, h.contact),
+            (mccs_link::DeviceKind::OneDof, mccs_link::ContactKind::Glued)
+        );
+        assert_eq!((h.tissue_w, h.tissue_h), (h.grid, h.grid));
+    });
+    step(s, "its presses render a force along z", || {
+        let rx = device.telemetry_stream();
+        device.watch(10).unwrap();
+        let armed = device.arm().unwrap();
+        let got = collect(&rx, Duration::from_secs(8), |g| g.len() > 600);
+        drop(armed);
+        let pressed: Vec<&TelemetrySample> = got
+            .iter()
+            .filter(|t| t.flags.contains(Flags::CONTACT))
+            .collect();
+        let deepest = got
+            .iter()
+            .map(|t| t.probe_mm[2])
+            .fold(f64::INFINITY, f64::min);
+        let most = got.iter().map(|t| t.force_n[2]).fold(0.0, f64::max);
+        assert!(deepest < -1.0, "the lever never pressed: {deepest} mm");
+        assert!(
+            most > 0.3 && pressed.len() > 50,
+            "{most} N, {} pressed samples",
+            pressed.len()
+        );
+        assert!(got.iter().all(|t| t.fault == FaultReason::None), "a fault");
+        println!("LINK case=one_dof samples={} pressed={} deepest_mm={deepest:.3} most_force_n={most:.3}", got.len(), pressed.len());
+    });
+}
 
-    // The mesh for the visuals, through the CLI: every free node of the N = 8 patch once
-    // a mesh, near its rest position (the live device is in its safe state in QEMU: its
-    // patch barely moved), at most 60 meshes a second of the device's ticks.
-    drop(link);
-    let (meshes, worst, free) = super::mesh_run(&addr, "1", 8);
-    assert!(meshes.len() >= 3, "{} meshes", meshes.len());
-    assert!(worst < 0.5, "a node {worst} mm from rest");
-    let ticks: Vec<u32> = meshes.values().map(|(t, _)| *t).collect();
-    println!(
-        "LINK case=mesh meshes={} nodes={free} least_ticks_apart={}",
-        meshes.len(),
-        ticks.windows(2).map(|w| w[1] - w[0]).min().unwrap_or(0)
-    );
+#[test]
+fn a_board_whose_ticks_overrun_ends_in_its_safe_state() {
+    if !wanted() {
+        return;
+    }
+    let s = "overrun";
+    // The simulated arm board at a quarter of the core's speed: every tick overruns.
+    let (_qemu, addr) = start("overrun", &["--sim", "--icount-shift", "5"]);
+    let device = open(&addr);
+    step(s, "the run of overruns ends in the safe state", || {
+        let end = Instant::now() + Duration::from_secs(60);
+        let st = loop {
+            let st = device.status().unwrap().raw;
+            if st.fault != FaultReason::None || Instant::now() > end {
+                break st;
+            }
+            std::thread::sleep(Duration::from_millis(200));
+        };
+        assert_eq!(st.fault, FaultReason::Overruns, "{st:?}");
+        assert!(st.overruns >= haptic_f405::BOARD.max_overruns_in_row);
+        let rx = device.telemetry_stream();
+        device.watch(10).unwrap();
+        let got = collect(&rx, Duration::from_secs(5), |g| g.len() > 20);
+        assert!(got.iter().all(|t| t.force_n == [0.0; 3]
+            && t.flags.contains(Flags::FAULT)
+            && t.fault == FaultReason::Overruns));
+        println!(
+            "LINK case=overruns overruns={} fault={}",
+            st.overruns,
+            st.fault.name()
+        );
+    });
+    let _ = scale::GAIN_FULL;
 }

@@ -64,6 +64,29 @@ pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     most_damping: f32,
 }
 
+/// A run of the linearised step in progress ([`Linearised::start`],
+/// [`Linearised::advance`]): its state, its coefficients and how far it is.
+#[derive(Clone, Debug)]
+pub(super) struct Run<const NODES: usize, const EDGES: usize> {
+    x: [[i32; 3]; NODES],
+    v: [[i32; 3]; NODES],
+    kappa: [i32; EDGES],
+    chi: i32,
+    chi_node: i32,
+    kappa_c: i32,
+    chi_c: i32,
+    g: u32,
+    h: f32,
+    symplectic: bool,
+    /// Steps run.
+    step: usize,
+    exp: i32,
+    at_window: (f32, i32),
+}
+
+/// Steps of one run ([`RUN_STEPS`]).
+pub const STEPS_PER_RUN: u32 = RUN_STEPS as u32;
+
 /// [`q::mulhi_round`] (`a b / 2³²` rounded to nearest, exact: a floor's bias acts as
 /// a damping over the run, measured up to 0.4 in the logarithm of a lightly damped
 /// patch's growth): one instruction where the core has a long multiply, else out of
@@ -149,7 +172,22 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// energy (kinetic and elastic, which an oscillation trades without changing their
     /// sum, so that the ratio does not depend on the phase it stops at) over the last
     /// [`RUN_WINDOW`] of [`RUN_STEPS`] steps (the first let the decaying modes fall behind
-    /// the growing one, as in a power iteration); infinite where it overflows.
+    /// the growing one, as in a power iteration); infinite where it overflows. The run
+    /// in one call: [`Self::start`] and [`Self::advance`] run it in pieces.
+    #[cfg(test)]
+    pub(super) fn growth(&self, h: f64) -> f32 {
+        match self.start(h) {
+            Ok(mut run) => loop {
+                if let Some(g) = self.advance(&mut run, RUN_STEPS as u32) {
+                    return g;
+                }
+            },
+            Err(g) => g,
+        }
+    }
+
+    /// A run of the step `h` from its fixed start, or its growth at once where a
+    /// coefficient says the step is unstable (infinite).
     ///
     /// In block fixed point, so that a core without an FPU runs it at integer speed (in
     /// software floating point it takes tens of seconds at their clocks): the
@@ -164,7 +202,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// (a one-mode step is stable only while `h²ω²D < 4` and `h γ D < 2`, and each
     /// coefficient is at most one of those), or where a step grows a component past
     /// [`STATE_LIMIT`].
-    pub(super) fn growth(&self, h: f64) -> f32 {
+    pub(super) fn start(&self, h: f64) -> Result<Run<NODES, EDGES>, f32> {
         let n = self.topo.node_count().min(NODES);
         let symplectic = self.integrator == Integrator::SymplecticDamped;
         let d = if symplectic {
@@ -188,7 +226,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         // stiffest node's `κ` and the most springs' `χ`: a one-mode step is stable only
         // while the sum is below 12, a node's springs' `κ` summing to at most 3 h²ω²D
         // and their `χ` to `h γ D`), so that a node's velocity change from its springs
-        // stays within 2^29.6 and sums in an `i32` (see the loop).
+        // stays within 2^29.6 and sums in an `i32` (see `advance`).
         let chi_f = q * self.c_spring / hf;
         let row = up * self.k_row + self.degree as f32 * chi_f;
         let (Some(_), Some(chi), Some(chi_node), Some(kappa_c), Some(chi_c), true) = (
@@ -199,16 +237,14 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             coeff(q * self.b_c / hf),
             row < ROW_LIMIT,
         ) else {
-            return f32::INFINITY;
+            return Err(f32::INFINITY);
         };
         let mut kappa = [0i32; EDGES];
         for (kq, k) in kappa.iter_mut().zip(self.springs.iter()) {
             *kq = libm::roundf(up * k * (1u32 << COEFF_FRAC) as f32) as i32;
         }
         let mut x = [[0i32; 3]; NODES];
-        let mut v = [[0i32; 3]; NODES];
         // A fixed pseudo-random start in every degree of freedom, ±0.5 mm in Q20.
-        let mut exp: i32 = -20;
         let mut seed: u32 = 0x2545_f491;
         for xi in x[..n].iter_mut().skip(1) {
             for c in xi.iter_mut() {
@@ -216,12 +252,51 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 *c = ((seed >> 8) as i32 - (1 << 23)) >> 4;
             }
         }
+        Ok(Run {
+            x,
+            v: [[0i32; 3]; NODES],
+            kappa,
+            chi,
+            chi_node,
+            kappa_c,
+            chi_c,
+            g,
+            h: hf,
+            symplectic,
+            step: 0,
+            exp: -20,
+            at_window: (0.0, 0),
+        })
+    }
+
+    /// Runs up to `steps` more steps of `run`; its growth once it has run all
+    /// [`RUN_STEPS`] (infinite where a step overflowed), `None` before.
+    pub(super) fn advance(&self, run: &mut Run<NODES, EDGES>, steps: u32) -> Option<f32> {
+        let n = self.topo.node_count().min(NODES);
         let c = self.topo.contact() as usize;
-        let mut at_window = (0.0f32, 0);
-        for step in 0..RUN_STEPS {
-            if step == RUN_STEPS - RUN_WINDOW {
-                at_window = (self.energy(&x, &v, hf, g), exp);
+        let Run {
+            x,
+            v,
+            kappa,
+            chi,
+            chi_node,
+            kappa_c,
+            chi_c,
+            g,
+            h: hf,
+            symplectic,
+            step: done,
+            exp,
+            at_window,
+        } = run;
+        let (chi, chi_node, kappa_c, chi_c, g, hf, symplectic) =
+            (*chi, *chi_node, *kappa_c, *chi_c, *g, *hf, *symplectic);
+        let last = (*done).saturating_add(steps as usize).min(RUN_STEPS);
+        while *done < last {
+            if *done == RUN_STEPS - RUN_WINDOW {
+                *at_window = (self.energy(x, v, hf, g), *exp);
             }
+            *done += 1;
             let mut dv = [[0i32; 3]; NODES];
             // (Slot 0 is the ground: its state stays zero, and what its springs add to
             // its velocity change is never read.) With components within ±2^STATE_BITS
@@ -274,7 +349,9 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                     let x_new = xi as i64 + ((step + ((1i64 << g) >> 1)) >> g);
                     let grown = x_new.unsigned_abs() | v_new.unsigned_abs() as u64;
                     if grown >= STATE_LIMIT {
-                        return f32::INFINITY;
+                        *done = RUN_STEPS;
+                        *at_window = (0.0, 0);
+                        return Some(f32::INFINITY);
                     }
                     x[i][j] = x_new as i32;
                     v[i][j] = v_new;
@@ -300,16 +377,19 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                         };
                     }
                 }
-                exp -= up;
+                *exp -= up;
             }
         }
-        let e = self.energy(&x, &v, hf, g);
-        let (e0, exp0) = at_window;
-        if e0 > 0.0 {
-            libm::ldexpf(e / e0, 2 * (exp - exp0))
+        if *done < RUN_STEPS {
+            return None;
+        }
+        let e = self.energy(x, v, hf, g);
+        let (e0, exp0) = *at_window;
+        Some(if e0 > 0.0 {
+            libm::ldexpf(e / e0, 2 * (*exp - exp0))
         } else {
             f32::INFINITY
-        }
+        })
     }
 
     /// The energy at displacements `x` and velocities per step `v` (substep `h`), over

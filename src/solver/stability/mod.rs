@@ -65,13 +65,15 @@
 //! The masses are haptic masses (a few grams per node), not the tissue's: they set how
 //! many substeps a tick needs, not the settled force.
 
+mod check;
 mod linearised;
+
+pub use check::{StabilityCheck, MAX_CHECK_STEPS};
 
 use super::{ConfigKey, SolverConfig, SolverError};
 use crate::arith::{Integrator, MAX_H_OVER_M, MAX_SUBSTEP};
 use crate::table::ForceTable;
 use crate::topology::{Topology, GROUND};
-use linearised::Linearised;
 
 /// Which stability bound a solver takes its substeps from (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -120,7 +122,7 @@ pub fn substeps_for<const NODES: usize, const EDGES: usize, const S: usize>(
 
 /// The substeps per tick for a substep of at most `h_max`, checked against the
 /// configuration's limit and the arithmetics'.
-fn substeps_of(h_max: f64, config: &SolverConfig) -> Result<u32, SolverError> {
+pub(crate) fn substeps_of(h_max: f64, config: &SolverConfig) -> Result<u32, SolverError> {
     let needed = libm::ceil(1.0 / (config.tick_hz * h_max));
     if needed.is_nan() || needed > config.max_substeps as f64 {
         let needed = if needed < u32::MAX as f64 {
@@ -185,29 +187,9 @@ pub fn bounds<const NODES: usize, const EDGES: usize, const S: usize>(
     table: &ForceTable<S>,
     config: &SolverConfig,
 ) -> Result<Bounds, SolverError> {
-    config.validate()?;
-    let k_max = table.max_stiffness().to_num::<f64>();
-    let closed = closed_form(topo, k_max, config)?;
-    let (estimated, chosen) = match config.bound {
-        Bound::Conservative => (None, CONSERVATIVE_FACTOR * closed),
-        Bound::Estimated => {
-            let lin = Linearised::new(topo, k_max, config);
-            let e = estimate(&lin, closed, config.integrator);
-            let h = ESTIMATE_MARGIN * e;
-            // Trusted where the motion visibly dies out at the step taken; a lightly
-            // damped patch, whose growth near the edge is too slow to measure, falls back.
-            if lin.growth(h) <= TRUSTED_DECAY {
-                (Some(e), h)
-            } else {
-                (Some(e), CONSERVATIVE_FACTOR * closed)
-            }
-        }
-    };
-    Ok(Bounds {
-        closed,
-        estimated,
-        chosen,
-    })
+    let mut check = StabilityCheck::new(topo, table, config, None)?;
+    while check.advance(topo, MAX_CHECK_STEPS).is_none() {}
+    Ok(check.bounds())
 }
 
 /// The closed form `min(2/θ, 2/γ)` of the module docs, s.
@@ -272,37 +254,4 @@ fn closed_form<const NODES: usize, const EDGES: usize>(
         return Err(SolverError::NoDamping);
     }
     Ok(h)
-}
-
-/// The largest `h` with the linearised step's growth at most 1, bisected geometrically
-/// between `closed / 4` and `4 closed` (7 steps: at most 2.2 % below the edge), or for
-/// [`Integrator::SymplecticDamped`], whose bound grows as `1/√k` on stiff patches, up to
-/// `16 closed` (9 steps: at most 0.8 % below the edge). Should even `closed / 4` grow,
-/// half of it.
-fn estimate<const NODES: usize, const EDGES: usize>(
-    lin: &Linearised<'_, NODES, EDGES>,
-    closed: f64,
-    integrator: Integrator,
-) -> f64 {
-    let stable = |h: f64| lin.growth(h) <= 1.0;
-    let (top, steps) = match integrator {
-        Integrator::ImprovedEuler => (4.0, 7),
-        Integrator::SymplecticDamped => (16.0, 9),
-    };
-    let (mut lo, mut hi) = (closed / 4.0, top * closed);
-    if stable(hi) {
-        return hi;
-    }
-    if !stable(lo) {
-        return 0.5 * lo;
-    }
-    for _ in 0..steps {
-        let mid = libm::sqrt(lo * hi);
-        if stable(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
 }

@@ -7,8 +7,8 @@ use super::fw_common::exit;
 use super::harness::Harness;
 use core::hint::black_box;
 use mccs::{Arm, Force};
-use mccs_firmware::arm_device::WOODENHAPTICS;
-use mccs_firmware::arm_f32::ArmF32;
+use mccs_firmware::arm::device::WOODENHAPTICS;
+use mccs_firmware::arm::float::ArmF32;
 
 /// B 20°, C 38° (the probe near the tissue's origin), A at 5°.
 const COUNTS: [i32; 3] = [222, 1333, 2533];

@@ -241,20 +241,24 @@ fn roaming_in<const N: usize, const E: usize, Spec: ShapeSpec>(
 
 /// What the host link adds to a tick (the board's TIM2, docs/link.md): the guard's gain
 /// stepped in a critical section, the pose and the swap flag read, the device's pose
-/// step and force scaling ([`mccs_firmware::link::LinkedDevice`]). Two controllers on
-/// the 3 × 3 patch (the cost does not depend on the patch) follow the same indentation,
-/// one through the link's device; the difference of their ticks, averaged over 4.
+/// step, frame change and force scaling ([`mccs_firmware::link::LinkedDevice`]), the
+/// flags and the snapshot for the main loop. Two controllers on the 3 × 3 patch (the
+/// cost does not depend on the patch) follow the same indentation, one through the
+/// link's device under a tilted pose (the rotation's cost: its worst case); the
+/// difference of their ticks, averaged over 4.
 #[inline(never)]
 pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
-    use mccs_firmware::link::{LinkedDevice, TickLink};
-    use mccs_firmware::{Controller, Mailbox, SimulatedDevice};
+    use mccs_firmware::link::{Guard, GuardTimes, LinkState, LinkedDevice};
+    use mccs_firmware::{Controller, SimulatedDevice};
     const N: usize = mccs::topology::standard_capacity(3).0;
     const E: usize = mccs::topology::standard_capacity(3).1;
-    // The board's call (boards/f405's bin keeps these two in statics; here they are on
-    // the stack: the M0's 16 KiB hold no second parameter set beside the bench's stack).
-    let link = TickLink::new(1000);
-    let swap: Mailbox<mccs::ParamSet<64>> = Mailbox::new();
-    let mesh: Mailbox<mccs_firmware::link::Mesh<N>> = Mailbox::new();
+    // The board's call (boards/f405's bin keeps it in a static; here it is on the stack:
+    // the M0's 16 KiB hold no second parameter set beside the bench's stack).
+    let link: LinkState<N, 64, mccs::DefaultArith> =
+        LinkState::new(Guard::new(GuardTimes::at_rate(1000, 0)));
+    // A quarter turn about z, still turning while the ticks are measured (it takes 500
+    // ticks at 180°/s): the slew's worst case, the probe still on the z axis.
+    link.set_pose(mccs_link::Pose::from_mm_deg([0.0; 3], [0.0, 0.0, 90.0]));
     let solver = || {
         let Ok(topo) = Topology::<N, E>::standard_patch(3, 2.5) else {
             exit(false)
@@ -270,11 +274,14 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
     let mut bare = Controller::new(solver(), SimulatedDevice::new(path), u32::MAX);
     let mut linked = Controller::new(
         solver(),
-        LinkedDevice::new(SimulatedDevice::new(path), 0.01),
+        LinkedDevice::new(
+            SimulatedDevice::new(path),
+            mccs::TissuePose::new(200.0, 180.0, 1000.0),
+        ),
         u32::MAX,
     );
     let link_tick = |ctl: &mut Controller<LinkedDevice<SimulatedDevice<7>>, N, E, 64>| {
-        let f = link.tick(ctl, &swap, &mesh);
+        let f = link.run_tick(ctl);
         black_box(ctl.device().probe());
         f
     };

@@ -1,7 +1,7 @@
 //! [`SimulatedArm`]: the arm's whole chain on a recorded motion, for the demo firmware in
 //! QEMU (whose timers cannot be driven as encoders) and its twin on the host. A probe
 //! path is converted to joint counts once, when the device is built — one sample every
-//! [`SAMPLE_TICKS`] ticks by [`counts_at`] (inverse kinematics, `f64`) — and each tick
+//! [`SAMPLE_TICKS`] ticks by `mccs::arm::inverse` (inverse kinematics, `f64`) — and each tick
 //! interpolates the counts between two samples (integers, no division), then runs the
 //! core's [`Arm`]: counts → the probe in the tissue's frame, and the force → duties. The
 //! arm is homed from the start; the duties are recorded, not rendered.
@@ -59,45 +59,6 @@ impl core::fmt::Display for SimArmError {
     }
 }
 
-/// The joint counts that put the probe at `device_mm` (the device frame), on the arm's
-/// working branch: the base turned toward the point, the elbow above the line from the
-/// shoulder to the probe (`0 < B + C < 180°`), every joint within its range; `None` out
-/// of reach. Configuration time (`f64`, `libm`): the inverse of the convention of
-/// docs/arm.md, independent of the host's twin, which the tests hold it to.
-pub fn counts_at(spec: &ArmSpec, device_mm: [f64; 3]) -> Option<[i32; 3]> {
-    let (lb, lc) = (spec.upper_arm_mm, spec.forearm_mm);
-    let [x, y, z] = device_mm;
-    let r = libm::hypot(x, y);
-    let h = z - spec.base_height_mm;
-    let d2 = r * r + h * h;
-    let d = libm::sqrt(d2);
-    if !(d > (lb - lc).abs() && d < lb + lc) {
-        return None;
-    }
-    let a = libm::atan2(y, x);
-    // The elbow at `along` from the shoulder toward the probe and `off` to its side.
-    let along = (lb * lb - lc * lc + d2) / (2.0 * d);
-    let off = libm::sqrt((lb * lb - along * along).max(0.0));
-    let (ur, uh) = (r / d, h / d);
-    let (er, eh) = (along * ur - off * uh, along * uh + off * ur);
-    // B from vertical up to the elbow; C from vertical down, elbow to probe.
-    let b = libm::atan2(er, eh);
-    let c = libm::atan2(r - er, -(h - eh));
-    let angles = [a, b, c];
-    let mut counts = [0i32; 3];
-    for k in 0..3 {
-        let j = &spec.joints[k];
-        let deg = angles[k].to_degrees();
-        if !(deg >= j.min_angle_deg && deg <= j.max_angle_deg) {
-            return None;
-        }
-        let per_turn = j.counts_per_rev * j.ratio;
-        let count = j.home_count as f64 + (deg - j.home_angle_deg) / 360.0 * per_turn / j.sign;
-        counts[k] = libm::round(count) as i32;
-    }
-    (libm::sin(b + c) > 0.0).then_some(counts)
-}
-
 /// A simulated arm of up to `S` samples of counts.
 #[derive(Clone, Debug)]
 pub struct SimulatedArm<const S: usize> {
@@ -131,7 +92,7 @@ impl<const S: usize> SimulatedArm<S> {
             let tick = (i as u32) << SAMPLE_SHIFT;
             let p = path.at(tick);
             let device = core::array::from_fn(|k| p[k].to_num::<f64>() + spec.tissue_origin_mm[k]);
-            *s = counts_at(spec, device).ok_or(SimArmError::Unreachable(tick))?;
+            *s = mccs::arm::inverse::counts(spec, device).ok_or(SimArmError::Unreachable(tick))?;
         }
         Ok(Self {
             arm,

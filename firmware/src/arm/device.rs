@@ -15,8 +15,8 @@
 //! - The joints' limits are reported ([`ArmDevice::flags`]); a probe beyond what the
 //!   tissue's frame holds reads far above the tissue: no contact.
 
+use crate::arm::encoder::{Extended, JointEncoder};
 use crate::device::HapticDevice;
-use crate::drivers::joint_encoder::{Extended, JointEncoder};
 use embedded_hal::digital::{InputPin, OutputPin};
 use embedded_hal::pwm::SetDutyCycle;
 use mccs::arm::OUTSIDE;
@@ -223,6 +223,14 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         let duty = self.zero();
         let enable = self.enable.set_low().map_err(|_| ArmFault::Enable);
         duty.and(enable)
+    }
+
+    fn status(&self) -> crate::device::DeviceStatus {
+        crate::device::DeviceStatus {
+            homed: self.homed,
+            at_limit: self.flags() & mccs::arm::LIMITS != 0,
+            duties: self.duty,
+        }
     }
 }
 

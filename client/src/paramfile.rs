@@ -237,7 +237,7 @@ fn sig(x: f64) -> String {
 
 /// The line (1-based) of `key = …` in the section `[section]` (or written `section.key`
 /// at the top level), if it is there.
-pub(crate) fn key_line(text: &str, section: &str, key: &str) -> Option<usize> {
+pub fn key_line(text: &str, section: &str, key: &str) -> Option<usize> {
     let mut current = String::new();
     for (i, raw) in text.lines().enumerate() {
         let line = raw.trim();
@@ -259,7 +259,7 @@ pub(crate) fn key_line(text: &str, section: &str, key: &str) -> Option<usize> {
 }
 
 /// The line (1-based) of the table `[section]` or of the first key `section.…`.
-pub(crate) fn section_line(text: &str, section: &str) -> Option<usize> {
+pub fn section_line(text: &str, section: &str) -> Option<usize> {
     text.lines()
         .position(|raw| {
             let line = raw.trim();
@@ -285,7 +285,7 @@ fn nearest(given: &str) -> Option<String> {
 }
 
 /// Of `names`, the one nearest `given`, if a few edits away.
-pub(crate) fn nearest_in(given: &str, names: impl IntoIterator<Item = String>) -> Option<String> {
+pub fn nearest_in(given: &str, names: impl IntoIterator<Item = String>) -> Option<String> {
     let (d, best) = names
         .into_iter()
         .map(|n| (edits(given, &n), n))

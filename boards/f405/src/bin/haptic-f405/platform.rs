@@ -1,0 +1,135 @@
+//! What differs between the board and QEMU, in one place (`board_qemu`, from build.rs):
+//! the clock tree, the timers' clock, the log's transport, the cycle counter that times
+//! the tick, and the ways out — a panic, a hard fault, the end of a QEMU run.
+//!
+//! - On the board: the HSE and the PLL (`BoardConfig`), the timers at the HAL's
+//!   clocks, defmt over RTT, the DWT cycle counter, `panic-probe` (a panic logs and
+//!   stops the core at a breakpoint).
+//! - In QEMU (`netduinoplus2`, which models no RCC: an HSE or PLL never reports ready):
+//!   the reset clock (HSI, 16 MHz), the timers at QEMU's 1 GHz, defmt over
+//!   semihosting, SysTick free-running at the core clock as the cycle counter (QEMU
+//!   models no DWT cycle counter: it reads 0; under `-icount` SysTick counts
+//!   instructions), and every way out exits QEMU through semihosting.
+
+use haptic_f405::config::{self, BOARD};
+use stm32f4xx_hal::prelude::*;
+use stm32f4xx_hal::rcc::{Clocks, Rcc};
+
+#[cfg(not(board_qemu))]
+use defmt_rtt as _;
+#[cfg(board_qemu)]
+use defmt_semihosting as _;
+#[cfg(not(board_qemu))]
+use panic_probe as _;
+
+/// The clock tree: the board's from its crystal; QEMU's reset clock.
+pub fn clocks(rcc: Rcc) -> Clocks {
+    if cfg!(board_qemu) {
+        rcc.cfgr.freeze()
+    } else {
+        rcc.cfgr
+            .use_hse(BOARD.hse_hz.Hz())
+            .sysclk(BOARD.sysclk_hz.Hz())
+            .freeze()
+    }
+}
+
+/// The clock of TIM2, the tick's timer.
+pub fn timer_clock(clocks: &Clocks) -> u32 {
+    if cfg!(board_qemu) {
+        config::QEMU_TIMER_CLOCK_HZ
+    } else {
+        clocks.timclk1().raw()
+    }
+}
+
+/// Starts the counter [`cycles`] reads.
+pub fn start_cycle_counter(cp: &mut cortex_m::Peripherals) {
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
+    if cfg!(board_qemu) {
+        use cortex_m::peripheral::syst::SystClkSource;
+        cp.SYST.set_clock_source(SystClkSource::Core);
+        cp.SYST.set_reload(0x00FF_FFFF);
+        cp.SYST.clear_current();
+        cp.SYST.enable_counter();
+    }
+}
+
+/// The cycle counter now: the DWT's, counting up; in QEMU SysTick's (24 bits, counting
+/// down at the core clock).
+pub fn cycles() -> u32 {
+    if cfg!(board_qemu) {
+        cortex_m::peripheral::SYST::get_current()
+    } else {
+        cortex_m::peripheral::DWT::cycle_count()
+    }
+}
+
+/// Cycles of [`cycles`] in one tick's period: the core clock's (QEMU's SysTick counts
+/// at the 168 MHz the machine models, whatever the clock tree says).
+pub fn tick_period_cycles(clocks: &Clocks) -> u32 {
+    let hz = if cfg!(board_qemu) {
+        168_000_000
+    } else {
+        clocks.sysclk().raw()
+    };
+    hz / BOARD.tick_hz
+}
+
+/// Cycles from `start` to `end` of [`cycles`].
+pub fn elapsed(start: u32, end: u32) -> u32 {
+    if cfg!(board_qemu) {
+        start.wrapping_sub(end) & 0x00FF_FFFF
+    } else {
+        end.wrapping_sub(start)
+    }
+}
+
+#[cfg(board_run_ends)]
+/// Cycles of the QEMU cycle counter as instructions: SysTick counts at 168 MHz, an
+/// instruction is 2^3 ns under `-icount shift=3`.
+pub fn qemu_instructions(cycles: u32) -> u32 {
+    (cycles as f32 * 1e9 / (168e6 * 8.0)) as u32
+}
+
+/// Stops after a start-up failure: on the board the motor pins stay at their safe
+/// levels, the watchdog and the tick never start; in QEMU, exit with failure.
+pub fn stop() -> ! {
+    if cfg!(board_qemu) {
+        exit(false)
+    }
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// QEMU exits through semihosting (0 on success); on the board, a breakpoint.
+pub fn exit(success: bool) -> ! {
+    #[cfg(board_qemu)]
+    {
+        use cortex_m_semihosting::debug;
+        debug::exit(if success {
+            debug::EXIT_SUCCESS
+        } else {
+            debug::EXIT_FAILURE
+        });
+    }
+    let _ = success;
+    loop {
+        cortex_m::asm::bkpt();
+    }
+}
+
+#[cfg(board_qemu)]
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    exit(false)
+}
+
+#[cfg(board_qemu)]
+#[cortex_m_rt::exception]
+unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    exit(false)
+}

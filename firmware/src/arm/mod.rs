@@ -1,0 +1,16 @@
+//! The arm in the firmware: the core's fixed-point chain ([`mccs::Arm`]) as the tick's
+//! device, with what surrounds it.
+//!
+//! - [`device`]: a 3-DOF arm as a [`crate::HapticDevice`] — three joints (a counter, a
+//!   PWM channel and a direction pin each), a driver enable and a home input — with its
+//!   homing and safe state, and the WoodenHaptics constant;
+//! - [`encoder`]: a joint's quadrature counter, carried past its 16 bits;
+//! - [`sim`]: the arm's chain on a recorded motion (the demo on the arm);
+//! - [`plant`]: a simulated arm behind the board's own parts (the board's `sim` build);
+//! - [`float`]: the same chain in `f32`, the bench's peer.
+
+pub mod device;
+pub mod encoder;
+pub mod float;
+pub mod plant;
+pub mod sim;

@@ -1,0 +1,183 @@
+//! [`TissuePose`]: where a tissue lies in the device's frame — its origin and rotation —
+//! and how the tick moves it toward where a host asked, at bounded speed, in fixed
+//! point: a point `p` of the tissue's frame is at `origin + R p` in the device's frame,
+//! so the probe is read into the tissue's frame as `Rᵀ (probe − origin)` and the force
+//! the tissue returns is rendered as `R f`. A tilted organ surface then pushes along its
+//! own normal.
+//!
+//! Per tick ([`TissuePose::step`]): each axis of the origin moves toward its target by
+//! at most the step a tick allows (the speed limit, per axis); the rotation's unit
+//! quaternion moves toward its target by at most the chord a tick allows (a rotation of
+//! `θ` is a chord of `2 sin(θ/4)` between unit quaternions), then is renormalised (two
+//! Newton steps: within 1e-13 of unit), and the matrix is rebuilt from it. No division,
+//! one reciprocal square root ([`crate::q`]'s, 2e-8) when the rotation moves, none when
+//! it holds; the unrotated pose skips the matrix.
+//!
+//! Formats: origin Q24 mm, quaternion and matrix Q30, forces Q20 N.
+
+use crate::q::{self, V3};
+use crate::units::{Force, Length, LEN_FRAC};
+
+/// A quaternion's or the matrix's fraction bits.
+pub const QUAT_FRAC: u32 = 30;
+const ONE: i32 = 1 << QUAT_FRAC;
+const IDENTITY_Q: [i32; 4] = [ONE, 0, 0, 0];
+const IDENTITY_R: [[i32; 3]; 3] = [[ONE, 0, 0], [0, ONE, 0], [0, 0, ONE]];
+
+/// Whether `q` (Q30) is a unit quaternion within 2⁻¹⁰ of its squared norm: what a pose
+/// from a host must be (the tick renormalises what it slews, not what it is sent).
+pub fn is_unit(q: [i32; 4]) -> bool {
+    let n2: i64 = q.iter().map(|&c| c as i64 * c as i64).sum();
+    (n2 - (1i64 << 60)).abs() <= 1i64 << 50
+}
+
+/// A tissue's pose in the device's frame, moving toward a target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TissuePose {
+    origin: V3,
+    target_origin: V3,
+    q: [i32; 4],
+    target_q: [i32; 4],
+    r: [[i32; 3]; 3],
+    rotated: bool,
+    /// The largest move of each axis of the origin a tick, Q24 mm.
+    max_step: i32,
+    /// The largest chord between the quaternion before and after a tick, Q30.
+    max_chord: i32,
+}
+
+impl TissuePose {
+    /// At the device's origin, unrotated; moving at most `speed_mm_s` per axis and
+    /// `turn_deg_s` at `tick_hz` (start-up: `f64`).
+    pub fn new(speed_mm_s: f64, turn_deg_s: f64, tick_hz: f64) -> Self {
+        let step = crate::units::from_f64(speed_mm_s / tick_hz, LEN_FRAC).max(1);
+        let theta = (turn_deg_s / tick_hz).to_radians();
+        let chord = crate::units::from_f64(2.0 * libm::sin(theta / 4.0), QUAT_FRAC).max(1);
+        Self {
+            origin: [0; 3],
+            target_origin: [0; 3],
+            q: IDENTITY_Q,
+            target_q: IDENTITY_Q,
+            r: IDENTITY_R,
+            rotated: false,
+            max_step: step,
+            max_chord: chord,
+        }
+    }
+
+    /// Where to move: an origin (Q24 mm) and a unit quaternion (Q30, [`is_unit`]: the
+    /// caller checks it). The nearer of `q` and `−q` (the same rotation) is taken.
+    pub fn set_target(&mut self, origin: V3, rotation: [i32; 4]) {
+        self.target_origin = origin;
+        let dot: i64 = (0..4).map(|k| self.q[k] as i64 * rotation[k] as i64).sum();
+        self.target_q = if dot < 0 {
+            rotation.map(|c| c.saturating_neg())
+        } else {
+            rotation
+        };
+    }
+
+    /// The origin now, Q24 mm.
+    pub fn origin(&self) -> V3 {
+        self.origin
+    }
+
+    /// The rotation now, Q30.
+    pub fn rotation(&self) -> [i32; 4] {
+        self.q
+    }
+
+    /// Whether the pose has reached its target.
+    pub fn settled(&self) -> bool {
+        self.origin == self.target_origin && self.q == self.target_q
+    }
+
+    /// One tick's move toward the target.
+    pub fn step(&mut self) {
+        for k in 0..3 {
+            let d = self.target_origin[k].saturating_sub(self.origin[k]);
+            // (Not `clamp`, which asserts its bounds: a panic path in the tick.)
+            self.origin[k] =
+                self.origin[k].saturating_add(d.max(-self.max_step).min(self.max_step));
+        }
+        if self.q == self.target_q {
+            return;
+        }
+        let d: [i32; 4] = core::array::from_fn(|k| self.target_q[k].saturating_sub(self.q[k]));
+        let d2: i64 = d.iter().map(|&c| c as i64 * c as i64).sum();
+        let s = self.max_chord as i64;
+        if d2 <= s * s {
+            self.q = self.target_q;
+        } else {
+            // λ = s / |d| in Q30 (below 1): s · y · 2^(e/2 − 62) · 2^30.
+            let (y, e) = q::rsqrt(d2);
+            let lambda = ((self.max_chord as u64 * y as u64) >> (32 - e / 2)) as i64;
+            for k in 0..4 {
+                let m = (d[k] as i64 * lambda) >> QUAT_FRAC;
+                self.q[k] = self.q[k].saturating_add(m as i32);
+            }
+            // A step moves the quaternion up to `s sin(β/2)` inside the sphere (β its arc
+            // to the target): n² within 1 − 2 s; two Newton steps bring it within 1e-13.
+            self.renormalise();
+            self.renormalise();
+        }
+        self.rebuild();
+    }
+
+    /// `q ← q (3 − |q|²)/2`: one Newton step toward unit length.
+    fn renormalise(&mut self) {
+        let n2: i64 = self.q.iter().map(|&c| c as i64 * c as i64).sum();
+        let f = ((3i64 << 60) - n2) >> (QUAT_FRAC + 1);
+        self.q = self.q.map(|c| ((c as i64 * f) >> QUAT_FRAC) as i32);
+    }
+
+    /// The matrix of the quaternion now.
+    fn rebuild(&mut self) {
+        let [w, x, y, z] = self.q;
+        // 2ab in Q30: a b / 2²⁹.
+        let p = |a: i32, b: i32| ((a as i64 * b as i64) >> (QUAT_FRAC - 1)) as i32;
+        let one = ONE;
+        self.r = [
+            [
+                one - p(y, y) - p(z, z),
+                p(x, y) - p(w, z),
+                p(x, z) + p(w, y),
+            ],
+            [
+                p(x, y) + p(w, z),
+                one - p(x, x) - p(z, z),
+                p(y, z) - p(w, x),
+            ],
+            [
+                p(x, z) - p(w, y),
+                p(y, z) + p(w, x),
+                one - p(x, x) - p(y, y),
+            ],
+        ];
+        self.rotated = self.q != IDENTITY_Q;
+    }
+
+    /// A point of the device's frame in the tissue's: `Rᵀ (p − origin)`.
+    pub fn to_tissue(&self, p: [Length; 3]) -> [Length; 3] {
+        let d: V3 = core::array::from_fn(|k| p[k].to_bits().saturating_sub(self.origin[k]));
+        if !self.rotated {
+            return d.map(Length::from_bits);
+        }
+        core::array::from_fn(|i| {
+            let s: i64 = (0..3).map(|j| self.r[j][i] as i64 * d[j] as i64).sum();
+            Length::from_bits(q::sat(s >> QUAT_FRAC))
+        })
+    }
+
+    /// A force of the tissue's frame in the device's: `R f`.
+    pub fn to_device(&self, f: [Force; 3]) -> [Force; 3] {
+        if !self.rotated {
+            return f;
+        }
+        let b = f.map(Force::to_bits);
+        core::array::from_fn(|i| {
+            let s: i64 = (0..3).map(|j| self.r[i][j] as i64 * b[j] as i64).sum();
+            Force::from_bits(q::sat(s >> QUAT_FRAC))
+        })
+    }
+}
