@@ -28,6 +28,8 @@ for target in $(sed -n 's/^name = "\(.*\)"$/\1/p' fuzz/Cargo.toml | grep -v mccs
   echo "fuzz.sh: building and running $target for $seconds s" >&2
   log="target/fuzz/$target.log"
   mkdir -p "fuzz/corpus/$target"
+  # The committed inputs start every corpus (the test command runs them too).
+  cp -n fuzz/seeds/"$target"/* "fuzz/corpus/$target/" 2>/dev/null || true
   rc=0
   run_stage "$target" fuzz_one "$target" || rc=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)

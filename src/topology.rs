@@ -334,8 +334,13 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
 
     /// Rest length of edge `e` (mm), from its stored `1/l0`.
     pub fn rest_length(e: &Edge) -> f64 {
-        (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64
+        rest_length(e)
     }
+}
+
+/// An edge's rest length, mm, from its `1 / l0` (start-up: `f64`).
+pub fn rest_length(e: &Edge) -> f64 {
+    (1u64 << INV_LEN_FRAC) as f64 / e.inv_len as f64
 }
 
 /// The springs of a [`Topology`] with their rest geometry open to rewriting and their ends

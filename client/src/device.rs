@@ -20,12 +20,13 @@
 use crate::error::Error;
 use crate::mesh::Mesh;
 use crate::session::{worker, Session};
+pub use crate::telemetry::TelemetrySample;
 use crate::tissue::Tissue;
 use crate::transport;
 use crate::Addr;
 use mccs_link::{
-    scale, FaultReason, Flags, HelloInfo, Pose, StatusInfo, Telemetry, TissueBegin, ToDevice,
-    ToHost, PROTOCOL, SCHEMA, TISSUE_CHUNK,
+    scale, HelloInfo, Pose, StatusInfo, TissueBegin, ToDevice, ToHost, PROTOCOL, SCHEMA,
+    TISSUE_CHUNK,
 };
 use std::fmt;
 use std::sync::mpsc::Receiver;
@@ -238,55 +239,6 @@ impl fmt::Display for Status {
     }
 }
 
-/// A live tick, in units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TelemetrySample {
-    /// Counts telemetry messages: a gap is a drop.
-    pub seq: u32,
-    /// The device's tick.
-    pub tick: u32,
-    /// When it arrived, since the session opened.
-    pub received: Duration,
-    /// The probe in the tissue's frame, mm.
-    pub probe_mm: [f64; 3],
-    /// The force rendered in the device's frame, N.
-    pub force_n: [f64; 3],
-    /// The link's gain, 0 … 1.
-    pub gain: f64,
-    /// The tick's flags.
-    pub flags: Flags,
-    /// Why the device is in its safe state (`None` when not).
-    pub fault: FaultReason,
-    /// The joints' duties, −1 … 1 of full scale.
-    pub duties: [f64; 3],
-    /// The proxy in the tissue's frame, mm (with [`Flags::CONTACT`] on a roaming device).
-    pub proxy_mm: [f64; 3],
-    /// The window's origin in the tissue's frame, mm.
-    pub window_mm: [f64; 2],
-    /// Telemetry the device dropped so far.
-    pub dropped: u32,
-}
-
-impl TelemetrySample {
-    /// From the message, received at `received`.
-    pub fn from_raw(t: &Telemetry, received: Duration) -> Self {
-        Self {
-            seq: t.seq,
-            tick: t.tick,
-            received,
-            probe_mm: t.probe.map(scale::mm),
-            force_n: t.force.map(scale::newtons),
-            gain: scale::gain(t.gain),
-            flags: t.flags,
-            fault: t.fault,
-            duties: t.duties.map(scale::duty),
-            proxy_mm: t.proxy.map(scale::mm),
-            window_mm: t.window.map(scale::mm),
-            dropped: t.dropped,
-        }
-    }
-}
-
 /// A session with a device.
 pub struct Device {
     session: Arc<Session>,
@@ -485,7 +437,9 @@ impl Device {
     /// [`Device::load_tissue`] with what it proposes.
     pub fn load_tissue_proposing(&self, tissue: &Tissue, proposal: Proposal) -> Result<u32, Error> {
         let substeps = match proposal {
-            Proposal::Computed => crate::substeps::for_device(&self.info, tissue).unwrap_or(0),
+            Proposal::Computed => {
+                crate::substeps::for_device(&self.info.hello, tissue).unwrap_or(0)
+            }
             Proposal::None => 0,
             Proposal::Substeps(n) => n as u32,
         };

@@ -35,6 +35,7 @@ pub mod paramfile;
 pub mod replay;
 mod session;
 pub mod substeps;
+pub mod telemetry;
 pub mod tissue;
 pub mod trajectory;
 mod transport;

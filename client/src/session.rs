@@ -8,8 +8,8 @@
 
 use crate::error::{Error, Refusal};
 use crate::mesh::{Mesh, MeshAssembly};
+use crate::telemetry::TelemetrySample;
 use crate::transport::{Reader, Writer};
-use crate::TelemetrySample;
 use mccs_link::{encode, parse, Decoder, ToDevice, ToHost, MAX_FRAME};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -4,14 +4,12 @@
 //! checks them with two runs of its linearised patch instead of searching with ten
 //! (docs/protocol.md, "Tissue loads"). The device decides either way.
 
-use crate::device::Info;
 use crate::tissue::Tissue;
 use mccs::{Coupling, ForceTable, Integrator, SolverConfig, Topology};
-use mccs_link::table_bytes;
+use mccs_link::{table_bytes, HelloInfo};
 
 /// The solver configuration a device runs, from its hello.
-pub fn config_of(info: &Info) -> SolverConfig {
-    let h = &info.hello;
+pub fn config_of(h: &HelloInfo) -> SolverConfig {
     SolverConfig {
         tick_hz: h.tick_hz as f64,
         node_mass: h.solver.node_mass_kg,
@@ -32,13 +30,13 @@ pub fn config_of(info: &Info) -> SolverConfig {
     }
 }
 
-/// The substeps `tissue` needs on the device `info` describes; `None` where they cannot
-/// be computed here (a patch or table size this client does not hold, or the solver
-/// refuses: the device then says why).
-pub fn for_device(info: &Info, tissue: &Tissue) -> Option<u32> {
-    let config = config_of(info);
-    let grid = info.hello.grid as usize;
-    let spacing = mccs_link::scale::mm(info.hello.spacing);
+/// The substeps `tissue` needs on the device its hello describes; `None` where they
+/// cannot be computed here (a patch or table size this client does not hold, or the
+/// solver refuses: the device then says why).
+pub fn for_device(hello: &HelloInfo, tissue: &Tissue) -> Option<u32> {
+    let config = config_of(hello);
+    let grid = hello.grid as usize;
+    let spacing = mccs_link::scale::mm(hello.spacing);
     macro_rules! on_grid {
         ($($n:literal),*) => {
             match grid {

@@ -7,6 +7,7 @@
 pub mod arm;
 pub mod cli;
 pub mod fit;
+pub mod fuzz_checks;
 pub mod link;
 pub mod patch;
 pub mod reference;

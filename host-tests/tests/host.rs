@@ -32,6 +32,8 @@ mod docs;
 mod fit;
 #[path = "float_patch.rs"]
 mod float_patch;
+#[path = "fuzz_inputs.rs"]
+mod fuzz_inputs;
 #[path = "link/mod.rs"]
 mod link;
 #[path = "patch.rs"]

@@ -3,7 +3,7 @@
 //! patch's nodes, for the visuals).
 
 use crate::flags::Flags;
-use crate::message::{Friction, Pose};
+use crate::tissue::{Friction, Pose};
 use postcard_schema::Schema;
 use serde::{Deserialize, Serialize};
 

@@ -2,8 +2,9 @@
 //! other (docs/protocol.md is the normative page; docs/link.md the how-to). `no_std`, no
 //! heap: the firmware, the host's client and the CLI share this crate.
 //!
-//! - [`message`]: the messages, [`ToDevice`] and [`ToHost`], and the small types they
-//!   carry ([`Pose`], [`Friction`], [`TissueBegin`]);
+//! - [`message`]: the messages, [`ToDevice`] and [`ToHost`];
+//! - [`tissue`]: what a host says about a tissue ([`Pose`], [`Friction`],
+//!   [`TissueBegin`]);
 //! - [`info`]: what the device tells of itself: hello, status, telemetry, mesh;
 //! - [`nak`]: why it refuses; [`flags`]: a live tick's flags;
 //! - [`frame`]: a message on the wire — postcard bytes, a CRC-32 over them, COBS with a
@@ -30,6 +31,7 @@ pub mod replay;
 pub mod scale;
 pub mod schema;
 pub mod table_bytes;
+pub mod tissue;
 pub mod tissue_file;
 
 pub use flags::Flags;
@@ -38,7 +40,8 @@ pub use info::{
     ContactKind, Core, DeviceKind, FaultReason, HelloInfo, MeshPart, SolverInfo, StatusInfo,
     Telemetry, MESH_PART,
 };
-pub use message::{Friction, Pose, TissueBegin, ToDevice, ToHost, TISSUE_CHUNK};
+pub use message::{ToDevice, ToHost};
 pub use nak::{NakReason, SpecOption};
 pub use replay::{PathPoint, ReplayRow, ReplaySpec, RoamSpec};
 pub use schema::{PROTOCOL, SCHEMA};
+pub use tissue::{Friction, Pose, TissueBegin, TISSUE_CHUNK};

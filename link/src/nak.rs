@@ -7,32 +7,32 @@ use serde::{Deserialize, Serialize};
 /// Why the device refused.
 #[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NakReason {
-    /// 0. A replay, a load or a tissue check is under way.
+    /// (0) A replay, a load or a tissue check is under way.
     Busy,
-    /// 1. A chunk out of order, or a commit without a begin.
+    /// (1) A chunk out of order, or a commit without a begin.
     Order,
-    /// 2. The bytes received are not the length announced, or not a table's.
+    /// (2) The bytes received are not the length announced, or not a table's.
     Length,
-    /// 3. The bytes' hash is not the one announced.
+    /// (3) The bytes' hash is not the one announced.
     Hash,
-    /// 4. The table has another knot count than the device's.
+    /// (4) The table has another knot count than the device's.
     Segments,
-    /// 5. The table's own check refused it (`ForceTable::validate`).
+    /// (5) The table's own check refused it (`ForceTable::validate`).
     Table,
-    /// 6. Its recorded error is over the product's bound, or unmeasured.
+    /// (6) Its recorded error is over the product's bound, or unmeasured.
     Bound,
-    /// 7. The solver refused it on the device's patch (its substeps or coefficients).
+    /// (7) The solver refused it on the device's patch (its substeps or coefficients).
     Solver,
-    /// 8. A replay without a tissue.
+    /// (8) A replay without a tissue.
     NoTissue,
-    /// 9. A replay asks for more than the device holds: the option, and its limit.
+    /// (9) A replay asks for more than the device holds: the option, and its limit.
     Option {
         /// The option at fault.
         option: SpecOption,
         /// The device's limit for it.
         limit: i32,
     },
-    /// 10. The tissue's tick would pass the device's budget: `substeps` substeps cost
+    /// (10) The tissue's tick would pass the device's budget: `substeps` substeps cost
     /// `instructions` against `budget` (instructions a tick).
     Budget {
         /// Substeps the tissue needs.
@@ -42,15 +42,15 @@ pub enum NakReason {
         /// The device's budget.
         budget: u32,
     },
-    /// 11. The host's substeps are not stable on the device's patch with the margin the
+    /// (11) The host's substeps are not stable on the device's patch with the margin the
     /// device keeps (its own check of them failed).
     Stability {
         /// The substeps the host proposed.
         substeps: u16,
     },
-    /// 12. Friction coefficients above 2, or `mu_k > mu_s`.
+    /// (12) Friction coefficients above 2, or `mu_k > mu_s`.
     Friction,
-    /// 13. A pose whose origin is outside the workspace: the axis (0 = x) and the limit
+    /// (13) A pose whose origin is outside the workspace: the axis (0 = x) and the limit
     /// it passed (Q24 mm).
     Pose {
         /// 0, 1, 2: x, y, z.
@@ -58,7 +58,7 @@ pub enum NakReason {
         /// The workspace's bound on that axis, Q24 mm.
         limit: i32,
     },
-    /// 14. A pose whose rotation is not a unit quaternion (within 2⁻¹⁰).
+    /// (14) A pose whose rotation is not a unit quaternion (within 2⁻¹⁰).
     Rotation,
 }
 

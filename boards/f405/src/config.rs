@@ -18,6 +18,8 @@ pub const TICK_COUNTER_HZ: u32 = 1_000_000;
 pub const QEMU_TIMER_CLOCK_HZ: u32 = 1_000_000_000;
 /// The STM32F405's APB2 limit, Hz (SPI1's clock, TIM1's at ×2).
 pub const PCLK2_MAX_HZ: u32 = 84_000_000;
+/// Grid spacing of the patch and the tissue, mm.
+pub const SPACING_MM: f64 = 2.5;
 /// The STM32F405's APB1 limit, Hz (TIM2's clock at ×2).
 pub const PCLK1_MAX_HZ: u32 = 42_000_000;
 
@@ -394,17 +396,20 @@ impl BoardConfig {
             return Err(E::Link);
         }
         let [lo, hi] = self.workspace_mm;
-        let half_w = (self.tissue_nodes[0] / 2) as f64 * crate::device::SPACING_MM;
-        let half_h = (self.tissue_nodes[1] / 2) as f64 * crate::device::SPACING_MM;
+        let half_w = (self.tissue_nodes[0] / 2) as f64 * SPACING_MM;
+        let half_h = (self.tissue_nodes[1] / 2) as f64 * SPACING_MM;
         let in_range = |x: f64| x.is_finite() && x.abs() <= 100.0;
-        if !(0..3).all(|k| in_range(lo[k]) && in_range(hi[k]) && lo[k] <= hi[k])
-            || !(self.grid..=64).contains(&self.tissue_nodes[0])
-            || !(self.grid..=64).contains(&self.tissue_nodes[1])
-            || half_w > 100.0
-            || half_h > 100.0
-            || !(self.mu_s.is_finite() && self.mu_k.is_finite())
-            || !(0.0 <= self.mu_k && self.mu_k <= self.mu_s && self.mu_s <= 2.0)
-        {
+        let workspace = (0..3).all(|k| in_range(lo[k]) && in_range(hi[k]) && lo[k] <= hi[k]);
+        let sides = (self.grid..=64).contains(&self.tissue_nodes[0])
+            && (self.grid..=64).contains(&self.tissue_nodes[1])
+            && half_w <= 100.0
+            && half_h <= 100.0;
+        let friction = self.mu_s.is_finite()
+            && self.mu_k.is_finite()
+            && 0.0 <= self.mu_k
+            && self.mu_k <= self.mu_s
+            && self.mu_s <= 2.0;
+        if !(workspace && sides && friction) {
             return Err(E::Tissue);
         }
         if self.tick_budget == 0

@@ -28,8 +28,7 @@ pub const MAX_GRID: usize = 8;
 pub const NODES: usize = mccs::topology::standard_capacity(MAX_GRID).0;
 /// Springs of the N = 8 patch.
 pub const EDGES: usize = mccs::topology::standard_capacity(MAX_GRID).1;
-/// Grid spacing of the patch, mm.
-pub const SPACING_MM: f64 = 2.5;
+pub use crate::config::SPACING_MM;
 
 /// The board's device on these parts.
 pub type BoardDevice<SPI, PWM, DIR, EN> = OneDofDevice<SPI, PWM, DIR, EN>;

@@ -29,10 +29,13 @@ impl TickBudget {
 
     /// The most substeps within the budget.
     pub const fn most_substeps(&self) -> u32 {
-        if self.per_substep == 0 {
-            u32::MAX
-        } else {
-            self.tick.saturating_sub(self.base) / self.per_substep
+        match self
+            .tick
+            .saturating_sub(self.base)
+            .checked_div(self.per_substep)
+        {
+            Some(n) => n,
+            None => u32::MAX,
         }
     }
 }

@@ -24,7 +24,8 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, [f64; 3])>, String> {
         Some(h) if h == header => {}
         Some(h) => {
             return Err(format!(
-                "{file}: row 1: the header must be `{header}`, not `{h}`"
+                "{file}: row 1: the header must be `{header}`, not `{}`",
+                h.escape_debug()
             ))
         }
         None => return Err(format!("{file}: empty file")),

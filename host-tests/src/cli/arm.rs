@@ -58,7 +58,8 @@ fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
         Some(h) if h == want => {}
         Some(h) => {
             return Err(CliError::new(format!(
-                "{file}: row 1: the header must be `{want}`, not `{h}`"
+                "{file}: row 1: the header must be `{want}`, not `{}`",
+                h.escape_debug()
             )))
         }
         None => return Err(CliError::new(format!("{file}: empty file"))),

@@ -80,7 +80,9 @@ pub fn parse_data_noted(text: &str, file: &str) -> Result<(Vec<Point>, Option<St
             Some(1),
             format!(
                 "the header must be `strain,force_n`, not `{}`",
-                found.join(",")
+                // (Escaped: a quoted field may hold a line break, and the error is one
+                // line.)
+                found.join(",").escape_debug()
             ),
         ));
     }

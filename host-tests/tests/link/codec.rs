@@ -306,3 +306,45 @@ proptest! {
         prop_assert_eq!(table_bytes::hash(&t), table_bytes::hash_bytes(&bytes));
     }
 }
+
+/// The link's fuzz target starts from every message's frame, and a whole tissue load
+/// (`fuzz/seeds/link_device/`, written by `MCCS_UPDATE_SEEDS=1`).
+#[test]
+fn the_link_fuzz_seeds_are_every_message() {
+    let mut every = Vec::new();
+    for (_, m) in to_device() {
+        every.extend(frame_of(&m));
+    }
+    let t = mccs_client::Tissue::from_params(&mccs::Params::TABLE2).unwrap();
+    let mut load = frame_of(&ToDevice::TissueBegin(TissueBegin {
+        segments: 64,
+        len: t.bytes().len() as u32,
+        hash: t.hash(),
+        friction: None,
+        substeps: 0,
+    }));
+    for (i, c) in t.bytes().chunks(TISSUE_CHUNK).enumerate() {
+        load.extend(frame_of(&ToDevice::TissueChunk {
+            offset: (i * TISSUE_CHUNK) as u32,
+            bytes: c,
+        }));
+    }
+    load.extend(frame_of(&ToDevice::TissueCommit));
+    let dir = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzz/seeds/link_device"
+    ));
+    for (name, bytes) in [("every-message", every), ("tissue-load", load)] {
+        let path = dir.join(name);
+        if std::env::var("MCCS_UPDATE_SEEDS").as_deref() == Ok("1") {
+            std::fs::create_dir_all(dir).unwrap();
+            std::fs::write(&path, &bytes).unwrap();
+        }
+        assert_eq!(
+            std::fs::read(&path).ok(),
+            Some(bytes),
+            "{} is not the messages' frames (MCCS_UPDATE_SEEDS=1)",
+            path.display()
+        );
+    }
+}

@@ -476,22 +476,32 @@ fn silence(addr: &str) {
     };
     send(&mut s, &ToDevice::Watch { every: 1 });
     send(&mut s, &ToDevice::Arm);
-    let mut last_tick = 0;
     let start = Instant::now();
     while start.elapsed() < Duration::from_millis(300) {
         send(&mut s, &ToDevice::Keepalive);
-        for m in recv(&mut s) {
-            if let ToHost::Telemetry(t) = m {
-                last_tick = t.tick;
-            }
-        }
+        recv(&mut s);
         std::thread::sleep(Duration::from_millis(10));
     }
-    // Silent from here: the last frame reached the device at or after `last_tick`.
+    // The last frame: a status, whose answer says the tick the device took it on.
+    send(&mut s, &ToDevice::Status);
     let deadline = Instant::now() + Duration::from_secs(20);
+    let mut last_tick = None;
+    let mut pending = Vec::new();
+    while last_tick.is_none() {
+        assert!(Instant::now() < deadline, "no status");
+        for m in recv(&mut s) {
+            match m {
+                ToHost::Status(st) => last_tick = Some(st.ticks),
+                m => pending.push(m),
+            }
+        }
+    }
+    let last_tick = last_tick.unwrap_or(0);
     let zero_at = loop {
         assert!(Instant::now() < deadline, "the gain never reached zero");
-        let found = recv(&mut s).into_iter().find_map(|m| match m {
+        let mut got = std::mem::take(&mut pending);
+        got.extend(recv(&mut s));
+        let found = got.into_iter().find_map(|m| match m {
             ToHost::Telemetry(t)
                 if t.tick > last_tick && t.gain == 0 && !t.flags.contains(Flags::ARMED) =>
             {

@@ -7,7 +7,7 @@ use super::most_damping;
 use crate::arith::Integrator;
 use crate::q;
 use crate::solver::SolverConfig;
-use crate::topology::{Topology, GROUND};
+use crate::topology::{Edge, Topology, GROUND};
 use crate::units::DIR_FRAC;
 
 /// Steps of each run of the linearised step ([`Linearised::growth`]). At 768, a lightly
@@ -131,27 +131,13 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     pub(super) fn new(topo: &'a Topology<NODES, EDGES>, k_max: f64, config: &SolverConfig) -> Self {
         let mut springs = [0.0f32; EDGES];
         let mut row = [(0.0f32, 0u32); NODES];
-        for (s, e) in springs.iter_mut().zip(topo.edges()) {
-            *s = (k_max / Topology::<NODES, EDGES>::rest_length(e)) as f32;
-            for end in [e.a, e.b] {
-                if let Some(r) = row.get_mut(end as usize).filter(|_| end != GROUND) {
-                    *r = (r.0 + *s, r.1 + 1);
-                }
-            }
-        }
-        // (Compares, not `f32::max`: a library call on the M4F.)
-        let (mut k_spring, mut k_row, mut degree) = (0.0f32, 0.0f32, 0);
-        for &k in &springs[..topo.edges().len().min(EDGES)] {
-            if k > k_spring {
-                k_spring = k;
-            }
-        }
-        for r in &row[..topo.node_count().min(NODES)] {
-            if r.0 > k_row {
-                k_row = r.0;
-            }
-            degree = degree.max(r.1);
-        }
+        let (k_spring, k_row, degree) = spring_rows(
+            topo.edges(),
+            topo.node_count().min(NODES),
+            k_max,
+            &mut springs,
+            &mut row,
+        );
         Self {
             topo,
             springs,
@@ -272,121 +258,45 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// Runs up to `steps` more steps of `run`; its growth once it has run all
     /// [`RUN_STEPS`] (infinite where a step overflowed), `None` before.
     pub(super) fn advance(&self, run: &mut Run<NODES, EDGES>, steps: u32) -> Option<f32> {
-        let n = self.topo.node_count().min(NODES);
-        let c = self.topo.contact() as usize;
-        let Run {
-            x,
-            v,
-            kappa,
-            chi,
-            chi_node,
-            kappa_c,
-            chi_c,
-            g,
-            h: hf,
-            symplectic,
-            step: done,
-            exp,
-            at_window,
-        } = run;
-        let (chi, chi_node, kappa_c, chi_c, g, hf, symplectic) =
-            (*chi, *chi_node, *kappa_c, *chi_c, *g, *hf, *symplectic);
-        let last = (*done).saturating_add(steps as usize).min(RUN_STEPS);
-        while *done < last {
-            if *done == RUN_STEPS - RUN_WINDOW {
-                *at_window = (self.energy(x, v, hf, g), *exp);
+        let k = StepCoeffs {
+            chi: run.chi,
+            chi_node: run.chi_node,
+            kappa_c: run.kappa_c,
+            chi_c: run.chi_c,
+            g: run.g,
+            symplectic: run.symplectic,
+            n: self.topo.node_count().min(NODES),
+            contact: self.topo.contact() as usize,
+        };
+        let last = run.step.saturating_add(steps as usize).min(RUN_STEPS);
+        let mut dv = [[0i32; 3]; NODES];
+        while run.step < last {
+            if run.step == RUN_STEPS - RUN_WINDOW {
+                run.at_window = (self.energy(&run.x, &run.v, run.h, run.g), run.exp);
             }
-            *done += 1;
-            let mut dv = [[0i32; 3]; NODES];
-            // (Slot 0 is the ground: its state stays zero, and what its springs add to
-            // its velocity change is never read.) With components within ±2^STATE_BITS
-            // (2²¹) the extension is within 2^23.6, so a spring's stretch and push are
-            // within `κ` · 2^23.6 < 2^28.6 and its damping within `χ` · 2²² < 2²⁷; a
-            // node's sum, within its row's 64 · 2^23.6, fits an `i32`. Each product is
-            // a high word (`⌊a b / 2³²⌋`, exact) with its operands shifted up within
-            // 2³¹: `along · κ / 2²⁴`, `stretch · d / 2²³`, `ΔV · χ / 2²⁴`.
-            const _: () = assert!(COEFF_FRAC == 24 && DIR_FRAC == 23 && STATE_BITS == 21);
-            for (e, &k) in self.topo.edges().iter().zip(kappa.iter()) {
-                let (a, b) = (e.a as usize, e.b as usize);
-                let (Some(xa), Some(xb), Some(va), Some(vb)) =
-                    (x.get(a), x.get(b), v.get(a), v.get(b))
-                else {
-                    continue;
-                };
-                let stretch = mulhi(along(xa, xb, &e.dir) << 7, k << 1);
-                let on_a: [i32; 3] = core::array::from_fn(|j| {
-                    mulhi(stretch << 2, e.dir[j] << 7) + mulhi((vb[j] - va[j]) << 8, chi)
-                });
-                if let Some(da) = dv.get_mut(a) {
-                    for j in 0..3 {
-                        da[j] = da[j].wrapping_add(on_a[j]);
-                    }
-                }
-                if let Some(db) = dv.get_mut(b) {
-                    for j in 0..3 {
-                        db[j] = db[j].wrapping_sub(on_a[j]);
-                    }
-                }
-            }
-            let mut magnitude = 0u32;
-            for i in 1..n {
-                for j in 0..3 {
-                    let (xi, vi) = (x[i][j], v[i][j]);
-                    // The springs' change within 2^29.6 (their row), each node term within
-                    // 2²⁶ (`χ`, `κ` < 32 on components within 2²¹): all within `i32`, and
-                    // so are `V'`, `V + V'` and `X'` (below 2^30.5).
-                    let mut dvi = dv[i][j] - mulhi(vi << 8, chi_node);
-                    if i == c {
-                        dvi -= mulhi(xi << 8, kappa_c) + mulhi(vi << 8, chi_c);
-                    }
-                    let v_new = vi + dvi;
-                    // (`X` in half units of `V / 2^g`: the position step, rounded.)
-                    let step = if symplectic {
-                        2 * v_new as i64
-                    } else {
-                        vi as i64 + v_new as i64
-                    };
-                    let x_new = xi as i64 + ((step + ((1i64 << g) >> 1)) >> g);
-                    let grown = x_new.unsigned_abs() | v_new.unsigned_abs() as u64;
-                    if grown >= STATE_LIMIT {
-                        *done = RUN_STEPS;
-                        *at_window = (0.0, 0);
-                        return Some(f32::INFINITY);
-                    }
-                    x[i][j] = x_new as i32;
-                    v[i][j] = v_new;
-                    magnitude |= grown as u32;
-                }
-            }
-            // Renormalise: the largest component back into [2^(STATE_BITS − 2),
-            // 2^STATE_BITS) (only the growth matters).
-            // (Slot 0, the ground, stays zero either way.)
-            let bits = u32::BITS - magnitude.leading_zeros();
-            let up = if bits > STATE_BITS || (magnitude != 0 && bits < STATE_BITS - 1) {
-                (STATE_BITS - 1) as i32 - bits as i32
-            } else {
-                0
-            };
-            if up != 0 {
-                for (xi, vi) in x[..n].iter_mut().zip(v[..n].iter_mut()) {
-                    for j in 0..3 {
-                        (xi[j], vi[j]) = if up > 0 {
-                            (xi[j] << up, vi[j] << up)
-                        } else {
-                            (xi[j] >> -up, vi[j] >> -up)
-                        };
-                    }
-                }
-                *exp -= up;
+            run.step += 1;
+            let edges = self.topo.edges();
+            if !step_once(
+                edges,
+                &run.kappa,
+                &mut run.x,
+                &mut run.v,
+                &mut dv,
+                &k,
+                &mut run.exp,
+            ) {
+                run.step = RUN_STEPS;
+                run.at_window = (0.0, 0);
+                return Some(f32::INFINITY);
             }
         }
-        if *done < RUN_STEPS {
+        if run.step < RUN_STEPS {
             return None;
         }
-        let e = self.energy(x, v, hf, g);
-        let (e0, exp0) = *at_window;
+        let e = self.energy(&run.x, &run.v, run.h, run.g);
+        let (e0, exp0) = run.at_window;
         Some(if e0 > 0.0 {
-            libm::ldexpf(e / e0, 2 * (*exp - exp0))
+            libm::ldexpf(e / e0, 2 * (run.exp - exp0))
         } else {
             f32::INFINITY
         })
@@ -396,30 +306,213 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// `2^(2 exp)` of the state's exponent: elastic `½ Σ k ((x_b − x_a)·d)²` and the
     /// coupling's (N/mm · units²), kinetic `½ m (v/h)²` in the same unit.
     fn energy(&self, x: &[[i32; 3]; NODES], v: &[[i32; 3]; NODES], h: f32, g: u32) -> f32 {
-        let at = |i: u16| x.get(i as usize).copied().unwrap_or([0; 3]);
-        let mut elastic = 0.0f32;
-        for (e, k) in self.topo.edges().iter().zip(self.springs.iter()) {
-            let s = along(&at(e.a), &at(e.b), &e.dir) as f32;
-            elastic += 0.125 * k * s * s;
-        }
-        let n = self.topo.node_count().min(NODES);
-        let c = self.topo.contact() as usize;
-        // ½ m v² with m = 1000/per_mass kg and v = V/h: in N·mm per unit² (as the
-        // elastic part), 0.5e-3 m / h².
-        let w_v = 0.5 / (self.per_mass * h * h * (1u32 << (2 * g)) as f32);
-        let mut kinetic = 0.0f32;
-        for vi in &v[1..n] {
-            for c in vi {
-                kinetic += (*c as f32) * (*c as f32);
-            }
-        }
-        if let Some(xc) = x[..n].get(c).filter(|_| c != 0) {
-            for c in xc {
-                elastic += 0.125 * self.k_c * (*c as f32) * (*c as f32);
-            }
-        }
-        elastic + w_v * kinetic
+        energy_of(
+            self.topo.edges(),
+            &self.springs,
+            x,
+            v,
+            self.topo.node_count().min(NODES),
+            self.topo.contact() as usize,
+            self.k_c,
+            self.per_mass,
+            h,
+            g,
+        )
     }
+}
+
+/// Each spring's `k_max / l0` into `springs`, each node's sum of them and count into
+/// `row`; the stiffest spring, the largest node's sum and the most springs on a node
+/// (on slices: one copy for every capacity).
+#[inline(never)]
+fn spring_rows(
+    edges: &[Edge],
+    nodes: usize,
+    k_max: f64,
+    springs: &mut [f32],
+    row: &mut [(f32, u32)],
+) -> (f32, f32, u32) {
+    for (s, e) in springs.iter_mut().zip(edges) {
+        *s = (k_max / crate::topology::rest_length(e)) as f32;
+        for end in [e.a, e.b] {
+            if let Some(r) = row.get_mut(end as usize).filter(|_| end != GROUND) {
+                *r = (r.0 + *s, r.1 + 1);
+            }
+        }
+    }
+    // (Compares, not `f32::max`: a library call on the M4F.)
+    let (mut k_spring, mut k_row, mut degree) = (0.0f32, 0.0f32, 0);
+    for &k in springs.iter().take(edges.len()) {
+        if k > k_spring {
+            k_spring = k;
+        }
+    }
+    for r in row.iter().take(nodes) {
+        if r.0 > k_row {
+            k_row = r.0;
+        }
+        degree = degree.max(r.1);
+    }
+    (k_spring, k_row, degree)
+}
+
+/// A run's fixed coefficients and its patch's shape, for [`step_once`].
+#[derive(Clone, Copy)]
+struct StepCoeffs {
+    chi: i32,
+    chi_node: i32,
+    kappa_c: i32,
+    chi_c: i32,
+    g: u32,
+    symplectic: bool,
+    /// Node slots in use (the ground's included).
+    n: usize,
+    contact: usize,
+}
+
+/// One step of the linearised patch (see [`Linearised::start`]), on slices: one copy of
+/// the loop for every patch's capacity (monomorphised per capacity, it was five copies
+/// of 10 KB in the bench firmware). `dv` is scratch, as long as `x`. False where a
+/// component grew past [`STATE_LIMIT`] (the step is unstable).
+#[inline(never)]
+fn step_once(
+    edges: &[Edge],
+    kappa: &[i32],
+    x: &mut [[i32; 3]],
+    v: &mut [[i32; 3]],
+    dv: &mut [[i32; 3]],
+    k: &StepCoeffs,
+    exp: &mut i32,
+) -> bool {
+    let StepCoeffs {
+        chi,
+        chi_node,
+        kappa_c,
+        chi_c,
+        g,
+        symplectic,
+        n,
+        contact: c,
+    } = *k;
+    for d in dv.iter_mut() {
+        *d = [0; 3];
+    }
+    // (Slot 0 is the ground: its state stays zero, and what its springs add to its
+    // velocity change is never read.) With components within ±2^STATE_BITS (2²¹) the
+    // extension is within 2^23.6, so a spring's stretch and push are within `κ` · 2^23.6
+    // < 2^28.6 and its damping within `χ` · 2²² < 2²⁷; a node's sum, within its row's
+    // 64 · 2^23.6, fits an `i32`. Each product is a high word (`⌊a b / 2³²⌋`, exact)
+    // with its operands shifted up within 2³¹: `along · κ / 2²⁴`, `stretch · d / 2²³`,
+    // `ΔV · χ / 2²⁴`.
+    const _: () = assert!(COEFF_FRAC == 24 && DIR_FRAC == 23 && STATE_BITS == 21);
+    for (e, &kq) in edges.iter().zip(kappa.iter()) {
+        let (a, b) = (e.a as usize, e.b as usize);
+        let (Some(xa), Some(xb), Some(va), Some(vb)) = (x.get(a), x.get(b), v.get(a), v.get(b))
+        else {
+            continue;
+        };
+        let stretch = mulhi(along(xa, xb, &e.dir) << 7, kq << 1);
+        let on_a: [i32; 3] = core::array::from_fn(|j| {
+            mulhi(stretch << 2, e.dir[j] << 7) + mulhi((vb[j] - va[j]) << 8, chi)
+        });
+        if let Some(da) = dv.get_mut(a) {
+            for j in 0..3 {
+                da[j] = da[j].wrapping_add(on_a[j]);
+            }
+        }
+        if let Some(db) = dv.get_mut(b) {
+            for j in 0..3 {
+                db[j] = db[j].wrapping_sub(on_a[j]);
+            }
+        }
+    }
+    let mut magnitude = 0u32;
+    for i in 1..n.min(x.len()).min(v.len()).min(dv.len()) {
+        for j in 0..3 {
+            let (xi, vi) = (x[i][j], v[i][j]);
+            // The springs' change within 2^29.6 (their row), each node term within 2²⁶
+            // (`χ`, `κ` < 32 on components within 2²¹): all within `i32`, and so are
+            // `V'`, `V + V'` and `X'` (below 2^30.5).
+            let mut dvi = dv[i][j] - mulhi(vi << 8, chi_node);
+            if i == c {
+                dvi -= mulhi(xi << 8, kappa_c) + mulhi(vi << 8, chi_c);
+            }
+            let v_new = vi + dvi;
+            // (`X` in half units of `V / 2^g`: the position step, rounded.)
+            let step = if symplectic {
+                2 * v_new as i64
+            } else {
+                vi as i64 + v_new as i64
+            };
+            let x_new = xi as i64 + ((step + ((1i64 << g) >> 1)) >> g);
+            let grown = x_new.unsigned_abs() | v_new.unsigned_abs() as u64;
+            if grown >= STATE_LIMIT {
+                return false;
+            }
+            x[i][j] = x_new as i32;
+            v[i][j] = v_new;
+            magnitude |= grown as u32;
+        }
+    }
+    // Renormalise: the largest component back into [2^(STATE_BITS − 2), 2^STATE_BITS)
+    // (only the growth matters). (Slot 0, the ground, stays zero either way.)
+    let bits = u32::BITS - magnitude.leading_zeros();
+    let up = if bits > STATE_BITS || (magnitude != 0 && bits < STATE_BITS - 1) {
+        (STATE_BITS - 1) as i32 - bits as i32
+    } else {
+        0
+    };
+    if up != 0 {
+        for (xi, vi) in x.iter_mut().zip(v.iter_mut()).take(n) {
+            for j in 0..3 {
+                (xi[j], vi[j]) = if up > 0 {
+                    (xi[j] << up, vi[j] << up)
+                } else {
+                    (xi[j] >> -up, vi[j] >> -up)
+                };
+            }
+        }
+        *exp -= up;
+    }
+    true
+}
+
+/// [`Linearised::energy`] on slices (one copy for every capacity).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn energy_of(
+    edges: &[Edge],
+    springs: &[f32],
+    x: &[[i32; 3]],
+    v: &[[i32; 3]],
+    n: usize,
+    c: usize,
+    k_c: f32,
+    per_mass: f32,
+    h: f32,
+    g: u32,
+) -> f32 {
+    let at = |i: u16| x.get(i as usize).copied().unwrap_or([0; 3]);
+    let mut elastic = 0.0f32;
+    for (e, k) in edges.iter().zip(springs.iter()) {
+        let s = along(&at(e.a), &at(e.b), &e.dir) as f32;
+        elastic += 0.125 * k * s * s;
+    }
+    // ½ m v² with m = 1000/per_mass kg and v = V/h: in N·mm per unit² (as the elastic
+    // part), 0.5e-3 m / h².
+    let w_v = 0.5 / (per_mass * h * h * (1u32 << (2 * g)) as f32);
+    let mut kinetic = 0.0f32;
+    for vi in v.iter().take(n).skip(1) {
+        for c in vi {
+            kinetic += (*c as f32) * (*c as f32);
+        }
+    }
+    if let Some(xc) = x.get(c).filter(|_| c != 0 && c < n) {
+        for c in xc {
+            elastic += 0.125 * k_c * (*c as f32) * (*c as f32);
+        }
+    }
+    elastic + w_v * kinetic
 }
 
 #[cfg(test)]

@@ -198,19 +198,45 @@ fn closed_form<const NODES: usize, const EDGES: usize>(
     k_max: f64,
     config: &SolverConfig,
 ) -> Result<f64, SolverError> {
+    let mut row = [0.0f64; NODES];
+    let mut k_row = [0.0f64; NODES];
+    let n = topo.node_count().min(NODES);
+    closed_form_in(
+        topo.edges(),
+        n,
+        topo.contact() as usize,
+        k_max,
+        config,
+        &mut row,
+        &mut k_row,
+    )
+}
+
+/// [`closed_form`] on slices (one copy for every capacity): `row` and `k_row` are
+/// scratch, one slot a node.
+#[inline(never)]
+fn closed_form_in(
+    edges: &[crate::topology::Edge],
+    nodes: usize,
+    contact: usize,
+    k_max: f64,
+    config: &SolverConfig,
+    row: &mut [f64],
+    k_row: &mut [f64],
+) -> Result<f64, SolverError> {
     let (c_s, c_n) = (config.spring_damping, config.node_damping);
     let cp = &config.coupling;
-    let contact = topo.contact() as usize;
     // γ: the largest Gershgorin row sum of C (a spring between two free nodes puts C on
     // the diagonal and C off it; to the ground, on the diagonal only), over the mass.
-    let mut row = [c_n; NODES];
     // θ for the springs: the stiffest spring per unit length over its damping (N/m over
     // N·s/m); without spring damping, every spring's stiffness over the node damping,
     // through K's Gershgorin row sums.
-    let mut k_row = [0.0f64; NODES];
+    for (r, kr) in row.iter_mut().zip(k_row.iter_mut()) {
+        (*r, *kr) = (c_n, 0.0);
+    }
     let mut shortest = f64::INFINITY;
-    for e in topo.edges() {
-        let l0 = Topology::<NODES, EDGES>::rest_length(e);
+    for e in edges {
+        let l0 = crate::topology::rest_length(e);
         shortest = shortest.min(l0);
         let k = k_max / l0 * 1000.0;
         let two_ends = e.b != GROUND;
@@ -227,10 +253,8 @@ fn closed_form<const NODES: usize, const EDGES: usize>(
     if let Some(r) = row.get_mut(contact) {
         *r += cp.damping;
     }
-    let gamma = (1..topo.node_count().min(NODES))
-        .map(|i| row[i])
-        .fold(0.0, f64::max)
-        / config.node_mass;
+    let nodes = nodes.min(row.len()).min(k_row.len());
+    let gamma = (1..nodes).map(|i| row[i]).fold(0.0, f64::max) / config.node_mass;
     let k_c = cp.stiffness * 1000.0;
     let theta = if c_s > 0.0 {
         let springs = k_max / shortest * 1000.0 / c_s;
@@ -242,7 +266,7 @@ fn closed_form<const NODES: usize, const EDGES: usize>(
         };
         springs.max(coupling)
     } else if c_n > 0.0 {
-        let k_rows = (1..topo.node_count().min(NODES))
+        let k_rows = (1..nodes)
             .map(|i| k_row[i] + if i == contact { k_c } else { 0.0 })
             .fold(0.0, f64::max);
         k_rows / c_n

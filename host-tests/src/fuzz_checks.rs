@@ -1,0 +1,407 @@
+//! What every fuzz target asserts, as functions of the input's bytes: the fuzz targets
+//! (`fuzz/fuzz_targets/`, cargo-fuzz on nightly) call them, and so does an ordinary test
+//! on stable over the committed inputs (`fuzz/seeds/<target>/`) and whatever a fuzzing
+//! run left (`fuzz/corpus/`, `fuzz/artifacts/`), so that a change that breaks a parser's
+//! promise fails the test command, not only the next fuzzing. A structured input is
+//! built from the bytes as libFuzzer builds it (`Arbitrary::arbitrary_take_rest`); text
+//! targets take only UTF-8, as libFuzzer's `&str` inputs do.
+
+use arbitrary::{Arbitrary, Unstructured};
+use mccs::arith::{narrow::table_force, ArithTable};
+use mccs::{ForceTable, Narrow, Params, RawTable, Strain};
+use std::path::Path;
+
+/// A target's check: the input's bytes; a broken promise panics.
+pub type Check = fn(&[u8]);
+
+/// The targets, by name, with their checks.
+pub const TARGETS: [(&str, Check); 9] = [
+    ("param_file", param_file),
+    ("fit_data", fit_data),
+    ("trajectory", trajectory),
+    ("table", table),
+    ("encoder_frames", encoder_frames),
+    ("link_device", link_device),
+    ("demo_summary", demo_summary),
+    ("arm_device_file", arm_device_file),
+    ("joints", joints),
+];
+
+/// A parameter file: a one-line error naming the file, or parameters that validate,
+/// build a law, and round-trip through the writer.
+pub fn param_file(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match crate::paramfile::parse(text, Path::new("fuzz.toml")) {
+        Ok(p) => {
+            assert!(p.validate().is_ok());
+            let law = mccs::Law::new(&p).expect("validated");
+            let _ = crate::reference::Reference::new(&p).expect("validated");
+            let _ = mccs::ForceTable64::one_placement_unmeasured(&law, -0.5, 0.95);
+            let again = crate::paramfile::parse(&crate::paramfile::to_toml(&p), Path::new("x"));
+            assert_eq!(again, Ok(p), "round trip");
+        }
+        Err(e) => {
+            let line = e.to_string();
+            assert!(
+                line.starts_with("fuzz.toml: ") && !line.contains('\n'),
+                "{line}"
+            );
+        }
+    }
+}
+
+/// The fit's data: a one-line error naming the file (and row), or rows the models take.
+pub fn fit_data(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match crate::fit::parse_data(text, "fuzz.csv") {
+        Ok(points) => {
+            assert!(points.len() >= 5 && points.len() <= crate::fit::MAX_ROWS);
+            for w in points.windows(2) {
+                assert!(w[1].0 > w[0].0 && w[1].1 > w[0].1);
+            }
+            assert!(points.iter().all(|&(e, f)| e > 0.0 && e < 1.0 && f > 0.0));
+            let m = crate::fit::metrics(&crate::fit::Fitted::Mccs(Params::TABLE2), &points);
+            assert!(m.mean_abs.is_finite());
+        }
+        Err(e) => {
+            let line = e.to_string();
+            assert!(
+                line.starts_with("fuzz.csv: ") && !line.contains('\n'),
+                "{line}"
+            );
+        }
+    }
+}
+
+/// A probe trajectory: a one-line error, or a path whose samples are finite and in range.
+pub fn trajectory(data: &[u8]) {
+    use crate::trajectory::{parse, MAX_POSITION_MM};
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match parse(text, "fuzz.csv") {
+        Ok(t) => {
+            let (a, b) = t.span();
+            assert!(a.is_finite() && b.is_finite() && b >= a);
+            for x in [a, (a + b) / 2.0, b, a - 1.0, b + 1.0] {
+                assert!(t
+                    .at(x)
+                    .iter()
+                    .all(|c| c.is_finite() && c.abs() <= MAX_POSITION_MM));
+            }
+        }
+        Err(e) => {
+            let line = e.to_string();
+            assert!(
+                line.starts_with("fuzz.csv") && !line.contains('\n'),
+                "{line}"
+            );
+        }
+    }
+}
+
+/// The table builder's arguments and any raw table.
+#[derive(Arbitrary, Debug)]
+struct TableInput {
+    scales: [f64; 11],
+    from: f64,
+    to: f64,
+    knots: u8,
+    raw: ([i32; 10], [u32; 3], [[i32; 4]; 16], [i32; 7]),
+    strains: Vec<i32>,
+}
+
+fn evaluate<const S: usize>(t: &ForceTable<S>, strains: &[i32]) {
+    let narrow = ArithTable::<S, Narrow>::new(*t);
+    for &e in strains.iter().chain(&[i32::MIN, i32::MAX, 0]) {
+        let e = Strain::from_bits(e);
+        let _ = t.force_and_stiffness(e);
+        let _ = t.force(e);
+        let _ = t.force_within::<26>(e);
+        let _ = table_force(&narrow, e);
+    }
+}
+
+fn build<const S: usize>(p: &Params, from: f64, to: f64, strains: &[i32]) {
+    if let Ok(t) = ForceTable::<S>::with_domain(p, from, to) {
+        assert_eq!(t.validate(), Ok(()));
+        evaluate(&t, strains);
+        if let Ok(law) = mccs::Law::new(p) {
+            let m = t.measured(&law, from, to).max_error();
+            assert!(m.is_some_and(|e| e.force >= 0.0 && e.stiffness >= 0.0));
+            let bounded = ForceTable::<S>::with_bound(p, from, to, &mccs::TableBound::PRODUCT);
+            assert!(matches!(
+                bounded,
+                Ok(_) | Err(mccs::TableError::BoundNotMet { .. })
+            ));
+        }
+    }
+}
+
+/// The table builder on any spring scale, domain and knot count, and any raw table: a
+/// typed error or a valid table, its measured error, the bound's verdict, and every
+/// evaluation in both arithmetics, without a panic.
+pub fn table(data: &[u8]) {
+    let Ok(i) = TableInput::arbitrary_take_rest(Unstructured::new(data)) else {
+        return;
+    };
+    let mut p = Params::TABLE2;
+    for (k, s) in mccs::ParamKey::ALL.iter().zip(i.scales) {
+        if let Some(v) = k.get(&p) {
+            k.set(&mut p, v * s);
+        }
+    }
+    match i.knots % 4 {
+        0 => build::<16>(&p, i.from, i.to, &i.strains),
+        1 => build::<32>(&p, i.from, i.to, &i.strains),
+        2 => build::<64>(&p, i.from, i.to, &i.strains),
+        _ => build::<128>(&p, i.from, i.to, &i.strains),
+    }
+    let (a, b, segments, c) = i.raw;
+    let raw = RawTable {
+        strain_lo: a[0],
+        strain_hi: a[1],
+        index_pre: b[0],
+        index_scale: b[1],
+        anchor_lo: a[2],
+        force_lo: a[3],
+        stiffness_lo: a[4],
+        slope_lo: a[9],
+        force_hi: a[5],
+        // Half of them within ±2¹⁹, where the line above's slope is Q28.
+        stiffness_hi: if a[7] & 1 == 0 { a[6] >> 12 } else { a[6] },
+        slope_hi: c[6],
+        shift: b[2],
+        stiff_scale: a[7],
+        stiff_post: a[8],
+        corner_hi: c[0],
+        corner_anchor: c[1],
+        corner_pre: c[2] as u32,
+        corner_base: c[3] as u32,
+        corner_scale: c[4],
+        corner_post: c[5],
+        err_force_ppb: b[0],
+        err_stiffness_ppb: b[1],
+        segments,
+    };
+    let t = ForceTable::from_raw(raw);
+    let _ = t.validate();
+    let _ = t.max_stiffness();
+    evaluate(&t, &i.strains);
+}
+
+/// The encoder driver's input: its mounting and a stream of response frames.
+#[derive(Arbitrary, Debug)]
+struct EncoderInput {
+    zero: u16,
+    mm_per_count: f64,
+    max_step: u16,
+    diag_every: u16,
+    frames: Vec<Option<u16>>,
+}
+
+/// An SPI bus answering with the frames given (`None`: a failed transfer).
+struct Frames(std::vec::IntoIter<Option<u16>>);
+
+impl embedded_hal::spi::ErrorType for Frames {
+    type Error = embedded_hal::spi::ErrorKind;
+}
+
+impl embedded_hal::spi::SpiDevice<u8> for Frames {
+    fn transaction(
+        &mut self,
+        ops: &mut [embedded_hal::spi::Operation<'_, u8>],
+    ) -> Result<(), Self::Error> {
+        let frame = self
+            .0
+            .next()
+            .flatten()
+            .ok_or(embedded_hal::spi::ErrorKind::Other)?;
+        for op in ops {
+            if let embedded_hal::spi::Operation::Transfer(rx, _) = op {
+                let b = frame.to_be_bytes();
+                for (k, r) in rx.iter_mut().enumerate() {
+                    *r = b[k % 2];
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The encoder driver on any frames and mounting: no panic, every position within half a
+/// turn of travel.
+pub fn encoder_frames(data: &[u8]) {
+    use mccs_firmware::drivers::as5047p::{As5047p, EncoderConfig};
+    let Ok(i) = EncoderInput::arbitrary_take_rest(Unstructured::new(data)) else {
+        return;
+    };
+    let n = i.frames.len();
+    let config = EncoderConfig {
+        zero: i.zero,
+        mm_per_count: i.mm_per_count,
+        max_step: i.max_step,
+        diag_every: i.diag_every,
+    };
+    let limit = 8192.0 * 0.01 + 1e-3;
+    let mut enc = As5047p::new(Frames(i.frames.into_iter()), config);
+    for _ in 0..n {
+        if let Ok(z) = enc.read() {
+            assert!(z.to_num::<f64>().abs() <= limit, "{z}");
+        }
+    }
+    let _ = enc.errors();
+}
+
+/// The device's side of the link on any bytes: the board's own server, link state and
+/// glued controller on the N = 3 patch, a tick between polls of at most 64 bytes; no
+/// panic; a valid `Hello` after them is answered.
+pub fn link_device(data: &[u8]) {
+    use mccs_firmware::link::{
+        Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Live, Session, TickBudget, Work,
+    };
+    use mccs_firmware::{Controller, SimulatedDevice};
+    use mccs_link::{
+        encode, parse, ContactKind, Core, Decoder, DeviceKind, ToDevice, ToHost, MAX_FRAME,
+    };
+    const N: usize = mccs::topology::standard_capacity(3).0;
+    const E: usize = mccs::topology::standard_capacity(3).1;
+    static TABLE: std::sync::OnceLock<mccs::ForceTable64> = std::sync::OnceLock::new();
+    let table = *TABLE.get_or_init(|| mccs::ForceTable64::new(&Params::TABLE2).expect("Table 2"));
+    let config = mccs::SolverConfig::default();
+    let live = Live {
+        device: DeviceKind::OneDof,
+        simulated: true,
+        core: Core::M4f,
+        contact: ContactKind::Glued,
+        grid: 3,
+        spacing: 2.5,
+        tissue: [3, 3],
+        config,
+        workspace: [[-50 << 24; 3], [50 << 24; 3]],
+        pose_speed_mm_s: 200,
+        pose_turn_deg_s: 180,
+        baud: mccs_link::rates::DEFAULT_BAUD,
+        budget: TickBudget {
+            tick: 84_000,
+            base: 10_000,
+            per_substep: 5_000,
+        },
+        narrow: false,
+    };
+    let state: LinkState<N, 64, mccs::Wide> =
+        LinkState::new(Guard::new(GuardTimes::at_rate(1000, 500)));
+    let mut work: Box<Work<N, E, 64, mccs::Wide, 16>> = Box::default();
+    let mut server = LinkServer::new(&state, &mut work, Session::new(live, table, None), 64);
+    let topo = mccs::Topology::<N, E>::standard_patch(3, 2.5).expect("N = 3");
+    let solver = mccs::Solver::new(topo, table, &config).expect("Table 2 on N = 3");
+    let path = mccs_firmware::indentation_path(1000).expect("the indentation");
+    let device = LinkedDevice::new(
+        SimulatedDevice::new(path),
+        mccs::TissuePose::new(200.0, 180.0, 1000.0),
+    );
+    let mut ctl = Controller::new(solver, device, u32::MAX);
+    let mut hello = [0u8; MAX_FRAME];
+    let hello = encode(&ToDevice::Hello, &mut hello)
+        .expect("a frame")
+        .to_vec();
+    let all: Vec<u8> = data.iter().copied().chain([0u8]).chain(hello).collect();
+    let mut decoder = Decoder::new();
+    let mut answers = Vec::new();
+    let mut rx = all.iter().copied();
+    let mut left = all.len();
+    // Every byte read, then a few polls for the work the bytes started (a replay, a
+    // check) to reach the hello.
+    for _ in 0..all.len() / 8 + 2000 {
+        state.run_tick(&mut ctl);
+        let mut chunk: Vec<u8> = rx.by_ref().take(64).collect();
+        left -= chunk.len();
+        let mut bytes = chunk.drain(..);
+        let mut sent = Vec::new();
+        server.poll(&mut || bytes.next(), 0, &mut |f| {
+            sent.extend_from_slice(f);
+            true
+        });
+        for b in sent {
+            if let Some(Ok(p)) = decoder.push(b) {
+                answers.push(parse::<ToHost>(p).expect("the device sends messages"));
+            }
+        }
+        if left == 0
+            && answers
+                .iter()
+                .rev()
+                .take(64)
+                .any(|m| matches!(m, ToHost::Hello(_)))
+        {
+            return;
+        }
+    }
+    panic!("the hello after the bytes was not answered");
+}
+
+/// A firmware's SUMMARY line: what parses prints and parses again the same.
+pub fn demo_summary(data: &[u8]) {
+    let Ok(line) = std::str::from_utf8(data) else {
+        return;
+    };
+    if let Some(s) = crate::cli::parse_summary(line) {
+        let mut again = format!(
+            "SUMMARY ticks={} overruns={} max_force_n={} steady_force_n={} window_shifts={}",
+            s.ticks, s.overruns, s.max_force, s.steady_force, s.window_shifts
+        );
+        if let Some(arm) = s.arm {
+            let [a, b, c] = arm.steady_duty;
+            again += &format!(
+                " steady_duty_a={a} steady_duty_b={b} steady_duty_c={c} max_duty={}",
+                arm.max_duty
+            );
+        }
+        let t = crate::cli::parse_summary(&again).expect("a printed summary parses");
+        assert_eq!(t.ticks, s.ticks);
+        assert_eq!(t.window_shifts, s.window_shifts);
+        assert!(t.max_force.to_bits() == s.max_force.to_bits() || s.max_force.is_nan());
+        assert_eq!(t.arm.is_some(), s.arm.is_some());
+        if let (Some(x), Some(y)) = (t.arm, s.arm) {
+            assert!(x.max_duty.to_bits() == y.max_duty.to_bits() || y.max_duty.is_nan());
+        }
+    }
+}
+
+/// An arm's device file: a one-line error, or an arm that validates, builds and drives.
+pub fn arm_device_file(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match crate::arm::device_file::parse(text, Path::new("fuzz.toml")) {
+        Ok(spec) => {
+            assert!(spec.validate().is_ok());
+            let arm = mccs::Arm::new(&spec).expect("validated");
+            let pose = arm.pose(arm.home_counts());
+            let drive = arm.drive(&pose, [mccs::Force::from_num(1); 3]);
+            assert!(drive.duty_q16.iter().all(|d| d.abs() <= 65_536));
+        }
+        Err(e) => assert!(e.starts_with("fuzz.toml") && !e.contains('\n'), "{e}"),
+    }
+}
+
+/// A recorded arm motion: a one-line error, or rows in time order with whole counts.
+pub fn joints(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match crate::arm::joints::parse(text, "fuzz.csv") {
+        Ok(rows) => {
+            assert!(rows.windows(2).all(|w| w[1].0 > w[0].0));
+            assert!(rows.iter().all(|r| r.1.iter().all(|c| c.fract() == 0.0)));
+            let arm = mccs::Arm::new(&mccs_firmware::arm::device::WOODENHAPTICS).expect("valid");
+            let ticks = crate::arm::joints::ticks(&rows, 10.0, &arm);
+            assert!(!ticks.is_empty());
+        }
+        Err(e) => assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}"),
+    }
+}
