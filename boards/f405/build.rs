@@ -9,6 +9,7 @@
 //!     (`qemu` without `qemu-link`);
 //!   - `board_sim`: the plant is simulated — no encoder, no driver (`sim`);
 //!   - `board_arm`: the 3-DOF arm, not the 1-DOF lever (`arm`);
+//!   - `board_fault_test`: a fault injected after 100 ticks (`fault-test`);
 //! - the STM32F405's memory map: `memory/stm32f405.x` at the workspace root, copied to
 //!   OUT_DIR as `target-memory.x`, which the root `memory.x` (a selector: see its
 //!   comment) includes. Host builds need none of it.
@@ -30,6 +31,7 @@ fn main() {
         ("board_run_ends", feature("qemu") && !feature("qemu-link")),
         ("board_sim", feature("sim")),
         ("board_arm", feature("arm")),
+        ("board_fault_test", feature("fault-test")),
     ];
     for (name, on) in facts {
         println!("cargo::rustc-check-cfg=cfg({name})");

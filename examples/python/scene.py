@@ -19,7 +19,7 @@ def main(addr: str) -> int:
         info = device.info()
         print(f"device: {info.device}{' (simulated)' if info.simulated else ''}, {info.tick_hz} Hz, "
               f"{'roaming' if info.roaming else 'glued'} patch {info.grid}x{info.grid} on a "
-              f"{info.tissue[0]}x{info.tissue[1]} tissue, clamp {info.force_clamp_n:.3g} N, mu {info.friction}")
+              f"{info.tissue[0]}x{info.tissue[1]} tissue, clamp {info.force_clamp_n:.3g} N, mu {info.friction[0]:.2g}/{info.friction[1]:.2g}")
         print(f"tissue: {device.load_tissue('params/table2-stiffer.toml', friction=(0.5, 0.4)):08x}")
         device.watch(20)
         device.watch_mesh(50)

@@ -22,6 +22,8 @@ pub enum OneDofError<S, P, D, E = core::convert::Infallible> {
     Spi(S),
     /// Too many bad encoder frames in a row.
     Encoder,
+    /// The lever left its travel (`EncoderConfig::max_travel_counts`).
+    Travel,
     /// The motor drive failed.
     Motor(MotorError<P, D, E>),
 }
@@ -50,6 +52,9 @@ where
         let z = self.encoder.read().map_err(OneDofError::Spi)?;
         if self.encoder.errors().consecutive > self.max_bad_frames {
             return Err(OneDofError::Encoder);
+        }
+        if self.encoder.out_of_travel() {
+            return Err(OneDofError::Travel);
         }
         Ok([Length::ZERO, Length::ZERO, z])
     }

@@ -3,7 +3,7 @@
 //! at every device call ending with every duty at zero and the driver disabled.
 
 use mccs::{Arm, Force, Length};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits};
 use mccs_firmware::arm::encoder::Extended;
 use mccs_firmware::HapticDevice;
 use proptest::prelude::*;
@@ -224,6 +224,89 @@ fn no_force_before_the_arm_is_homed() {
     assert!(p.iter().all(|c| c.abs() < Length::from_num(127)), "{p:?}");
     dev.write_force(force).unwrap();
     assert!(r.duty.iter().any(|d| d.get() > 0), "no duty after homing");
+}
+
+/// The rig with the board's runaway limits (2 rev/s a joint, 1 m/s the probe, 5 ticks
+/// in a row at 1 kHz), homed and at work; the joints' counts at work.
+fn limited() -> (Rig, Device, [i32; 3]) {
+    let (r, dev) = rig();
+    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../devices/woodenhaptics.toml"
+    )))
+    .unwrap();
+    let limits = SpeedLimits::of(&spec, 1000, 2.0, 1000.0, 5);
+    // 32,000 counts a turn of A, 24,000 of B and C: 64 and 48 a tick at 2 rev/s; 1 mm
+    // a tick at 1 m/s.
+    assert_eq!(limits.joint_counts, [64, 48, 48]);
+    assert_eq!(limits.probe, Length::from_num(1));
+    let mut dev = dev.with_speed_limits(limits);
+    dev.enable().unwrap();
+    r.home.set(true);
+    dev.read_position().unwrap();
+    r.home.set(false);
+    at_work(&r);
+    // One tick's jump (a tick over the limits), then a tick at rest (the run broken).
+    dev.read_position().unwrap();
+    dev.read_position().unwrap();
+    let work = [0, r.raw[1].get() as i32, r.raw[2].get() as i32];
+    (r, dev, work)
+}
+
+/// Moves joint `k` by `step` counts a tick from `counts`, `ticks` times; the first error.
+fn spin(
+    r: &Rig,
+    dev: &mut Device,
+    counts: &mut [i32; 3],
+    k: usize,
+    step: i32,
+    ticks: usize,
+) -> Result<usize, ArmFault> {
+    for t in 0..ticks {
+        counts[k] += step;
+        r.raw[k].set(counts[k] as u16);
+        dev.read_position().inspect_err(|e| {
+            assert_eq!(
+                t, 4,
+                "the fault on the 5th tick over, not tick {t} (joint {k}, {step} a tick, at {counts:?}: {e:?})"
+            );
+        })?;
+    }
+    Ok(ticks)
+}
+
+#[test]
+fn a_runaway_joint_or_probe_is_a_fault_on_its_fifth_tick_in_a_row() {
+    // The elbow at 2.5 rev/s (60 counts a tick).
+    let (r, mut dev, mut c) = limited();
+    assert_eq!(
+        spin(&r, &mut dev, &mut c, 2, 60, 10),
+        Err(ArmFault::Overspeed(2))
+    );
+
+    // At 0.4 rev/s (10 counts a tick, the probe about 0.5 mm a tick) the elbow turns
+    // 15° and back without a fault. (The probe's speed is seen where the probe is within
+    // the tissue frame's ±128 mm; far from the tissue only the joints' limits hold.)
+    let (r, mut dev, mut c) = limited();
+    assert_eq!(spin(&r, &mut dev, &mut c, 2, 10, 100), Ok(100));
+    assert_eq!(spin(&r, &mut dev, &mut c, 2, -10, 100), Ok(100));
+
+    // The base at 1.9 rev/s (60 counts a tick): within its limit, but the probe, about
+    // 200 mm out, moves over 1 m/s: the probe's fault.
+    let (r, mut dev, mut c) = limited();
+    assert_eq!(
+        spin(&r, &mut dev, &mut c, 0, 60, 10),
+        Err(ArmFault::ProbeSpeed)
+    );
+
+    // Fast for 4 ticks, then one within: never a fault (the ticks must be in a row).
+    let (r, mut dev, mut c) = limited();
+    for _ in 0..20 {
+        assert_eq!(spin(&r, &mut dev, &mut c, 2, 60, 4), Ok(4));
+        assert_eq!(spin(&r, &mut dev, &mut c, 2, 0, 1), Ok(1));
+        assert_eq!(spin(&r, &mut dev, &mut c, 2, -60, 4), Ok(4));
+        assert_eq!(spin(&r, &mut dev, &mut c, 2, 0, 1), Ok(1));
+    }
 }
 
 #[test]

@@ -66,6 +66,7 @@ fn plain() -> EncoderConfig {
         mm_per_count: MM_PER_COUNT,
         max_step: 8191,
         diag_every: 0,
+        max_travel_counts: 1 << 24,
     }
 }
 
@@ -80,7 +81,7 @@ fn angles_become_travel_and_bad_frames_keep_the_last_good() {
     tx.extend(xfer(read_command(ERRFL), frame(0, true))); // the flag, still set
     tx.extend(xfer(angle, frame(0x0004, false))); // ERRFL contents: not an angle
     tx.extend(xfer(angle, frame(16384 + 100 - 500, false))); // −500 counts, wrapped
-    tx.extend(xfer(angle, frame(100 + 8191, false))); // half a turn less one
+    tx.extend(xfer(angle, frame(100 + 7000, false))); // +7,500 counts: under half a turn
     let spi = SpiMock::new(&tx);
     let mut enc = As5047p::new(spi, plain());
     let mm = |c: f64| Length::from_num(c * MM_PER_COUNT);
@@ -101,10 +102,67 @@ fn angles_become_travel_and_bad_frames_keep_the_last_good() {
     }
     assert!(close(enc.read().unwrap(), mm(-500.0)));
     let last = enc.read().unwrap();
-    assert!(close(last, mm(8191.0)), "{last} vs {}", mm(8191.0));
+    assert!(close(last, mm(7000.0)), "{last} vs {}", mm(7000.0));
     let e = enc.errors();
     assert_eq!((e.parity, e.flagged, e.consecutive), (1, 2, 0));
     enc.release().done();
+}
+
+/// A lever that turns on past half a turn reads on over whole turns (it once wrapped at
+/// ±8192 counts, ±23.6 mm: a lever beyond read suddenly deep, and was driven into its
+/// stop), and past its travel the encoder says so, and the device's read fails.
+#[test]
+fn the_lever_is_followed_over_whole_turns_and_beyond_its_travel_is_a_fault() {
+    let angle = read_command(ANGLECOM);
+    // 0, then steps of 3000 counts: through half a turn (8192) and a whole one.
+    let steps: Vec<i64> = (0..8).map(|k| k * 3000).collect();
+    let mut tx = xfer(angle, frame(0, false)); // the power-up NOP's answer
+    for &c in &steps {
+        tx.extend(xfer(angle, frame(((100 + c) % 16384) as u16, false)));
+    }
+    let config = EncoderConfig {
+        max_travel_counts: 20_000,
+        ..plain()
+    };
+    let mut enc = As5047p::new(SpiMock::new(&tx), config);
+    enc.read().unwrap();
+    for &c in &steps {
+        let z = enc.read().unwrap();
+        assert_eq!(enc.counts() as i64, c);
+        let want = c as f64 * MM_PER_COUNT;
+        assert!((z.to_num::<f64>() - want).abs() < 1e-5, "{z} vs {want}");
+        assert_eq!(enc.out_of_travel(), c > 20_000, "at {c} counts");
+    }
+    enc.release().done();
+
+    // The device: the same lever, through OneDofDevice, fails its read past the travel.
+    let mut tx = xfer(angle, frame(0, false));
+    for &c in &steps {
+        tx.extend(xfer(angle, frame(((100 + c) % 16384) as u16, false)));
+    }
+    let enc = As5047p::new(SpiMock::new(&tx), config);
+    let pwm = PwmMock::new(&[PwmTx::max_duty_cycle(1000)]);
+    let config = MotorConfig {
+        force_at_full_duty: 3.0,
+    };
+    let motor = PwmMotor::new(pwm, PinMock::new(&[]), config).unwrap();
+    let mut dev = OneDofDevice {
+        encoder: enc,
+        motor,
+        max_bad_frames: 3,
+    };
+    let reads: Vec<bool> = (0..=steps.len())
+        .map(|_| dev.read_position().is_ok())
+        .collect();
+    // NOP, 0 … 18,000 counts read; 21,000 is beyond 20,000.
+    assert_eq!(
+        reads,
+        [true, true, true, true, true, true, true, true, false]
+    );
+    dev.encoder.release().done();
+    let (mut pwm, mut dir, _) = dev.motor.release();
+    pwm.done();
+    dir.done();
 }
 
 /// An SPI device that answers like an AS5047P at a scripted angle per frame (the
@@ -179,6 +237,7 @@ fn checked() -> EncoderConfig {
         mm_per_count: MM_PER_COUNT,
         max_step: EncoderConfig::max_step_for(MM_PER_COUNT, 500.0, 1000.0),
         diag_every: 100,
+        max_travel_counts: 1 << 24,
     }
 }
 

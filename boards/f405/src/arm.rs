@@ -11,7 +11,7 @@ use crate::device::{
 };
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
 
@@ -37,6 +37,8 @@ impl StartError<ArmFault> {
                 ArmFault::Direction(k) => DevicePart::JointDirection(k),
                 ArmFault::Enable => DevicePart::Enable,
                 ArmFault::Home => DevicePart::Home,
+                ArmFault::Overspeed(k) => DevicePart::JointSpeed(k),
+                ArmFault::ProbeSpeed => DevicePart::ProbeSpeed,
             }),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
@@ -44,6 +46,13 @@ impl StartError<ArmFault> {
         }
     }
 }
+
+/// A joint turning faster than this, rev/s, is running away (docs/safety.md).
+pub const RUNAWAY_JOINT_REV_S: f64 = 2.0;
+/// A probe moving faster than this, mm/s, is running away.
+pub const RUNAWAY_PROBE_MM_S: f64 = 1000.0;
+/// Ticks in a row over either that make the fault.
+pub const RUNAWAY_TICKS: u8 = 5;
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input
@@ -58,7 +67,14 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
 ) -> Result<BoardArm<A, B, C, EN, HOME>, StartError<ArmFault>> {
     config.check().map_err(StartError::Config)?;
     let arm = Arm::new(spec).map_err(StartError::Arm)?;
-    let mut device = ArmDevice::new(arm, joints, enable, home);
+    let limits = SpeedLimits::of(
+        spec,
+        config.tick_hz,
+        RUNAWAY_JOINT_REV_S,
+        RUNAWAY_PROBE_MM_S,
+        RUNAWAY_TICKS,
+    );
+    let mut device = ArmDevice::new(arm, joints, enable, home).with_speed_limits(limits);
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

@@ -11,7 +11,7 @@
 //! | Joint A/B/C direction | PC0, PC1, PC2 | push-pull, high = angle grows | input, floating |
 //! | Driver enable        | PB1  | push-pull output, high = on       | input, floating  |
 //! | Home                 | PC3  | input, pull-down, high = at home  | input, floating  |
-//! | Host link TX / RX    | PA2, PA3 | USART2 AF7, 115200 8N1        | input, floating  |
+//! | Host link TX / RX    | PA2, PA3 | USART2 AF7, 1 Mbaud 8N1       | input, floating  |
 //!
 //! As on the 1-DOF board, the driver's enable and PWM inputs need pull-downs, so that a
 //! reset leaves the driver off; the home switch pulls PC3 high while the arm is held in

@@ -49,6 +49,9 @@ pub struct BoardConfig {
     pub mm_per_count: f64,
     /// The fastest the probe moves, mm/s: the encoder's plausibility check.
     pub max_speed_mm_s: f64,
+    /// The lever's travel either side of zero, mm (0 < x ≤ 1000): the encoder follows it
+    /// over whole turns, and a lever beyond it is a fault (the safe state).
+    pub travel_mm: f64,
     /// Encoder frames between diagnostic reads (DIAAGC), 0 for never.
     pub diag_every: u16,
     /// Bad encoder frames in a row tolerated before the safe state.
@@ -107,7 +110,8 @@ pub struct BoardConfig {
     /// See `tick_budget`.
     pub substep_cost: u32,
     /// Steps of a tissue's stability check run between two polls of the link: at most
-    /// 5 ms of the core (a test holds them to the bench's cost of a step).
+    /// 5 ms of the M4F at 168 MHz at N = 8 (`link::device::a_slice_of_a_tissue_check_
+    /// holds_the_main_loop_under_5_ms` holds them to the bench's cost of a step).
     pub check_steps_per_poll: u32,
 }
 
@@ -124,6 +128,7 @@ pub const BOARD: BoardConfig = BoardConfig {
     encoder_zero: 0,
     mm_per_count: 0.002876,
     max_speed_mm_s: 500.0,
+    travel_mm: 40.0,
     diag_every: 100,
     max_bad_frames: 8,
     force_at_full_duty: 3.0,
@@ -146,7 +151,7 @@ pub const BOARD: BoardConfig = BoardConfig {
     tick_budget: 84_000,
     tick_base_cost: 27_000,
     substep_cost: 18_000,
-    check_steps_per_poll: 32,
+    check_steps_per_poll: 20,
 };
 
 /// A board constant out of its range: which one, in words.
@@ -164,7 +169,8 @@ pub enum BoardConfigError {
     PwmResolution,
     /// `watchdog_ms` is not 10 ticks … 10,000 ms.
     Watchdog,
-    /// `encoder_zero` is above 16383, or `mm_per_count` is not finite and 0 < |x| < 0.01.
+    /// `encoder_zero` is above 16383, or `mm_per_count` is not finite and 0 < |x| < 0.01,
+    /// or `travel_mm` is not 0 < x ≤ 1000 (and within 2²⁴ counts).
     Encoder,
     /// `max_speed_mm_s` is not a finite positive number.
     Speed,
@@ -201,7 +207,9 @@ impl BoardConfigError {
             }
             Self::PwmResolution => "pwm_hz: fewer than 1000 duty steps at this timer clock",
             Self::Watchdog => "watchdog_ms: must be 10 ticks … 10000 ms",
-            Self::Encoder => "encoder_zero ≤ 16383 and 0 < |mm_per_count| < 0.01",
+            Self::Encoder => {
+                "encoder_zero ≤ 16383, 0 < |mm_per_count| < 0.01, 0 < travel_mm ≤ 1000 and within 2^24 counts"
+            }
             Self::Speed => "max_speed_mm_s: must be finite and positive",
             Self::Motor(_) => "force_at_full_duty: must be 0.001 … 1024 N",
             Self::Patch => "grid 3 … 8, node_mass_g and spring_damping finite and positive",
@@ -366,6 +374,12 @@ impl BoardConfig {
         if self.encoder_zero > 0x3FFF || !mpc.is_finite() || mpc == 0.0 || libm::fabs(mpc) >= 0.01 {
             return Err(E::Encoder);
         }
+        let travel = self.travel_mm;
+        if !(travel.is_finite() && travel > 0.0 && travel <= 1000.0)
+            || travel / libm::fabs(mpc) > (1u32 << 24) as f64
+        {
+            return Err(E::Encoder);
+        }
         if !(self.max_speed_mm_s.is_finite() && self.max_speed_mm_s > 0.0) {
             return Err(E::Speed);
         }
@@ -435,6 +449,8 @@ impl BoardConfig {
                 self.tick_hz as f64,
             ),
             diag_every: self.diag_every,
+            max_travel_counts: libm::ceil(self.travel_mm / libm::fabs(self.mm_per_count))
+                .clamp(0.0, (1u32 << 24) as f64) as u32,
         }
     }
 

@@ -90,6 +90,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
             Self::SafeState(e) => StartFault::SafeState(match e {
                 OneDofError::Spi(_) => DevicePart::Spi,
                 OneDofError::Encoder => DevicePart::Encoder,
+                OneDofError::Travel => DevicePart::Travel,
                 OneDofError::Motor(MotorError::Pwm(_)) => DevicePart::Pwm,
                 OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
                 OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
@@ -126,6 +127,8 @@ pub enum DevicePart {
     Spi,
     /// The encoder's frames (too many bad ones in a row).
     Encoder,
+    /// The lever beyond its travel (`BoardConfig::travel_mm`).
+    Travel,
     /// The motor's PWM channel.
     Pwm,
     /// The motor's direction pin.
@@ -140,6 +143,10 @@ pub enum DevicePart {
     JointDirection(u8),
     /// The arm's home input.
     Home,
+    /// The arm's joint `0..3` turned faster than its limit (a runaway).
+    JointSpeed(u8),
+    /// The arm's probe moved faster than its limit (a runaway).
+    ProbeSpeed,
 }
 
 impl DevicePart {
@@ -148,6 +155,7 @@ impl DevicePart {
         match self {
             Self::Spi => "the encoder's SPI bus",
             Self::Encoder => "the encoder's frames",
+            Self::Travel => "the lever beyond its travel",
             Self::Pwm => "the motor's PWM channel",
             Self::Direction => "the motor's direction pin",
             Self::Enable => "the motor driver's enable pin",
@@ -176,6 +184,15 @@ impl DevicePart {
                 ],
             ),
             Self::Home => "the arm's home input",
+            Self::JointSpeed(k) => pick(
+                *k,
+                [
+                    "joint A running away",
+                    "joint B running away",
+                    "joint C running away",
+                ],
+            ),
+            Self::ProbeSpeed => "the probe running away",
         }
     }
 }

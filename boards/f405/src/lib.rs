@@ -9,6 +9,7 @@
 //!   but the pins, held to the parts' limits, and the HAL's clock arithmetic;
 //! - [`arm`]: the arm variant's device (`--features arm`: the WoodenHaptics arm);
 //! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
+//! - [`safe_stop`]: the motor cut every way out of the firmware takes first;
 //! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
 //! - [`tissue`]: the force table the firmware runs (`boards/f405/tissue.rs`);
 //! - `pins`, `arm_pins` (firmware builds only): the pin maps, 1-DOF and arm.
@@ -24,6 +25,7 @@ pub mod config;
 pub mod device;
 #[cfg(target_os = "none")]
 pub mod pins;
+pub mod safe_stop;
 pub mod telemetry;
 pub mod tissue;
 

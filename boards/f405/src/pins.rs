@@ -11,7 +11,7 @@
 //! | Motor PWM         | PA8 | TIM1 CH1 AF1, 20 kHz          | input, floating           |
 //! | Motor direction   | PB0 | push-pull output, low = −z    | input, floating           |
 //! | Motor enable      | PB1 | push-pull output, high = on   | input, floating           |
-//! | Host link TX      | PA2 | USART2 AF7, 115200 8N1        | input, floating           |
+//! | Host link TX      | PA2 | USART2 AF7, 1 Mbaud 8N1       | input, floating           |
 //! | Host link RX      | PA3 | USART2 AF7                    | input, floating           |
 //!
 //! Every pin is a floating input from reset until the firmware drives it: the motor

@@ -14,6 +14,12 @@
 //!   idle, never pushing the wrong way).
 //! - The joints' limits are reported ([`ArmDevice::flags`]); a probe beyond what the
 //!   tissue's frame holds reads far above the tissue: no contact.
+//! - **No runaway.** With [`SpeedLimits`] ([`ArmDevice::with_speed_limits`]), a joint
+//!   faster than its limit (2 rev/s by default) or a probe faster than its limit (1 m/s)
+//!   for [`SpeedLimits::ticks`] ticks in a row is a fault ([`ArmFault::Overspeed`],
+//!   [`ArmFault::ProbeSpeed`]): the controller's safe state, zero duty first. Counted
+//!   once the arm is homed (before, its counts mean nothing and its duty is zero), from
+//!   the tick after (its counts jump to the home pose).
 
 use crate::arm::encoder::{Extended, JointEncoder};
 use crate::device::HapticDevice;
@@ -46,6 +52,56 @@ pub enum ArmFault {
     Enable,
     /// The home input.
     Home,
+    /// Joint `0..3` turned faster than its limit for the ticks [`SpeedLimits`] allows.
+    Overspeed(u8),
+    /// The probe moved faster than its limit for the ticks [`SpeedLimits`] allows.
+    ProbeSpeed,
+}
+
+/// The speeds beyond which the arm is running away, per tick (counts and probe travel
+/// between two reads), and how many ticks in a row make a fault.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SpeedLimits {
+    /// Each joint's largest change of count in one tick.
+    pub joint_counts: [u32; 3],
+    /// The probe's largest move in one tick, along any axis (Q of [`Length`]).
+    pub probe: Length,
+    /// Ticks in a row over a limit that make a fault (at least 1).
+    pub ticks: u8,
+}
+
+impl SpeedLimits {
+    /// No limit (what [`ArmDevice::new`] starts with).
+    pub const NONE: SpeedLimits = SpeedLimits {
+        joint_counts: [u32::MAX; 3],
+        probe: Length::MAX,
+        ticks: u8::MAX,
+    };
+
+    /// The limits of `spec` at `tick_hz` (start-up: floating point): a joint at
+    /// `joint_rev_s` turns a second, the probe at `probe_mm_s`, for `ticks` ticks.
+    pub fn of(
+        spec: &mccs::ArmSpec,
+        tick_hz: u32,
+        joint_rev_s: f64,
+        probe_mm_s: f64,
+        ticks: u8,
+    ) -> Self {
+        let hz = tick_hz.max(1) as f64;
+        let per_tick = |j: &mccs::JointSpec| {
+            let c = libm::ceil(libm::fabs(j.counts_per_rev * j.ratio) * joint_rev_s / hz);
+            c.clamp(1.0, u32::MAX as f64) as u32
+        };
+        SpeedLimits {
+            joint_counts: [
+                per_tick(&spec.joints[0]),
+                per_tick(&spec.joints[1]),
+                per_tick(&spec.joints[2]),
+            ],
+            probe: Length::from_bits(mccs::units::from_f64(probe_mm_s / hz, 24)),
+            ticks: ticks.max(1),
+        }
+    }
 }
 
 /// A joint's part that failed.
@@ -98,6 +154,11 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     homed: bool,
     pose: Option<ArmPose>,
     duty: [i32; 3],
+    limits: SpeedLimits,
+    /// Ticks in a row over a limit: each joint's, the probe's.
+    over: [u8; 4],
+    /// The probe at the last read (None: not yet, or the homing tick).
+    last_probe: Option<[Length; 3]>,
 }
 
 impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B, C, EN, HOME> {
@@ -113,7 +174,46 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             homed: false,
             pose: None,
             duty: [0; 3],
+            limits: SpeedLimits::NONE,
+            over: [0; 4],
+            last_probe: None,
         }
+    }
+
+    /// The device with speed limits (a runaway is a fault).
+    pub fn with_speed_limits(mut self, limits: SpeedLimits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    /// Counts a tick over or within each limit: `deltas` the joints' changes of count,
+    /// `probe` where the probe is now; the fault once a run of ticks over reaches the
+    /// limit's.
+    fn check_speed(&mut self, deltas: [i32; 3], probe: [Length; 3]) -> Result<(), ArmFault> {
+        let mut fast = [false; 4];
+        for k in 0..3 {
+            fast[k] = deltas[k].unsigned_abs() > self.limits.joint_counts[k];
+        }
+        if let Some(last) = self.last_probe {
+            fast[3] = (0..3)
+                .any(|i| probe[i].saturating_sub(last[i]).saturating_abs() > self.limits.probe);
+        }
+        self.last_probe = Some(probe);
+        for k in 0..4 {
+            self.over[k] = if fast[k] {
+                self.over[k].saturating_add(1)
+            } else {
+                0
+            };
+            if self.over[k] >= self.limits.ticks {
+                return Err(if k < 3 {
+                    ArmFault::Overspeed(k as u8)
+                } else {
+                    ArmFault::ProbeSpeed
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Enables the driver (duties still zero).
@@ -183,8 +283,11 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             self.joints.2.read().map_err(|_| ArmFault::Encoder(2))?,
         ];
         let mut counts = [0i32; 3];
+        let mut deltas = [0i32; 3];
         for k in 0..3 {
+            let was = self.counts[k].count();
             counts[k] = self.counts[k].update(raw[k]);
+            deltas[k] = counts[k].wrapping_sub(was);
         }
         if !self.homed && self.home.is_high().map_err(|_| ArmFault::Home)? {
             let home = self.arm.home_counts();
@@ -193,9 +296,16 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             }
             counts = home;
             self.homed = true;
+            // The counts jumped to the home pose: no speed this tick.
+            deltas = [0; 3];
+            self.last_probe = None;
         }
         let pose = self.arm.pose(counts);
         self.pose = Some(pose);
+        if self.homed {
+            // (Before homing the counts mean nothing and every duty is zero.)
+            self.check_speed(deltas, pose.probe)?;
+        }
         if pose.flags & OUTSIDE != 0 {
             // Beyond the tissue's frame: far above it, no contact.
             return Ok([Length::ZERO, Length::ZERO, Length::MAX]);

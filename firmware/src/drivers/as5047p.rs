@@ -31,8 +31,12 @@
 //!   half the frames are parity errors, and the jumps of the others fail the
 //!   plausibility check unless they are small.
 //!
-//! Travel: `mm = wrap(angle − zero) · mm_per_count`, with `wrap` into ±8192 counts (half a
-//! turn). For a lever of radius `r` mm turned through a capstan of ratio `i`,
+//! Travel: `mm = counts · mm_per_count`, where `counts` starts at `wrap(angle − zero)`
+//! (`wrap` into ±8192 counts, half a turn) and then follows the angle over whole turns:
+//! each good angle adds its wrapped step from the last good one. A lever that travels
+//! past half a turn reads on, never jumps to the other end. Past `max_travel_counts`
+//! from zero (either way) the driver reports [`As5047p::out_of_travel`], and the device
+//! takes it as a fault: the lever has left the travel it was built for. For a lever of radius `r` mm turned through a capstan of ratio `i`,
 //! `mm_per_count = 2π r / (16384 i)`; e.g. r = 75 mm, i = 10: 0.002876 mm per count.
 
 use embedded_hal::spi::SpiDevice;
@@ -98,6 +102,10 @@ pub struct EncoderConfig {
     /// Frames between diagnostic reads of DIAAGC (0: never). One frame in this many
     /// carries no angle (the position holds for that tick).
     pub diag_every: u16,
+    /// The travel either side of zero, counts (any turns), beyond which the position is
+    /// out of travel ([`As5047p::out_of_travel`]); at most 2²⁴ (the Q24 mm position's
+    /// range at the largest `mm_per_count`).
+    pub max_travel_counts: u32,
 }
 
 impl EncoderConfig {
@@ -145,6 +153,9 @@ pub struct As5047p<SPI> {
     last_angle: Option<u16>,
     last_good: i32,
     since_good: u32,
+    /// Travel from zero, counts, over whole turns (the last good angle's), and its limit.
+    counts: i32,
+    max_travel: i32,
     /// The command sent in the last frame, answered in the next.
     in_flight: u16,
     /// Whether the next frame reads ERRFL (after an error flag).
@@ -167,6 +178,8 @@ impl<SPI: SpiDevice<u8>> As5047p<SPI> {
             last_angle: None,
             last_good: 0,
             since_good: 0,
+            counts: 0,
+            max_travel: config.max_travel_counts.min(1 << 24) as i32,
             // The first frame answers nothing we sent: treat it as a NOP's answer.
             in_flight: NOP,
             errfl_pending: false,
@@ -247,12 +260,28 @@ impl<SPI: SpiDevice<u8>> As5047p<SPI> {
                 return;
             }
         }
-        let delta = ((angle.wrapping_sub(self.zero) << 2) as i16) >> 2; // ±8192
-                                                                        // Counts · Q30 mm/count → Q24 mm.
-        self.last_good = mccs::q::sat((delta as i64 * self.scale as i64) >> 6);
+        self.counts = match self.last_angle {
+            // The wrapped step from the last good angle (±8192), over whole turns.
+            Some(last) => self
+                .counts
+                .saturating_add((((angle.wrapping_sub(last)) << 2) as i16 >> 2) as i32),
+            None => (((angle.wrapping_sub(self.zero) << 2) as i16) >> 2) as i32,
+        };
+        // Counts · Q30 mm/count → Q24 mm.
+        self.last_good = mccs::q::sat((self.counts as i64 * self.scale as i64) >> 6);
         self.last_angle = Some(angle);
         self.since_good = 0;
         self.errors.consecutive = 0;
+    }
+
+    /// Travel from zero, counts, over whole turns (the last good angle's).
+    pub fn counts(&self) -> i32 {
+        self.counts
+    }
+
+    /// Whether the last good angle is beyond `max_travel_counts` from zero.
+    pub fn out_of_travel(&self) -> bool {
+        self.counts.unsigned_abs() > self.max_travel as u32
     }
 
     /// Error counters so far.

@@ -954,3 +954,37 @@ fn a_flood_of_garbage_is_counted_and_never_stalls_the_tick_or_the_link() {
     assert!(s.bad_frames > 100, "{} bad frames", s.bad_frames);
     assert_eq!(s.ticks as usize, polls + 1);
 }
+
+/// A slice of a tissue's check (`BoardConfig::check_steps_per_poll` steps of the
+/// linearised patch between two polls of the link) holds the main loop at most 5 ms on
+/// the M4F at 168 MHz at N = 8: the bench's `case=tissue_check` (two runs of 1,536
+/// steps, bench/baseline.txt) gives the time of a step.
+#[test]
+fn a_slice_of_a_tissue_check_holds_the_main_loop_under_5_ms() {
+    let base = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../bench/baseline.txt"
+    ))
+    .unwrap();
+    let line = base
+        .lines()
+        .find(|l| l.starts_with("BENCH core=m4f case=tissue_check n=8 "))
+        .expect("the M4F's tissue_check in bench/baseline.txt");
+    let ms: f64 = line
+        .rsplit("ms_at_clock=")
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let slice_ms = ms / (2.0 * 1536.0) * BOARD.check_steps_per_poll as f64;
+    println!(
+        "LINK check_slice ms_at_clock={slice_ms:.2} steps={}",
+        BOARD.check_steps_per_poll
+    );
+    assert!(
+        slice_ms <= 5.0,
+        "a slice of {} steps takes {slice_ms:.2} ms",
+        BOARD.check_steps_per_poll
+    );
+}

@@ -212,6 +212,8 @@ mod firmware {
         // The solver's start-up for the demo's patch, once (millions of instructions).
         let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
         report::startup(&mut figs, grid, ticks::startup(&h, table));
+        // A new tissue's check on the device, the host's substeps proposed (the link's).
+        report::tissue_check(&mut figs, grid, ticks::tissue_check(&h, table));
         // The demo's roaming: the longest tick without and with a window shift, and a
         // shift's own cost (the most a shift tick took over the tick before).
         let roam = ticks::roaming(&h, table, empty);

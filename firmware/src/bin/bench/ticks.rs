@@ -5,6 +5,7 @@
 use super::fw_common::exit;
 use super::harness::Harness;
 use core::hint::black_box;
+use mccs::solver::stability::StabilityCheck;
 use mccs::{Flat, ForceTable64, Length, ProxyConfig, ShapeSpec, Solver, Sphere, Topology};
 use mccs_firmware::demo::{self, DemoSpec};
 use mccs_firmware::entry as e;
@@ -52,6 +53,38 @@ fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64)
         ok = black_box(Solver::new(black_box(topo), *table, &spec.config())).is_ok();
     });
     if !ok {
+        exit(false)
+    }
+    n
+}
+
+/// A device's check of a new tissue as the link runs it: the host's proposed substeps
+/// (the count the search finds) verified by the device's own runs
+/// ([`StabilityCheck`] with a proposal, advanced to its end), once, in instructions. Exits
+/// with failure if the check does not take the search's count.
+#[inline(never)]
+pub fn tissue_check(h: &Harness, table: &ForceTable64) -> u64 {
+    match demo::spec_for(CORE).grid {
+        8 => tissue_check_in::<37, 214>(h, table),
+        5 => tissue_check_in::<10, 61>(h, table),
+        _ => tissue_check_in::<5, 30>(h, table),
+    }
+}
+
+#[inline(never)]
+fn tissue_check_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u64 {
+    let spec = demo::spec_for(CORE);
+    let topo = demo_topology::<N, E>(&spec);
+    let config = spec.config();
+    let proposal = demo_solver::<N, E>(&spec, table).substeps();
+    let mut outcome = None;
+    let n = h.measure_long(|| {
+        let check = StabilityCheck::new(black_box(&topo), table, &config, Some(proposal));
+        if let Ok(mut check) = check {
+            outcome = check.advance(&topo, u32::MAX);
+        }
+    });
+    if outcome != Some(Ok(proposal)) {
         exit(false)
     }
     n

@@ -98,6 +98,8 @@ mod firmware {
         else {
             fail("peripherals taken twice")
         };
+        // Every fault to its own handler, each of which cuts the motor first.
+        platform::enable_fault_handlers(&mut cp.SCB);
         if let Err(e) = BOARD.check() {
             fail_with(StartFault::Config(e));
         }
@@ -186,6 +188,10 @@ mod firmware {
             if t.run.ticks >= next_log {
                 next_log = next_log.saturating_add(BOARD.tick_hz);
                 log_second(&t);
+            }
+            #[cfg(board_fault_test)]
+            if t.run.ticks >= 100 {
+                platform::inject_fault(&mut cp.SCB);
             }
             #[cfg(board_run_ends)]
             if t.run.ticks >= BOARD.qemu_ticks {

@@ -3,13 +3,17 @@
 //! the tick, and the ways out — a panic, a hard fault, the end of a QEMU run.
 //!
 //! - On the board: the HSE and the PLL (`BoardConfig`), the timers at the HAL's
-//!   clocks, defmt over RTT, the DWT cycle counter, `panic-probe` (a panic logs and
-//!   stops the core at a breakpoint).
+//!   clocks, defmt over RTT, the DWT cycle counter; a way out stops at a breakpoint
+//!   (with no debugger, a HardFault that spins until the watchdog resets the chip).
 //! - In QEMU (`netduinoplus2`, which models no RCC: an HSE or PLL never reports ready):
 //!   the reset clock (HSI, 16 MHz), the timers at QEMU's 1 GHz, defmt over
 //!   semihosting, SysTick free-running at the core clock as the cycle counter (QEMU
 //!   models no DWT cycle counter: it reads 0; under `-icount` SysTick counts
 //!   instructions), and every way out exits QEMU through semihosting.
+//!
+//! Every way out — a panic, HardFault, MemManage, BusFault, UsageFault — cuts the motor
+//! first, on every build (`haptic_f405::safe_stop::cut_motor`: raw register writes),
+//! then logs what stopped it, then exits.
 
 use haptic_f405::config::{self, BOARD};
 use stm32f4xx_hal::prelude::*;
@@ -19,8 +23,6 @@ use stm32f4xx_hal::rcc::{Clocks, Rcc};
 use defmt_rtt as _;
 #[cfg(board_qemu)]
 use defmt_semihosting as _;
-#[cfg(not(board_qemu))]
-use panic_probe as _;
 
 /// The clock tree: the board's from its crystal; QEMU's reset clock.
 pub fn clocks(rcc: Rcc) -> Clocks {
@@ -121,15 +123,94 @@ pub fn exit(success: bool) -> ! {
     }
 }
 
-#[cfg(board_qemu)]
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
+    haptic_f405::safe_stop::cut_motor();
+    defmt::error!(
+        "stop: panic, the motor cut: {}",
+        defmt::Display2Format(info)
+    );
     exit(false)
 }
 
-#[cfg(board_qemu)]
+/// Enables the configurable faults (MemManage, BusFault, UsageFault), so that each comes
+/// to its own handler rather than escalating to HardFault; each cuts the motor as
+/// HardFault does. And DBGMCU: a debugger's halt stops TIM1 with its outputs off.
+pub fn enable_fault_handlers(scb: &mut cortex_m::peripheral::SCB) {
+    use cortex_m::peripheral::scb::Exception;
+    scb.enable(Exception::MemoryManagement);
+    scb.enable(Exception::BusFault);
+    scb.enable(Exception::UsageFault);
+    haptic_f405::safe_stop::freeze_tim1_on_halt();
+}
+
 #[cortex_m_rt::exception]
-unsafe fn HardFault(_frame: &cortex_m_rt::ExceptionFrame) -> ! {
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    haptic_f405::safe_stop::cut_motor();
+    defmt::error!("stop: HardFault at pc={=u32:#x}, the motor cut", frame.pc());
     exit(false)
+}
+
+#[cortex_m_rt::exception]
+fn MemoryManagement() -> ! {
+    haptic_f405::safe_stop::cut_motor();
+    defmt::error!("stop: MemManage, the motor cut");
+    exit(false)
+}
+
+#[cortex_m_rt::exception]
+fn BusFault() -> ! {
+    haptic_f405::safe_stop::cut_motor();
+    defmt::error!("stop: BusFault, the motor cut");
+    exit(false)
+}
+
+#[cortex_m_rt::exception]
+fn UsageFault() -> ! {
+    haptic_f405::safe_stop::cut_motor();
+    defmt::error!("stop: UsageFault, the motor cut");
+    exit(false)
+}
+
+/// A fault injected after start-up (`--features fault-test`, for the test command's
+/// `board-faults` stage): the class named on the run's semihosting command line
+/// (`panic`, `hard`, `mem`, `bus` or `usage`); none when it names none.
+#[cfg(board_fault_test)]
+pub fn inject_fault(scb: &mut cortex_m::peripheral::SCB) {
+    let mut line = [0u8; 128];
+    // SYS_GET_CMDLINE's block: the buffer and its length, which the host replaces with
+    // the length it wrote.
+    let mut block = [line.as_mut_ptr() as usize, line.len()];
+    // SAFETY: the host writes at most `block[1]` bytes to `block[0]`, a live buffer, and
+    // one word to `block[1]`; the call has no other effect.
+    let failed = unsafe {
+        cortex_m_semihosting::syscall1(
+            cortex_m_semihosting::nr::GET_CMDLINE,
+            block.as_mut_ptr() as usize,
+        )
+    } != 0;
+    let len = if failed { 0 } else { block[1].min(line.len()) };
+    let class = line[..len].split(|&b| b == b' ').nth(1).unwrap_or(b"");
+    defmt::info!("fault-test: injecting {=[u8]:a}", class);
+    match class {
+        b"panic" => panic!("injected"),
+        b"usage" => cortex_m::asm::udf(),
+        // UsageFault disabled, an undefined instruction escalates to HardFault.
+        b"hard" => {
+            scb.disable(cortex_m::peripheral::scb::Exception::UsageFault);
+            cortex_m::asm::udf()
+        }
+        // A read of the reserved space above the peripherals (no device answers).
+        // SAFETY: the read faults; it is the point.
+        b"bus" => unsafe {
+            core::ptr::read_volatile(0x6800_0000 as *const u32);
+        },
+        // A jump into the system region, which is never executable (XN).
+        // SAFETY: the call faults before any instruction there runs.
+        b"mem" => unsafe {
+            let f: extern "C" fn() = core::mem::transmute(0xE000_0001usize);
+            f();
+        },
+        _ => {}
+    }
 }
