@@ -130,3 +130,54 @@ fn what_does_not_fit_or_cannot_run_says_why() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(out.stderr, table.stderr);
 }
+
+/// `--device arm`: the arm board's whole tick on the M4F's N = 8 patch is the bare
+/// patch's bound plus the contact's own cost (the demo's roaming tick less its glued
+/// tick), the arm's chain and the link's share, each from the baseline; it fits half a
+/// tick.
+#[test]
+fn the_arm_boards_trainer_tick_adds_the_contact_the_chain_and_the_link() {
+    let out = mccs_ok(&["check", "--params", "params/table2.toml", "--device", "arm"]);
+    let (_, tick, budget, fits) = parse(String::from_utf8(out.stdout).unwrap().trim());
+    let c = |case: &str| baseline("m4f", case, "instructions");
+    let want = baseline("m4f", "largest_patch_1khz", "worst_instructions")
+        + c("tick_roaming_bound")
+        - c("tick")
+        + c("arm_kinematics")
+        + c("tick_link");
+    assert_eq!(tick, want);
+    assert!(fits && tick <= budget);
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("the arm's chain"), "{err}");
+}
+
+/// Each core's largest patch whose trainer tick (`--device arm`) fits half a 1 kHz tick,
+/// printed as `TRAINER core= largest_n= tick_instructions= budget=` for the docs: the M4F
+/// at N = 8 (the largest the bench measures a substep of), the M3 at 4, the M0 at 3, each
+/// fitting and the next size up not.
+#[test]
+fn each_cores_largest_trainer_tick() {
+    for (core, n) in [("m4f", 8), ("m3", 4), ("m0", 3)] {
+        let run = |n: u32| {
+            let grid = n.to_string();
+            mccs(&[
+                "check",
+                "--params",
+                "params/table2.toml",
+                "--device",
+                "arm",
+                "--core",
+                core,
+                "--grid",
+                &grid,
+            ])
+        };
+        let at = run(n);
+        assert_eq!(at.status.code(), Some(0), "{core} N = {n}");
+        let (_, tick, budget, _) = parse(String::from_utf8(at.stdout).unwrap().trim());
+        println!("TRAINER core={core} largest_n={n} tick_instructions={tick} budget={budget}");
+        if n < 8 {
+            assert_eq!(run(n + 1).status.code(), Some(1), "{core} N = {}", n + 1);
+        }
+    }
+}

@@ -448,6 +448,34 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
     step(s, "silence fades the force within 120 ticks", || {
         silence(&addr)
     });
+    step(s, "the worst tick within half a tick", || {
+        worst_tick("arm-sim")
+    });
+}
+
+/// The worst tick the board logged (its once-a-second line, `worst_tick_cycles`, the
+/// SysTick cycles at 168 MHz of QEMU's cycle counter) over the whole run, as
+/// instructions under `-icount shift=3` (8 ns each): at most half a 1 kHz tick, 84,000.
+fn worst_tick(name: &str) {
+    let log = std::fs::read_to_string(root().join(format!("target/qemu/link-{name}.log"))).unwrap();
+    let cycles = log
+        .lines()
+        .filter_map(|l| {
+            l.split("worst_tick_cycles=")
+                .nth(1)?
+                .split_whitespace()
+                .next()?
+                .parse::<u64>()
+                .ok()
+        })
+        .max()
+        .expect("the board logs its worst tick once a second");
+    let instructions = cycles * 1_000_000_000 / (168_000_000 * 8);
+    println!("LINK case=trainer_tick n=8 worst_instructions={instructions} budget=84000");
+    assert!(
+        instructions <= 84_000,
+        "the worst tick took {instructions} instructions"
+    );
 }
 
 /// A raw session: `Watch` every tick and `Arm`, frames for 300 ms, then silence with the
