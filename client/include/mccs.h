@@ -105,7 +105,8 @@ typedef struct {
   uint32_t dropped_telemetry;
   // 1 while a host holds it armed.
   int armed;
-  // 0: no fault; else why it is in its safe state (1 read, 2 write, 3 overruns).
+  // 0: no fault; else why it is in its safe state (1 read, 2 write, 3 overruns, 4 amplifier:
+  // the emergency stop or an amplifier fault).
   int fault;
   // The link's gain, 0 … 1.
   double gain;

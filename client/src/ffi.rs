@@ -98,7 +98,8 @@ pub struct McStatus {
     pub dropped_telemetry: u32,
     /// 1 while a host holds it armed.
     pub armed: c_int,
-    /// 0: no fault; else why it is in its safe state (1 read, 2 write, 3 overruns).
+    /// 0: no fault; else why it is in its safe state (1 read, 2 write, 3 overruns, 4 amplifier:
+    /// the emergency stop or an amplifier fault).
     pub fault: c_int,
     /// The link's gain, 0 … 1.
     pub gain: f64,

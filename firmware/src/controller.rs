@@ -128,6 +128,9 @@ pub enum Fault {
     /// Ticks overran their period too many times in a row
     /// ([`Controller::set_overrun_limit`]).
     Overruns,
+    /// The drive was cut outside the MCU (the board's break input: the emergency stop or
+    /// an amplifier's fault output), [`Controller::stop`].
+    Amplifier,
 }
 
 impl Fault {
@@ -137,6 +140,7 @@ impl Fault {
             Self::Read => "device read failed",
             Self::Write => "device write failed",
             Self::Overruns => "ticks overran their period too many times in a row",
+            Self::Amplifier => "the emergency stop or an amplifier fault cut the drive",
         }
     }
 }
@@ -344,6 +348,15 @@ impl<
         t.overruns_in_row = t.overruns_in_row.saturating_add(1);
         if self.overrun_limit != 0 && t.overruns_in_row >= self.overrun_limit && t.fault.is_none() {
             self.enter_safe_state(Fault::Overruns);
+        }
+    }
+
+    /// Latches `fault` from outside the tick's own checks (the board's break input): the
+    /// device's safe state at once, and every tick after. The first fault stays the one
+    /// reported.
+    pub fn stop(&mut self, fault: Fault) {
+        if self.telemetry.fault.is_none() {
+            self.enter_safe_state(fault);
         }
     }
 

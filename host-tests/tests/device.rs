@@ -803,6 +803,38 @@ fn any_device_error_latches_the_safe_state_and_reasserts_it() {
     }
 }
 
+/// A stop from outside the tick's own checks (the board's break input: the emergency
+/// stop or an amplifier fault) latches the safe state at once and on every tick after,
+/// with its reason; a later stop or device error does not replace the first reason.
+#[test]
+fn an_external_stop_latches_the_safe_state_with_its_reason() {
+    let dev = Flaky {
+        fail_read_at: 12,
+        fail_write_at: 0,
+        n: 0,
+        writes: vec![],
+        safe_calls: 0,
+    };
+    let mut ctl = Controller::new(solver(), dev, 0);
+    for _ in 0..5 {
+        ctl.tick(None);
+    }
+    assert!(
+        ctl.device().writes.iter().any(|f| f[2] != Force::ZERO),
+        "it was rendering"
+    );
+    ctl.stop(Fault::Amplifier);
+    assert_eq!(ctl.device().safe_calls, 1, "the safe state at once");
+    for _ in 0..10 {
+        ctl.tick(None);
+    }
+    ctl.stop(Fault::Overruns);
+    assert_eq!(ctl.telemetry().fault, Some(Fault::Amplifier));
+    assert_eq!(ctl.device().writes.len(), 5, "no writes after the stop");
+    assert_eq!(ctl.device().safe_calls, 11, "reasserted every tick");
+    assert_eq!(ctl.telemetry().force, [Force::ZERO; 3]);
+}
+
 /// The defect: a parameter set prepared for another topology was applied, and
 /// the force chattered. It is refused; the solver keeps its set, and the force is what
 /// it would have been without the swap.

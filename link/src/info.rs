@@ -81,6 +81,9 @@ pub enum FaultReason {
     Write,
     /// Ticks overran their period too many times in a row.
     Overruns,
+    /// The drive was cut outside the MCU: the emergency stop or an amplifier's fault
+    /// output tripped TIM1's break input.
+    Amplifier,
 }
 
 impl FaultReason {
@@ -91,6 +94,9 @@ impl FaultReason {
             Self::Read => "device read failed",
             Self::Write => "device write failed",
             Self::Overruns => "ticks overran their period too many times in a row",
+            Self::Amplifier => {
+                "the emergency stop or an amplifier fault cut the drive (break input)"
+            }
         }
     }
 
@@ -101,6 +107,7 @@ impl FaultReason {
             Self::Read => "read",
             Self::Write => "write",
             Self::Overruns => "overruns",
+            Self::Amplifier => "amplifier",
         }
     }
 }

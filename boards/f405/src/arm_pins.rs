@@ -10,6 +10,7 @@
 //! | Joint A/B/C PWM      | PA8, PA9, PA10 | TIM1 CH1/CH2/CH3 AF1, 20 kHz | input, floating |
 //! | Joint A/B/C direction | PC0, PC1, PC2 | push-pull, high = angle grows | input, floating |
 //! | Driver enable        | PB1  | push-pull output, high = on       | input, floating  |
+//! | Stop chain (BKIN)    | PB12 | TIM1_BKIN AF1, pull-down (raw: `safe_stop`) | input, floating |
 //! | Home                 | PC3  | input, pull-down, high = at home  | input, floating  |
 //! | Host link TX / RX    | PA2, PA3 | USART2 AF7, 1 Mbaud 8N1       | input, floating  |
 //!

@@ -82,6 +82,10 @@ pub struct BoardConfig {
     pub baud: u32,
     /// The force's ramp from zero after `Arm`, a start or homing, ms (0 … 5,000).
     pub ramp_ms: u32,
+    /// TIM1's break input on PB12 (`safe_stop::BreakInput`): the emergency stop's and
+    /// the amplifiers' fault chain, which cuts every PWM output in hardware. Default
+    /// active low (fail-safe: an open chain stops the drive; docs/safety.md).
+    pub break_input: crate::safe_stop::BreakInput,
     /// Overruns in a row that put the device in its safe state (1 … 1,000).
     pub max_overruns_in_row: u32,
     /// The pose's slew limits: mm/s per axis of its origin (1 … 1,000), degrees/s of
@@ -141,6 +145,7 @@ pub const BOARD: BoardConfig = BoardConfig {
     qemu_ticks: 1000,
     baud: mccs_link::rates::DEFAULT_BAUD,
     ramp_ms: 500,
+    break_input: crate::safe_stop::BreakInput::ActiveLow,
     max_overruns_in_row: 10,
     pose_speed_mm_s: 200,
     pose_turn_deg_s: 180,

@@ -11,6 +11,7 @@
 //! | Motor PWM         | PA8 | TIM1 CH1 AF1, 20 kHz          | input, floating           |
 //! | Motor direction   | PB0 | push-pull output, low = −z    | input, floating           |
 //! | Motor enable      | PB1 | push-pull output, high = on   | input, floating           |
+//! | Stop chain (BKIN) | PB12 | TIM1_BKIN AF1, pull-down (raw: `safe_stop`) | input, floating      |
 //! | Host link TX      | PA2 | USART2 AF7, 1 Mbaud 8N1       | input, floating           |
 //! | Host link RX      | PA3 | USART2 AF7                    | input, floating           |
 //!

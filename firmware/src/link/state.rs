@@ -62,6 +62,7 @@ pub fn fault_reason(f: Option<Fault>) -> FaultReason {
         Some(Fault::Read) => FaultReason::Read,
         Some(Fault::Write) => FaultReason::Write,
         Some(Fault::Overruns) => FaultReason::Overruns,
+        Some(Fault::Amplifier) => FaultReason::Amplifier,
     }
 }
 

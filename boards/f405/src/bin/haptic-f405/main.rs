@@ -118,6 +118,8 @@ mod firmware {
             Ok(built) => built,
             Err(fault) => fail_with(fault),
         };
+        // TIM1's PWM is set up, every duty zero: the stop chain's break input armed.
+        haptic_f405::safe_stop::arm_break_input(BOARD.break_input);
         let Some((psc, arr)) = tick_timer(platform::timer_clock(&clocks), BOARD.tick_hz) else {
             fail_with(StartFault::Config(config::BoardConfigError::Tick))
         };
@@ -274,6 +276,10 @@ mod firmware {
         if ctl.telemetry().ticks >= BOARD.qemu_ticks {
             tick.stop();
             return;
+        }
+        // The stop chain cut the drive in hardware: latch the safe state (and say why).
+        if haptic_f405::safe_stop::break_tripped_now() {
+            ctl.stop(mccs_firmware::Fault::Amplifier);
         }
         LINK.run_tick(ctl);
         watchdog.feed();
