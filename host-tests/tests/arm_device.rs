@@ -226,6 +226,63 @@ fn no_force_before_the_arm_is_homed() {
     assert!(r.duty.iter().any(|d| d.get() > 0), "no duty after homing");
 }
 
+/// Homing waits for the home input to stay high for the debounce's reads in a row with
+/// the arm still (within 2 counts): a bounce or a joint moving 3 counts starts the wait
+/// again; no duty until it homes. (It once homed on one sample of the input.)
+#[test]
+fn home_is_taken_only_after_the_input_stays_high_with_the_arm_still() {
+    let (r, dev) = rig();
+    let mut dev = dev.with_home_debounce(50);
+    dev.enable().unwrap();
+    let force = [Force::ZERO, Force::ZERO, Force::from_num(1.0)];
+    let mut read = |dev: &mut Device, n: usize| {
+        for _ in 0..n {
+            dev.read_position().unwrap();
+            dev.write_force(force).unwrap();
+            if !dev.homed() {
+                assert!(r.duty.iter().all(|d| d.get() == 0), "a duty before homing");
+            }
+        }
+    };
+    r.home.set(true);
+    read(&mut dev, 49);
+    assert!(!dev.homed(), "49 reads are not 50");
+    // A bounce: low for one read, then high again: 49 more are not enough.
+    r.home.set(false);
+    read(&mut dev, 1);
+    r.home.set(true);
+    read(&mut dev, 49);
+    assert!(!dev.homed(), "the bounce restarted the wait");
+    // Within 2 counts the arm is still; 3 counts is motion, and restarts it.
+    r.raw[1].set(2);
+    read(&mut dev, 1);
+    assert!(dev.homed(), "50 reads high, 2 counts of motion");
+    assert!(
+        r.duty.iter().all(|d| d.get() == 0),
+        "the homing tick's own write is zero duty"
+    );
+    at_work(&r);
+    dev.read_position().unwrap();
+    dev.write_force(force).unwrap();
+    assert!(
+        r.duty.iter().any(|d| d.get() > 0),
+        "then the force is rendered"
+    );
+    let (r, dev) = rig();
+    let mut dev = dev.with_home_debounce(50);
+    r.home.set(true);
+    for _ in 0..49 {
+        dev.read_position().unwrap();
+    }
+    r.raw[2].set(3);
+    for _ in 0..49 {
+        dev.read_position().unwrap();
+    }
+    assert!(!dev.homed(), "3 counts of motion restarted the wait");
+    dev.read_position().unwrap();
+    assert!(dev.homed());
+}
+
 /// The rig with the board's runaway limits (2 rev/s a joint, 1 m/s the probe, 5 ticks
 /// in a row at 1 kHz), homed and at work; the joints' counts at work.
 fn limited() -> (Rig, Device, [i32; 3]) {

@@ -53,6 +53,8 @@ pub const RUNAWAY_JOINT_REV_S: f64 = 2.0;
 pub const RUNAWAY_PROBE_MM_S: f64 = 1000.0;
 /// Ticks in a row over either that make the fault.
 pub const RUNAWAY_TICKS: u8 = 5;
+/// How long the home input must stay high, with the arm still, before the arm homes, ms.
+pub const HOME_DEBOUNCE_MS: u32 = 50;
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input
@@ -74,7 +76,10 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
         RUNAWAY_PROBE_MM_S,
         RUNAWAY_TICKS,
     );
-    let mut device = ArmDevice::new(arm, joints, enable, home).with_speed_limits(limits);
+    let debounce = (HOME_DEBOUNCE_MS as u64 * config.tick_hz as u64).div_ceil(1000) as u32;
+    let mut device = ArmDevice::new(arm, joints, enable, home)
+        .with_speed_limits(limits)
+        .with_home_debounce(debounce);
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

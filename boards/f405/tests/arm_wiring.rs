@@ -245,6 +245,11 @@ fn no_duty_before_homing_then_a_press_drives_the_joints() {
     // Homed at the pose the counters read as home (all zero): then pressed.
     rig.set_counts([0; 3]);
     rig.home.value.set(1);
+    // The home input must stay high 50 ms (50 ticks) with the arm still.
+    for _ in 0..49 {
+        rig.ctl.tick(None);
+    }
+    assert!(!rig.ctl.device().inner().homed(), "homed before 50 ms");
     rig.ctl.tick(None);
     assert!(rig.ctl.device().inner().homed());
     rig.home.value.set(0);
@@ -301,7 +306,9 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
             // first one after homing included): failing from the start, it fails there.
             part(&rig).fail.set(true);
             rig.home.value.set(1);
-            rig.ctl.tick(None);
+            for _ in 0..50 {
+                rig.ctl.tick(None);
+            }
             rig.home.value.set(0);
             rig.set_counts(pressed);
             for _ in 0..100 {
@@ -310,7 +317,9 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
             rig.set_counts(counts);
         } else {
             rig.home.value.set(1);
-            rig.ctl.tick(None);
+            for _ in 0..50 {
+                rig.ctl.tick(None);
+            }
             rig.home.value.set(0);
             rig.set_counts(pressed);
             for _ in 0..100 {

@@ -3,9 +3,11 @@
 //! home input — through the core's [`Arm`] (counts to the probe, the force to duties).
 //!
 //! # Safety
-//! - **No force before the arm is homed.** Until the home input reads high once (the arm
-//!   held at its home pose), the counts are not known: every write is zero duty. At the
-//!   home input each joint's count becomes its `home_count`.
+//! - **No force before the arm is homed.** Until the home input has read high for the
+//!   debounce's ticks in a row with every joint within 2 counts of where it was when the
+//!   input rose ([`ArmDevice::with_home_debounce`]; the board's: 50 ms), the counts are
+//!   not known: every write is zero duty. A bounce, or motion, starts the wait again.
+//!   Then each joint's count becomes its `home_count`.
 //! - **Faults end at the actuator.** A failed read or write is an error for the
 //!   controller, which puts the device in its safe state: zero duty on every joint first
 //!   (each attempted whatever the others did), then the driver disabled. A failed duty
@@ -159,7 +161,17 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     over: [u8; 4],
     /// The probe at the last read (None: not yet, or the homing tick).
     last_probe: Option<[Length; 3]>,
+    /// Reads in a row the home input must be high, still, to home (at least 1).
+    home_ticks: u32,
+    /// Homed at the last read: that tick's write is zero duty (its force was computed
+    /// with the gain of before; the link's ramp starts from the next).
+    fresh_home: bool,
+    /// Since the home input rose: the reads it has been high, and the counts then.
+    home_since: Option<(u32, [i32; 3])>,
 }
+
+/// The most a joint may move, counts, while the home input is being debounced.
+pub const HOME_STILL_COUNTS: i32 = 2;
 
 impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B, C, EN, HOME> {
     /// The device, not homed (zero duty until it is), the driver not enabled.
@@ -177,7 +189,36 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             limits: SpeedLimits::NONE,
             over: [0; 4],
             last_probe: None,
+            home_ticks: 1,
+            home_since: None,
+            fresh_home: false,
         }
+    }
+
+    /// The device homing only once its home input has read high for `ticks` reads in a
+    /// row (at least 1) with every joint within [`HOME_STILL_COUNTS`] of where it was
+    /// when the input rose.
+    pub fn with_home_debounce(mut self, ticks: u32) -> Self {
+        self.home_ticks = ticks.max(1);
+        self
+    }
+
+    /// Whether the home input, read now with the joints at `counts`, completes its
+    /// debounce.
+    fn home_settled(&mut self, high: bool, counts: [i32; 3]) -> bool {
+        self.home_since = match (high, self.home_since) {
+            (false, _) => None,
+            (true, Some((n, at)))
+                if (0..3).all(|k| {
+                    counts[k].wrapping_sub(at[k]).unsigned_abs() <= HOME_STILL_COUNTS as u32
+                }) =>
+            {
+                Some((n.saturating_add(1), at))
+            }
+            // Risen now, or moved: the wait starts again here.
+            (true, _) => Some((1, counts)),
+        };
+        matches!(self.home_since, Some((n, _)) if n >= self.home_ticks)
     }
 
     /// The device with speed limits (a runaway is a fault).
@@ -289,13 +330,20 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             counts[k] = self.counts[k].update(raw[k]);
             deltas[k] = counts[k].wrapping_sub(was);
         }
-        if !self.homed && self.home.is_high().map_err(|_| ArmFault::Home)? {
+        // (Only the tick that homes writes zero for it.)
+        self.fresh_home = false;
+        let settled = !self.homed && {
+            let high = self.home.is_high().map_err(|_| ArmFault::Home)?;
+            self.home_settled(high, counts)
+        };
+        if settled {
             let home = self.arm.home_counts();
             for k in 0..3 {
                 self.counts[k].rebase(home[k]);
             }
             counts = home;
             self.homed = true;
+            self.fresh_home = true;
             // The counts jumped to the home pose: no speed this tick.
             deltas = [0; 3];
             self.last_probe = None;
@@ -314,7 +362,8 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
     }
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), ArmFault> {
-        let duty = match (self.homed, self.pose) {
+        let fresh = core::mem::take(&mut self.fresh_home);
+        let duty = match (self.homed && !fresh, self.pose) {
             (true, Some(pose)) => self.arm.drive(&pose, force).duty_q16,
             _ => [0; 3],
         };

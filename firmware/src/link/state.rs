@@ -75,6 +75,8 @@ pub struct LinkState<const N: usize, const S: usize, A: Arith> {
     mesh_clock: MeshClock,
     mesh: Mailbox<Mesh<N>>,
     contact: Shared<bool>,
+    /// Whether the device was homed at the last tick (a homing restarts the ramp).
+    homed: Shared<bool>,
     snapshot: Shared<Snapshot>,
 }
 
@@ -90,6 +92,7 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
             mesh_clock: MeshClock::new(),
             mesh: Mailbox::new(),
             contact: Shared::new(false),
+            homed: Shared::new(false),
             snapshot: Shared::new(Snapshot {
                 ticks: 0,
                 overruns: 0,
@@ -186,6 +189,12 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
         let contact = ctl.contact_state();
         let rendered = ctl.device().rendered();
         let dev = ctl.device().status();
+        // Homed this tick (the arm's position just became known): the force starts again
+        // from zero, and ramps once the probe is out of contact.
+        if dev.homed && !self.homed.get() {
+            self.restart_ramp();
+        }
+        self.homed.set(dev.homed);
         let touching = match contact {
             Some(c) => c.touching,
             None => t.force != [Force::ZERO; 3],

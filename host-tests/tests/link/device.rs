@@ -988,3 +988,77 @@ fn a_slice_of_a_tissue_check_holds_the_main_loop_under_5_ms() {
         BOARD.check_steps_per_poll
     );
 }
+
+/// A device whose homing the test decides, held out of contact (far above the tissue).
+struct Homing(std::rc::Rc<std::cell::Cell<bool>>);
+
+impl mccs_firmware::HapticDevice for Homing {
+    type Error = ();
+    fn read_position(&mut self) -> Result<[Length; 3], ()> {
+        Ok([Length::ZERO, Length::ZERO, Length::from_num(20)])
+    }
+    fn write_force(&mut self, _: [Force; 3]) -> Result<(), ()> {
+        Ok(())
+    }
+    fn safe_state(&mut self) -> Result<(), ()> {
+        Ok(())
+    }
+    fn status(&self) -> mccs_firmware::DeviceStatus {
+        mccs_firmware::DeviceStatus {
+            homed: self.0.get(),
+            ..mccs_firmware::DeviceStatus::default()
+        }
+    }
+}
+
+/// Homing restarts the link's ramp: the gain, full before (standalone, out of contact),
+/// is zero the tick after the arm homes and climbs again over the ramp (500 ms). (Homing
+/// once left the force at full at once, with the hand perhaps resting in the tissue.)
+#[test]
+fn homing_restarts_the_ramp() {
+    use mccs_firmware::link::{LinkState, LinkedDevice};
+    let homed = std::rc::Rc::new(std::cell::Cell::new(false));
+    let state: LinkState<NODES, 64, mccs::Wide> =
+        LinkState::new(Guard::new(GuardTimes::at_rate(1000, 500)));
+    let topo = mccs::Topology::<NODES, EDGES>::standard_patch(BOARD.grid, 2.5).unwrap();
+    let solver = mccs::Solver::new(
+        topo,
+        ForceTable64::new(&Params::TABLE2).unwrap(),
+        &BOARD.solver(),
+    )
+    .unwrap();
+    let device = LinkedDevice::new(Homing(homed.clone()), TissuePose::new(200.0, 180.0, 1000.0));
+    let mut ctl = mccs_firmware::Controller::new(solver, device, u32::MAX);
+    for _ in 0..600 {
+        state.run_tick(&mut ctl);
+    }
+    assert_eq!(
+        state.snapshot().gain,
+        mccs_link::scale::GAIN_FULL,
+        "the start's ramp done"
+    );
+    homed.set(true);
+    state.run_tick(&mut ctl);
+    state.run_tick(&mut ctl);
+    let after = state.snapshot().gain;
+    assert!(
+        after <= mccs_link::scale::GAIN_FULL / 250,
+        "the gain after homing: {after}"
+    );
+    for _ in 0..250 {
+        state.run_tick(&mut ctl);
+    }
+    let half = state.snapshot().gain;
+    assert!(
+        half > after && half < mccs_link::scale::GAIN_FULL,
+        "climbing: {half}"
+    );
+    for _ in 0..300 {
+        state.run_tick(&mut ctl);
+    }
+    assert_eq!(
+        state.snapshot().gain,
+        mccs_link::scale::GAIN_FULL,
+        "full again"
+    );
+}
