@@ -235,7 +235,7 @@ fn home_is_taken_only_after_the_input_stays_high_with_the_arm_still() {
     let mut dev = dev.with_home_debounce(50);
     dev.enable().unwrap();
     let force = [Force::ZERO, Force::ZERO, Force::from_num(1.0)];
-    let mut read = |dev: &mut Device, n: usize| {
+    let read = |dev: &mut Device, n: usize| {
         for _ in 0..n {
             dev.read_position().unwrap();
             dev.write_force(force).unwrap();
