@@ -3,7 +3,7 @@
 //! at every device call ending with every duty at zero and the driver disabled.
 
 use mccs::{Arm, Force, Length};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Walls};
 use mccs_firmware::arm::encoder::Extended;
 use mccs_firmware::HapticDevice;
 use proptest::prelude::*;
@@ -224,6 +224,65 @@ fn no_force_before_the_arm_is_homed() {
     assert!(p.iter().all(|c| c.abs() < Length::from_num(127)), "{p:?}");
     dev.write_force(force).unwrap();
     assert!(r.duty.iter().any(|d| d.get() > 0), "no duty after homing");
+}
+
+/// The virtual walls 3° inside each joint's limits: nothing inside; past a wall a duty
+/// back toward the range, proportional, full at the limit (the stop); through the device
+/// added to the tissue's duty, on the joint past its wall only.
+#[test]
+fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
+    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../devices/woodenhaptics.toml"
+    )))
+    .unwrap();
+    let walls = Walls::of(&spec, 3.0);
+    // B: 24,000 counts a turn, limits −30° … 90°: walls at −27° and 87° (−1,800 and 5,800
+    // counts), 200 counts of margin.
+    assert_eq!(walls.at[1], (-1800, 5800));
+    assert_eq!(
+        walls.duty(walls.at.map(|(_, hi)| hi)),
+        [0; 3],
+        "at the wall: nothing"
+    );
+    assert_eq!(walls.duty([0, 3000, 3000]), [0; 3], "inside: nothing");
+    let past = walls.duty([0, 5900, 0]);
+    assert_eq!(
+        past[1],
+        -100 * walls.duty_per_count[1],
+        "half way to the stop, pushed back"
+    );
+    assert!(
+        (past[1] + 32_768).abs() < 200,
+        "about half duty: {}",
+        past[1]
+    );
+    assert_eq!(walls.duty([0, 6000, 0])[1], -65_536, "full at the stop");
+    assert_eq!(walls.duty([0, 9000, 0])[1], -65_536, "held to full beyond");
+    assert!(walls.duty([0, -1900, 0])[1] > 0, "the low wall pushes up");
+    assert_eq!(
+        walls.duty([0, 5900, 0])[0],
+        0,
+        "only the joint past its wall"
+    );
+
+    // Through the device: the same counts with and without walls differ by the wall.
+    let duties = |with: bool| {
+        let (r, dev) = rig();
+        let mut dev = if with { dev.with_walls(walls) } else { dev };
+        dev.enable().unwrap();
+        r.home.set(true);
+        dev.read_position().unwrap();
+        r.home.set(false);
+        r.raw[1].set(5900);
+        dev.read_position().unwrap();
+        dev.write_force([Force::ZERO; 3]).unwrap();
+        dev.duties()
+    };
+    let (plain, walled) = (duties(false), duties(true));
+    assert_eq!(walled[0], plain[0]);
+    assert_eq!(walled[2], plain[2]);
+    assert_eq!(walled[1], (plain[1] + past[1]).clamp(-65_536, 65_536));
 }
 
 /// Homing waits for the home input to stay high for the debounce's reads in a row with

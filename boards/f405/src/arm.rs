@@ -11,7 +11,7 @@ use crate::device::{
 };
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits, Walls};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
 
@@ -53,6 +53,8 @@ pub const RUNAWAY_JOINT_REV_S: f64 = 2.0;
 pub const RUNAWAY_PROBE_MM_S: f64 = 1000.0;
 /// Ticks in a row over either that make the fault.
 pub const RUNAWAY_TICKS: u8 = 5;
+/// The virtual walls stand this far inside each joint's mechanical stops, degrees.
+pub const WALL_MARGIN_DEG: f64 = 3.0;
 /// How long the home input must stay high, with the arm still, before the arm homes, ms.
 pub const HOME_DEBOUNCE_MS: u32 = 50;
 
@@ -79,7 +81,8 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
     let debounce = (HOME_DEBOUNCE_MS as u64 * config.tick_hz as u64).div_ceil(1000) as u32;
     let mut device = ArmDevice::new(arm, joints, enable, home)
         .with_speed_limits(limits)
-        .with_home_debounce(debounce);
+        .with_home_debounce(debounce)
+        .with_walls(Walls::of(spec, WALL_MARGIN_DEG));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

@@ -16,6 +16,10 @@
 //!   idle, never pushing the wrong way).
 //! - The joints' limits are reported ([`ArmDevice::flags`]); a probe beyond what the
 //!   tissue's frame holds reads far above the tissue: no contact.
+//! - **Virtual walls** ([`Walls`], [`ArmDevice::with_walls`]; the board's: 3° inside
+//!   each mechanical stop): a homed joint past its wall gets a duty back toward its range,
+//!   proportional to how far past, full duty at the stop, added to the tissue's (the sum
+//!   held to ±100 %).
 //! - **No runaway.** With [`SpeedLimits`] ([`ArmDevice::with_speed_limits`]), a joint
 //!   faster than its limit (2 rev/s by default) or a probe faster than its limit (1 m/s)
 //!   for [`SpeedLimits::ticks`] ticks in a row is a fault ([`ArmFault::Overspeed`],
@@ -70,6 +74,66 @@ pub struct SpeedLimits {
     pub probe: Length,
     /// Ticks in a row over a limit that make a fault (at least 1).
     pub ticks: u8,
+}
+
+/// Each joint's virtual walls: where they stand, in counts from home along the joint's
+/// angle (`sign · (count − home_count)`), and the duty per count past them (Q16).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Walls {
+    /// The low and the high wall, counts from home along the angle.
+    pub at: [(i32, i32); 3],
+    /// Duty per count past a wall, Q16 (full duty at the stop).
+    pub duty_per_count: [i32; 3],
+    /// Each joint's `sign` (+1 or −1): the duty's direction for a torque along the angle.
+    pub sign: [i32; 3],
+}
+
+impl Walls {
+    /// The walls of `spec`, `margin_deg` inside each joint's limits (start-up: floating
+    /// point). A margin of at least one count.
+    pub fn of(spec: &mccs::ArmSpec, margin_deg: f64) -> Self {
+        let wall = |j: &mccs::JointSpec| {
+            let per_deg = libm::fabs(j.counts_per_rev * j.ratio) / 360.0;
+            let at = |deg: f64| libm::round((deg - j.home_angle_deg) * per_deg) as i32;
+            let margin = libm::round(margin_deg * per_deg).max(1.0);
+            (
+                (
+                    at(j.min_angle_deg + margin_deg),
+                    at(j.max_angle_deg - margin_deg),
+                ),
+                libm::round(65_536.0 / margin) as i32,
+                if j.sign < 0.0 { -1 } else { 1 },
+            )
+        };
+        let w = [
+            wall(&spec.joints[0]),
+            wall(&spec.joints[1]),
+            wall(&spec.joints[2]),
+        ];
+        Walls {
+            at: w.map(|x| x.0),
+            duty_per_count: w.map(|x| x.1),
+            sign: w.map(|x| x.2),
+        }
+    }
+
+    /// The walls' duties at joint counts `from_home` (`count − home_count`), Q16: zero
+    /// inside, else back toward the range, at most full duty each.
+    pub fn duty(&self, from_home: [i32; 3]) -> [i32; 3] {
+        core::array::from_fn(|k| {
+            let a = from_home[k].saturating_mul(self.sign[k]);
+            let (lo, hi) = self.at[k];
+            let past = if a > hi {
+                a - hi
+            } else if a < lo {
+                a - lo
+            } else {
+                0
+            };
+            let d = (past as i64 * self.duty_per_count[k] as i64).clamp(-65_536, 65_536) as i32;
+            -d * self.sign[k]
+        })
+    }
 }
 
 impl SpeedLimits {
@@ -163,6 +227,8 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     last_probe: Option<[Length; 3]>,
     /// Reads in a row the home input must be high, still, to home (at least 1).
     home_ticks: u32,
+    /// The virtual walls (none by default).
+    walls: Option<Walls>,
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -192,7 +258,14 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             home_ticks: 1,
             home_since: None,
             fresh_home: false,
+            walls: None,
         }
+    }
+
+    /// The device with virtual walls at its joints' limits.
+    pub fn with_walls(mut self, walls: Walls) -> Self {
+        self.walls = Some(walls);
+        self
     }
 
     /// The device homing only once its home input has read high for `ticks` reads in a
@@ -363,10 +436,19 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), ArmFault> {
         let fresh = core::mem::take(&mut self.fresh_home);
-        let duty = match (self.homed && !fresh, self.pose) {
+        let mut duty = match (self.homed && !fresh, self.pose) {
             (true, Some(pose)) => self.arm.drive(&pose, force).duty_q16,
             _ => [0; 3],
         };
+        if let (Some(walls), true) = (self.walls, self.homed && !fresh) {
+            let home = self.arm.home_counts();
+            let from_home: [i32; 3] =
+                core::array::from_fn(|k| self.counts[k].count().wrapping_sub(home[k]));
+            let wall = walls.duty(from_home);
+            for k in 0..3 {
+                duty[k] = duty[k].saturating_add(wall[k]).clamp(-65_536, 65_536);
+            }
+        }
         let written = write_joint(&mut self.joints.0, &mut self.forward[0], 0, duty[0])
             .and_then(|()| write_joint(&mut self.joints.1, &mut self.forward[1], 1, duty[1]))
             .and_then(|()| write_joint(&mut self.joints.2, &mut self.forward[2], 2, duty[2]));
