@@ -274,7 +274,9 @@ scene_examples() {
   gcc examples/c/scene.c -I client/include -L "$lib" -lmccs_client \
     -o target/qemu/scene-c || return 1
   if [ ! -x "$venv/bin/python" ]; then python3 -m venv "$venv" || return 1; fi
-  "$venv/bin/pip" install --quiet ./client/python > /dev/null || return 1
+  # (From a copy: setuptools builds in the source tree, its build/ and egg-info.)
+  rm -rf target/python-src && cp -r client/python target/python-src || return 1
+  "$venv/bin/pip" install --quiet target/python-src > /dev/null || return 1
   bash scripts/qemu-link.sh --sim "$sock" > target/qemu/scene-firmware.log 2>&1 < /dev/null &
   qemu_pid=$!
   local waited=0

@@ -122,7 +122,8 @@ pub struct McTelemetry {
     /// The link's gain, 0 … 1.
     pub gain: f64,
     /// Flags: bit 0 contact, 1 slipping, 2 armed, 3 fault, 4 clamped, 5 homed, 6 at a
-    /// limit, 7 checking a tissue, 8 gain below full.
+    /// limit, 7 checking a tissue, 8 gain below full, 9 thermal (a joint's current
+    /// folded back by the I²t model).
     pub flags: u32,
     /// The arm's joint duties, −1 … 1.
     pub duties: [f64; 3],

@@ -29,6 +29,8 @@ pub struct DeviceStatus {
     pub homed: bool,
     /// A joint is at or past its limit.
     pub at_limit: bool,
+    /// A joint's current is folded back to its continuous current (the I²t model).
+    pub thermal: bool,
     /// The joints' duties last written, Q16 (zero where there are no joints).
     pub duties: [i32; 3],
 }
@@ -38,6 +40,7 @@ impl Default for DeviceStatus {
         Self {
             homed: true,
             at_limit: false,
+            thermal: false,
             duties: [0; 3],
         }
     }

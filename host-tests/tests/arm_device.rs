@@ -3,7 +3,9 @@
 //! at every device call ending with every duty at zero and the driver disabled.
 
 use mccs::{Arm, Force, Length};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Walls};
+use mccs_firmware::arm::device::{
+    ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Thermal, Walls,
+};
 use mccs_firmware::arm::encoder::Extended;
 use mccs_firmware::HapticDevice;
 use proptest::prelude::*;
@@ -283,6 +285,89 @@ fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
     assert_eq!(walled[0], plain[0]);
     assert_eq!(walled[2], plain[2]);
     assert_eq!(walled[1], (plain[1] + past[1]).clamp(-65_536, 65_536));
+}
+
+/// The I²t model: a joint held at 100 % duty folds back to its continuous current within
+/// 1.2 of its winding's time constant (the model's: at 0.118 τ, where the heat reaches
+/// (1 A / 3 A)²), stays within it while the demand lasts, with the `thermal` status, and
+/// comes back once the heat has fallen to 81 % of the limit's.
+#[test]
+fn a_joint_held_at_full_current_folds_back_to_its_continuous_current() {
+    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../devices/woodenhaptics.toml"
+    )))
+    .unwrap();
+    let model = Thermal::of(&spec, 1000);
+    let limit = model.limit_q16[0];
+    assert_eq!(limit, 21_845, "1 A of 3 A");
+    let (r, dev) = rig();
+    let mut dev = dev.with_thermal(model);
+    dev.enable().unwrap();
+    r.home.set(true);
+    dev.read_position().unwrap();
+    r.home.set(false);
+    at_work(&r);
+    // Far more force than the motors give: some joint at 100 %.
+    let push = [
+        Force::from_num(0.0),
+        Force::from_num(300.0),
+        Force::from_num(-300.0),
+    ];
+    let tau_ticks = (41.6 * 1000.0) as usize;
+    let mut folded_at = None;
+    let mut full = None;
+    for t in 0..60_000 {
+        dev.read_position().unwrap();
+        dev.write_force(push).unwrap();
+        let d = dev.duties();
+        if t == 0 {
+            full = d.iter().position(|x| x.abs() == 65_536);
+            assert!(full.is_some(), "a joint at 100 %: {d:?}");
+        }
+        let k = full.unwrap();
+        if folded_at.is_none() && d[k].abs() <= limit {
+            folded_at = Some(t);
+            assert!(dev.status().thermal, "the thermal status");
+        }
+        if folded_at.is_some() {
+            assert!(
+                d[k].abs() <= limit,
+                "held to the continuous current at tick {t}: {d:?}"
+            );
+        }
+    }
+    let at = folded_at.expect("folded back within 60 s");
+    println!(
+        "ARM case=i2t folded_after_tau={:.3}",
+        at as f64 / tau_ticks as f64
+    );
+    assert!(
+        at as f64 <= 1.2 * tau_ticks as f64,
+        "folded after {at} ticks"
+    );
+    assert!(
+        (at as f64 / tau_ticks as f64 - 0.118).abs() < 0.01,
+        "the model's 0.118 τ: {at}"
+    );
+    // The demand gone: it cools, and the full current comes back.
+    let mut back = None;
+    for t in 0..200_000 {
+        dev.read_position().unwrap();
+        dev.write_force([Force::ZERO; 3]).unwrap();
+        if !dev.status().thermal {
+            back = Some(t);
+            break;
+        }
+    }
+    assert!(back.is_some(), "it never cooled");
+    dev.read_position().unwrap();
+    dev.write_force(push).unwrap();
+    assert_eq!(
+        dev.duties()[full.unwrap()].abs(),
+        65_536,
+        "full current again"
+    );
 }
 
 /// Homing waits for the home input to stay high for the debounce's reads in a row with

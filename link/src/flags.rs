@@ -28,9 +28,11 @@ impl Flags {
     pub const CHECKING: Flags = Flags(1 << 7);
     /// The link's gain is below full (fading after silence, or ramping up after `Arm`).
     pub const GAIN_LIMITED: Flags = Flags(1 << 8);
+    /// A joint's current is folded back to its continuous current (the I²t model).
+    pub const THERMAL: Flags = Flags(1 << 9);
 
     /// Every flag, with its name in the CLI's columns, in bit order.
-    pub const ALL: [(Flags, &'static str); 9] = [
+    pub const ALL: [(Flags, &'static str); 10] = [
         (Self::CONTACT, "contact"),
         (Self::SLIPPING, "slipping"),
         (Self::ARMED, "armed"),
@@ -40,6 +42,7 @@ impl Flags {
         (Self::AT_LIMIT, "at_limit"),
         (Self::CHECKING, "checking"),
         (Self::GAIN_LIMITED, "gain_limited"),
+        (Self::THERMAL, "thermal"),
     ];
 
     /// None set.

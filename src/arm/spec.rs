@@ -18,6 +18,11 @@ pub struct JointSpec {
     pub torque_constant_nm_per_a: f64,
     /// The driver's current at 100 % duty, A (> 0).
     pub max_current_a: f64,
+    /// The motor's continuous (rated) current, A (`0 < x ≤ max_current_a`): what the I²t
+    /// model folds the current back to.
+    pub continuous_current_a: f64,
+    /// The motor winding's thermal time constant, s (1 … 10,000).
+    pub thermal_time_constant_s: f64,
     /// The joint's range, degrees (`min < max`, within ±180).
     pub min_angle_deg: f64,
     /// See `min_angle_deg`.
@@ -84,6 +89,9 @@ pub enum ArmError {
     Motor(u8),
     /// A range not within ±180° with `min < home < max`.
     Range(u8),
+    /// A continuous current not `0 < x ≤ max_current_a`, or a thermal time constant not
+    /// 1 … 10,000 s.
+    Thermal(u8),
     /// A mass or centre of mass negative or not finite, `g` not finite, or a gravity
     /// torque of 32,768 N·mm or more.
     Gravity,
@@ -99,6 +107,7 @@ impl ArmError {
             Self::Sign(_) => "joint: sign must be 1 or -1",
             Self::Motor(_) => "joint: torque_constant_nm_per_a and max_current_a must be finite and > 0",
             Self::Range(_) => "joint: min_angle_deg < home_angle_deg < max_angle_deg, within ±180",
+            Self::Thermal(_) => "joint: 0 < continuous_current_a ≤ max_current_a, thermal_time_constant_s 1 … 10000",
             Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g finite, the torques under 32768 N·mm",
         }
     }
@@ -106,7 +115,11 @@ impl ArmError {
     /// The joint it is about (0: A, 1: B, 2: C), if any.
     pub const fn joint(&self) -> Option<u8> {
         match self {
-            Self::Transmission(j) | Self::Sign(j) | Self::Motor(j) | Self::Range(j) => Some(*j),
+            Self::Transmission(j)
+            | Self::Sign(j)
+            | Self::Motor(j)
+            | Self::Range(j)
+            | Self::Thermal(j) => Some(*j),
             _ => None,
         }
     }
@@ -163,6 +176,11 @@ impl ArmSpec {
                 && j.home_angle_deg < j.max_angle_deg)
             {
                 return Err(ArmError::Range(i));
+            }
+            let c = j.continuous_current_a;
+            let tau = j.thermal_time_constant_s;
+            if !(positive(c) && c <= j.max_current_a && (1.0..=10_000.0).contains(&tau)) {
+                return Err(ArmError::Thermal(i));
             }
         }
         if let Some(g) = &self.gravity {

@@ -44,6 +44,7 @@ impl BoardTelemetry {
             device: DeviceStatus {
                 homed: false,
                 at_limit: false,
+                thermal: false,
                 duties: [0; 3],
             },
         }

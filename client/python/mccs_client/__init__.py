@@ -59,6 +59,7 @@ FLAGS = {
     "at_limit": 1 << 6,
     "checking": 1 << 7,
     "gain_limited": 1 << 8,
+    "thermal": 1 << 9,
 }
 
 

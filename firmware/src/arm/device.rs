@@ -16,6 +16,11 @@
 //!   idle, never pushing the wrong way).
 //! - The joints' limits are reported ([`ArmDevice::flags`]); a probe beyond what the
 //!   tissue's frame holds reads far above the tissue: no contact.
+//! - **I²t** ([`Thermal`], [`ArmDevice::with_thermal`]): each joint's winding heat as a
+//!   first-order model of the current's square (its time constant the winding's); at the
+//!   continuous current's square the joint's duty folds back to the continuous current,
+//!   and stays folded until the heat falls to 81 % of it (0.9 of the current); the
+//!   `thermal` status while any joint is folded.
 //! - **Virtual walls** ([`Walls`], [`ArmDevice::with_walls`]; the board's: 3° inside
 //!   each mechanical stop): a homed joint past its wall gets a duty back toward its range,
 //!   proportional to how far past, full duty at the stop, added to the tissue's (the sum
@@ -136,6 +141,67 @@ impl Walls {
     }
 }
 
+/// Each joint's I²t model, per tick: the heat `h` (the current's square over the
+/// maximum's, Q32) moves toward the duty's square by `α = 1 / (τ f)` a tick; at the
+/// continuous current's square the duty is held to the continuous current.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Thermal {
+    /// `α`, Q32 (at most 2³⁰: τ f ≥ 4).
+    pub alpha_q32: [i64; 3],
+    /// The continuous current over the maximum, as a duty, Q16.
+    pub limit_q16: [i32; 3],
+}
+
+impl Thermal {
+    /// The model of `spec`'s joints at `tick_hz` (start-up: floating point).
+    pub fn of(spec: &mccs::ArmSpec, tick_hz: u32) -> Self {
+        let f = tick_hz.max(1) as f64;
+        let j = &spec.joints;
+        let alpha = |k: usize| {
+            let a = 4_294_967_296.0 / (j[k].thermal_time_constant_s * f);
+            libm::round(a).clamp(1.0, (1u64 << 30) as f64) as i64
+        };
+        let limit = |k: usize| {
+            let r = j[k].continuous_current_a / j[k].max_current_a;
+            libm::round(r * 65_536.0).clamp(1.0, 65_536.0) as i32
+        };
+        Thermal {
+            alpha_q32: [alpha(0), alpha(1), alpha(2)],
+            limit_q16: [limit(0), limit(1), limit(2)],
+        }
+    }
+}
+
+/// A joint's heat ([`Thermal`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Heat {
+    /// The current's square over the maximum's, Q32 (0 … 2³²).
+    q32: i64,
+    /// Held to the continuous current.
+    folded: bool,
+}
+
+impl Heat {
+    /// One tick at `duty` (Q16, ±65,536): the duty, folded back if the heat says so.
+    fn tick(&mut self, duty: i32, model: &Thermal, k: usize) -> i32 {
+        let limit = model.limit_q16[k];
+        let trip = limit as i64 * limit as i64;
+        if self.q32 >= trip {
+            self.folded = true;
+        } else if self.q32 < trip * 81 / 100 {
+            self.folded = false;
+        }
+        let d = if self.folded {
+            duty.clamp(-limit, limit)
+        } else {
+            duty
+        };
+        let square = d as i64 * d as i64;
+        self.q32 += ((square - self.q32) * model.alpha_q32[k]) >> 32;
+        d
+    }
+}
+
 impl SpeedLimits {
     /// No limit (what [`ArmDevice::new`] starts with).
     pub const NONE: SpeedLimits = SpeedLimits {
@@ -229,6 +295,9 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     home_ticks: u32,
     /// The virtual walls (none by default).
     walls: Option<Walls>,
+    /// The I²t model (none by default) and each joint's heat.
+    thermal: Option<Thermal>,
+    heat: [Heat; 3],
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -259,7 +328,22 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             home_since: None,
             fresh_home: false,
             walls: None,
+            thermal: None,
+            heat: [Heat::default(); 3],
         }
+    }
+
+    /// The device with an I²t model of its motors.
+    pub fn with_thermal(mut self, thermal: Thermal) -> Self {
+        self.thermal = Some(thermal);
+        self
+    }
+
+    /// Each joint's heat, the current's square over the maximum's (0 … 1), and whether
+    /// it is folded back.
+    pub fn heat(&self) -> [(f32, bool); 3] {
+        self.heat
+            .map(|h| (h.q32 as f32 / 4_294_967_296.0, h.folded))
     }
 
     /// The device with virtual walls at its joints' limits.
@@ -449,6 +533,12 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
                 duty[k] = duty[k].saturating_add(wall[k]).clamp(-65_536, 65_536);
             }
         }
+        // The motors' heat, every tick (zero duty cools them).
+        if let Some(model) = self.thermal {
+            for k in 0..3 {
+                duty[k] = self.heat[k].tick(duty[k], &model, k);
+            }
+        }
         let written = write_joint(&mut self.joints.0, &mut self.forward[0], 0, duty[0])
             .and_then(|()| write_joint(&mut self.joints.1, &mut self.forward[1], 1, duty[1]))
             .and_then(|()| write_joint(&mut self.joints.2, &mut self.forward[2], 2, duty[2]));
@@ -470,6 +560,7 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         crate::device::DeviceStatus {
             homed: self.homed,
             at_limit: self.flags() & mccs::arm::LIMITS != 0,
+            thermal: self.heat.iter().any(|h| h.folded),
             duties: self.duty,
         }
     }
@@ -488,6 +579,8 @@ pub const WOODENHAPTICS: mccs::ArmSpec = {
             home_angle_deg: 0.0,
             torque_constant_nm_per_a: kt,
             max_current_a: 3.0,
+            continuous_current_a: 1.0,
+            thermal_time_constant_s: 41.6,
             min_angle_deg: min,
             max_angle_deg: max,
         }

@@ -208,6 +208,7 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
             .with(Flags::CLAMPED, t.clamped)
             .with(Flags::HOMED, dev.homed)
             .with(Flags::AT_LIMIT, dev.at_limit)
+            .with(Flags::THERMAL, dev.thermal)
             .with(Flags::GAIN_LIMITED, gain < GAIN_FULL);
         let window = contact.map_or([0; 2], |c| c.window);
         if self.mesh_clock.due() {

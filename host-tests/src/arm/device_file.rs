@@ -16,7 +16,7 @@ const ARM: [&str; 4] = [
     "tissue_origin_mm",
 ];
 /// The keys of each `[joint.*]`.
-const JOINT: [&str; 9] = [
+const JOINT: [&str; 11] = [
     "counts_per_rev",
     "ratio",
     "sign",
@@ -24,6 +24,8 @@ const JOINT: [&str; 9] = [
     "home_angle_deg",
     "torque_constant_nm_per_a",
     "max_current_a",
+    "continuous_current_a",
+    "thermal_time_constant_s",
     "min_angle_deg",
     "max_angle_deg",
 ];
@@ -208,6 +210,20 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
         )?;
         let torque_constant_nm_per_a = positive("torque_constant_nm_per_a")?;
         let max_current_a = positive("max_current_a")?;
+        let continuous_current_a = positive("continuous_current_a")?;
+        rule(
+            &sec,
+            "continuous_current_a",
+            continuous_current_a <= max_current_a,
+            "must be at most max_current_a",
+        )?;
+        let thermal_time_constant_s = n("thermal_time_constant_s")?;
+        rule(
+            &sec,
+            "thermal_time_constant_s",
+            (1.0..=10_000.0).contains(&thermal_time_constant_s),
+            "must be 1 … 10000 s",
+        )?;
         let angle = |k: &str| -> Result<f64, String> {
             let v = n(k)?;
             rule(
@@ -235,6 +251,8 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
             home_angle_deg,
             torque_constant_nm_per_a,
             max_current_a,
+            continuous_current_a,
+            thermal_time_constant_s,
             min_angle_deg,
             max_angle_deg,
         });

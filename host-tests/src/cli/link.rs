@@ -323,13 +323,13 @@ fn stream_args(seconds: f64, every: u16) -> Result<(), CliError> {
 }
 
 /// The telemetry CSV's columns (`watch`; a script's rows add `t_s` in front).
-pub(super) const TELEMETRY_COLUMNS: &str = "seq,tick,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,gain,contact,slipping,armed,fault,clamped,homed,at_limit,checking,fault_reason,duty_a,duty_b,duty_c,proxy_x_mm,proxy_y_mm,proxy_z_mm,dropped";
+pub(super) const TELEMETRY_COLUMNS: &str = "seq,tick,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,gain,contact,slipping,armed,fault,clamped,homed,at_limit,checking,thermal,fault_reason,duty_a,duty_b,duty_c,proxy_x_mm,proxy_y_mm,proxy_z_mm,dropped";
 
 /// A telemetry sample as a row of [`TELEMETRY_COLUMNS`].
 pub(super) fn telemetry_row(t: &TelemetrySample) -> String {
     let bit = |f: Flags| t.flags.contains(f) as u8;
     format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
         t.seq,
         t.tick,
         t.probe_mm[0],
@@ -347,6 +347,7 @@ pub(super) fn telemetry_row(t: &TelemetrySample) -> String {
         bit(Flags::HOMED),
         bit(Flags::AT_LIMIT),
         bit(Flags::CHECKING),
+        bit(Flags::THERMAL),
         t.fault.name(),
         t.duties[0],
         t.duties[1],

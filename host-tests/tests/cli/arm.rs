@@ -22,7 +22,7 @@ fn fk(device: &str, counts: &str, backend: &str) -> std::process::Output {
 fn bad_device_files_name_the_file_line_and_key() {
     let counts = temp_file("arm-counts.csv", "count_a,count_b,count_c\n0,1000,2000\n");
     let c = counts.to_str().unwrap();
-    let cases: [(&str, String, &[&str]); 7] = [
+    let cases: [(&str, String, &[&str]); 10] = [
         (
             "typo.toml",
             WOODEN.replace("upper_arm_mm = 205.0", "upper_arm_mn = 205.0"),
@@ -61,6 +61,29 @@ fn bad_device_files_name_the_file_line_and_key() {
             "joint.toml",
             WOODEN.replace("[joint.c]", "[joint.d]"),
             &["joint.d: unknown key"],
+        ),
+        (
+            "no_thermal.toml",
+            WOODEN.replacen("thermal_time_constant_s = 41.6\n", "", 1),
+            &["joint.a.thermal_time_constant_s: missing"],
+        ),
+        (
+            "hot.toml",
+            WOODEN.replacen(
+                "continuous_current_a = 1.0",
+                "continuous_current_a = 4.0",
+                1,
+            ),
+            &["joint.a.continuous_current_a: must be at most max_current_a"],
+        ),
+        (
+            "tau.toml",
+            WOODEN.replacen(
+                "thermal_time_constant_s = 41.6",
+                "thermal_time_constant_s = 0.1",
+                1,
+            ),
+            &["joint.a.thermal_time_constant_s: must be 1 … 10000 s"],
         ),
     ];
     for (name, text, needles) in cases {
