@@ -127,7 +127,8 @@ typedef struct {
   // The link's gain, 0 … 1.
   double gain;
   // Flags: bit 0 contact, 1 slipping, 2 armed, 3 fault, 4 clamped, 5 homed, 6 at a
-  // limit, 7 checking a tissue, 8 gain below full.
+  // limit, 7 checking a tissue, 8 gain below full, 9 thermal (a joint's current
+  // folded back by the I²t model).
   uint32_t flags;
   // The arm's joint duties, −1 … 1.
   double duties[3];

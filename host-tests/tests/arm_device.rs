@@ -28,6 +28,15 @@ proptest! {
     }
 }
 
+/// The shipped WoodenHaptics device file.
+fn wooden() -> mccs::ArmSpec {
+    mccs_host::arm::device_file::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../devices/woodenhaptics.toml"
+    )))
+    .unwrap()
+}
+
 /// Every call the device makes, numbered; the one numbered `fail_at` fails.
 #[derive(Default)]
 struct Calls {
@@ -142,11 +151,7 @@ struct Rig {
 type Device = ArmDevice<MockJoint, MockJoint, MockJoint, CountedPin, CountedPin>;
 
 fn rig() -> (Rig, Device) {
-    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../devices/woodenhaptics.toml"
-    )))
-    .unwrap();
+    let spec = wooden();
     let calls = Rc::new(Calls::default());
     let cell = || Rc::new(Cell::new(0u16));
     let raw = [cell(), cell(), cell()];
@@ -233,11 +238,7 @@ fn no_force_before_the_arm_is_homed() {
 /// added to the tissue's duty, on the joint past its wall only.
 #[test]
 fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
-    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../devices/woodenhaptics.toml"
-    )))
-    .unwrap();
+    let spec = wooden();
     let walls = Walls::of(&spec, 3.0);
     // B: 24,000 counts a turn, limits −30° … 90°: walls at −27° and 87° (−1,800 and 5,800
     // counts), 200 counts of margin.
@@ -293,11 +294,7 @@ fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
 /// comes back once the heat has fallen to 81 % of the limit's.
 #[test]
 fn a_joint_held_at_full_current_folds_back_to_its_continuous_current() {
-    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../devices/woodenhaptics.toml"
-    )))
-    .unwrap();
+    let spec = wooden();
     let model = Thermal::of(&spec, 1000);
     let limit = model.limit_q16[0];
     assert_eq!(limit, 21_845, "1 A of 3 A");
@@ -431,11 +428,7 @@ fn home_is_taken_only_after_the_input_stays_high_with_the_arm_still() {
 /// in a row at 1 kHz), homed and at work; the joints' counts at work.
 fn limited() -> (Rig, Device, [i32; 3]) {
     let (r, dev) = rig();
-    let spec = mccs_host::arm::device_file::read(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../devices/woodenhaptics.toml"
-    )))
-    .unwrap();
+    let spec = wooden();
     let limits = SpeedLimits::of(&spec, 1000, 2.0, 1000.0, 5);
     // 32,000 counts a turn of A, 24,000 of B and C: 64 and 48 a tick at 2 rev/s; 1 mm
     // a tick at 1 m/s.

@@ -125,9 +125,14 @@ impl Walls {
     /// The walls' duties at joint counts `from_home` (`count − home_count`), Q16: zero
     /// inside, else back toward the range, at most full duty each.
     pub fn duty(&self, from_home: [i32; 3]) -> [i32; 3] {
-        core::array::from_fn(|k| {
-            let a = from_home[k].saturating_mul(self.sign[k]);
-            let (lo, hi) = self.at[k];
+        let mut out = [0i32; 3];
+        let joints = self
+            .at
+            .iter()
+            .zip(self.duty_per_count.iter().zip(&self.sign));
+        for ((o, &count), (&(lo, hi), (&per, &sign))) in out.iter_mut().zip(&from_home).zip(joints)
+        {
+            let a = count.saturating_mul(sign);
             let past = if a > hi {
                 a - hi
             } else if a < lo {
@@ -135,9 +140,10 @@ impl Walls {
             } else {
                 0
             };
-            let d = (past as i64 * self.duty_per_count[k] as i64).clamp(-65_536, 65_536) as i32;
-            -d * self.sign[k]
-        })
+            let d = (past as i64 * per as i64).clamp(-65_536, 65_536) as i32;
+            *o = -d * sign;
+        }
+        out
     }
 }
 
@@ -150,6 +156,9 @@ pub struct Thermal {
     pub alpha_q32: [i64; 3],
     /// The continuous current over the maximum, as a duty, Q16.
     pub limit_q16: [i32; 3],
+    /// The heat at which the duty folds back (the limit's square), and below which it
+    /// comes back (81 % of that: 0.9 of the current), Q32.
+    pub trip_q32: [(i64, i64); 3],
 }
 
 impl Thermal {
@@ -165,9 +174,15 @@ impl Thermal {
             let r = j[k].continuous_current_a / j[k].max_current_a;
             libm::round(r * 65_536.0).clamp(1.0, 65_536.0) as i32
         };
+        let limit_q16 = [limit(0), limit(1), limit(2)];
+        let trip = |l: i32| {
+            let t = l as i64 * l as i64;
+            (t, libm::round(t as f64 * 0.81) as i64)
+        };
         Thermal {
             alpha_q32: [alpha(0), alpha(1), alpha(2)],
-            limit_q16: [limit(0), limit(1), limit(2)],
+            limit_q16,
+            trip_q32: limit_q16.map(trip),
         }
     }
 }
@@ -182,22 +197,23 @@ struct Heat {
 }
 
 impl Heat {
-    /// One tick at `duty` (Q16, ±65,536): the duty, folded back if the heat says so.
-    fn tick(&mut self, duty: i32, model: &Thermal, k: usize) -> i32 {
-        let limit = model.limit_q16[k];
-        let trip = limit as i64 * limit as i64;
+    /// One tick at `duty` (Q16, ±65,536) of a joint whose model is `alpha` (Q32), `limit`
+    /// (Q16) and `(trip, release)` (Q32): the duty, folded back if the heat says so.
+    #[inline(always)]
+    fn tick(&mut self, duty: i32, alpha: i64, limit: i32, (trip, release): (i64, i64)) -> i32 {
         if self.q32 >= trip {
             self.folded = true;
-        } else if self.q32 < trip * 81 / 100 {
+        } else if self.q32 < release {
             self.folded = false;
         }
+        // (`max`/`min`, not `clamp`: no panic path, whatever `limit` is.)
         let d = if self.folded {
-            duty.clamp(-limit, limit)
+            duty.max(-limit).min(limit)
         } else {
             duty
         };
         let square = d as i64 * d as i64;
-        self.q32 += ((square - self.q32) * model.alpha_q32[k]) >> 32;
+        self.q32 += ((square - self.q32) * alpha) >> 32;
         d
     }
 }
@@ -525,9 +541,12 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             _ => [0; 3],
         };
         if let (Some(walls), true) = (self.walls, self.homed && !fresh) {
-            let home = self.arm.home_counts();
-            let from_home: [i32; 3] =
-                core::array::from_fn(|k| self.counts[k].count().wrapping_sub(home[k]));
+            let (home, c) = (self.arm.home_counts(), self.counts);
+            let from_home = [
+                c[0].count().wrapping_sub(home[0]),
+                c[1].count().wrapping_sub(home[1]),
+                c[2].count().wrapping_sub(home[2]),
+            ];
             let wall = walls.duty(from_home);
             for k in 0..3 {
                 duty[k] = duty[k].saturating_add(wall[k]).clamp(-65_536, 65_536);
@@ -536,7 +555,8 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         // The motors' heat, every tick (zero duty cools them).
         if let Some(model) = self.thermal {
             for k in 0..3 {
-                duty[k] = self.heat[k].tick(duty[k], &model, k);
+                let (a, l, t) = (model.alpha_q32[k], model.limit_q16[k], model.trip_q32[k]);
+                duty[k] = self.heat[k].tick(duty[k], a, l, t);
             }
         }
         let written = write_joint(&mut self.joints.0, &mut self.forward[0], 0, duty[0])
