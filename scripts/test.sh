@@ -288,9 +288,9 @@ scene_examples() {
     fi
   done
   echo "C: target/qemu/scene-c unix:$sock"
-  LD_LIBRARY_PATH=$lib timeout 60 target/qemu/scene-c "unix:$sock" || status=1
+  LD_LIBRARY_PATH=$lib timeout --foreground 60 target/qemu/scene-c "unix:$sock" || status=1
   echo "Python: examples/python/scene.py unix:$sock"
-  MCCS_CLIENT_LIB=$lib/libmccs_client.so timeout 60 \
+  MCCS_CLIENT_LIB=$lib/libmccs_client.so timeout --foreground 60 \
     "$venv/bin/python" examples/python/scene.py "unix:$sock" || status=1
   pkill -f "path=$sock" 2> /dev/null; kill "$qemu_pid" 2> /dev/null; wait "$qemu_pid" 2> /dev/null
   return $status

@@ -25,6 +25,8 @@
 #![deny(missing_docs)]
 
 pub mod arm;
+#[cfg(target_os = "none")]
+pub mod command_line;
 pub mod controller;
 pub mod demo;
 pub mod device;

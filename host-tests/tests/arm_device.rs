@@ -188,6 +188,15 @@ fn rig() -> (Rig, Device) {
     )
 }
 
+/// The driver enabled and the arm homed (the home input high for one read, a device
+/// without debounce) at the rig's counts.
+fn enable_and_home(r: &Rig, dev: &mut Device) {
+    dev.enable().unwrap();
+    r.home.set(true);
+    dev.read_position().unwrap();
+    r.home.set(false);
+}
+
 /// Counts at a pose in the workspace, with the force pressing into it.
 fn at_work(r: &Rig) {
     // B 20°, C 38°: the probe near the tissue's origin, on the working branch
@@ -273,10 +282,7 @@ fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
     let duties = |with: bool| {
         let (r, dev) = rig();
         let mut dev = if with { dev.with_walls(walls) } else { dev };
-        dev.enable().unwrap();
-        r.home.set(true);
-        dev.read_position().unwrap();
-        r.home.set(false);
+        enable_and_home(&r, &mut dev);
         r.raw[1].set(5900);
         dev.read_position().unwrap();
         dev.write_force([Force::ZERO; 3]).unwrap();
@@ -300,10 +306,7 @@ fn a_joint_held_at_full_current_folds_back_to_its_continuous_current() {
     assert_eq!(limit, 21_845, "1 A of 3 A");
     let (r, dev) = rig();
     let mut dev = dev.with_thermal(model);
-    dev.enable().unwrap();
-    r.home.set(true);
-    dev.read_position().unwrap();
-    r.home.set(false);
+    enable_and_home(&r, &mut dev);
     at_work(&r);
     // Far more force than the motors give: some joint at 100 %.
     let push = [
@@ -435,10 +438,7 @@ fn limited() -> (Rig, Device, [i32; 3]) {
     assert_eq!(limits.joint_counts, [64, 48, 48]);
     assert_eq!(limits.probe, Length::from_num(1));
     let mut dev = dev.with_speed_limits(limits);
-    dev.enable().unwrap();
-    r.home.set(true);
-    dev.read_position().unwrap();
-    r.home.set(false);
+    enable_and_home(&r, &mut dev);
     at_work(&r);
     // One tick's jump (a tick over the limits), then a tick at rest (the run broken).
     dev.read_position().unwrap();
@@ -512,10 +512,7 @@ fn a_fault_at_every_device_call_ends_at_zero_duty() {
         Force::from_num(1.0),
         Force::from_num(-2.0),
     ];
-    dev.enable().unwrap();
-    r.home.set(true);
-    dev.read_position().unwrap();
-    r.home.set(false);
+    enable_and_home(&r, &mut dev);
     at_work(&r);
     dev.read_position().unwrap();
     dev.write_force(force).unwrap();
@@ -528,10 +525,7 @@ fn a_fault_at_every_device_call_ends_at_zero_duty() {
     let mut faults = Vec::new();
     for fail in 0..per_tick {
         let (r, mut dev) = rig();
-        dev.enable().unwrap();
-        r.home.set(true);
-        dev.read_position().unwrap();
-        r.home.set(false);
+        enable_and_home(&r, &mut dev);
         at_work(&r);
         // A tick at full force first (duties up), then one with the fault.
         dev.read_position().unwrap();
@@ -561,10 +555,7 @@ fn a_fault_at_every_device_call_ends_at_zero_duty() {
 #[test]
 fn a_failed_write_and_a_failing_safe_state_still_end_at_zero() {
     let (r, mut dev) = rig();
-    dev.enable().unwrap();
-    r.home.set(true);
-    dev.read_position().unwrap();
-    r.home.set(false);
+    enable_and_home(&r, &mut dev);
     at_work(&r);
     let force = [
         Force::from_num(1.5),

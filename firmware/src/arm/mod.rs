@@ -4,6 +4,8 @@
 //! - [`device`]: a 3-DOF arm as a [`crate::HapticDevice`] — three joints (a counter, a
 //!   PWM channel and a direction pin each), a driver enable and a home input — with its
 //!   homing and safe state, and the WoodenHaptics constant;
+//! - [`runaway`], [`walls`], [`thermal`]: what keeps the device safe beyond its parts'
+//!   faults — the speed limits, the virtual walls, the I²t model;
 //! - [`encoder`]: a joint's quadrature counter, carried past its 16 bits;
 //! - [`sim`]: the arm's chain on a recorded motion (the demo on the arm);
 //! - [`plant`]: a simulated arm behind the board's own parts (the board's `sim` build);
@@ -13,4 +15,7 @@ pub mod device;
 pub mod encoder;
 pub mod float;
 pub mod plant;
+pub mod runaway;
 pub mod sim;
+pub mod thermal;
+pub mod walls;

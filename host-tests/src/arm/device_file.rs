@@ -184,78 +184,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
         })?;
     let mut joints = Vec::new();
     for j in ["a", "b", "c"] {
-        let sec = format!("joint.{j}");
-        let n = |k: &str| number(&sec, k);
-        let positive = |k: &str| -> Result<f64, String> {
-            let v = n(k)?;
-            rule(&sec, k, v.is_finite() && v > 0.0, "must be > 0")?;
-            Ok(v)
-        };
-        let counts_per_rev = positive("counts_per_rev")?;
-        let ratio = positive("ratio")?;
-        rule(
-            &sec,
-            "counts_per_rev",
-            (16.0..=(1u64 << 30) as f64).contains(&(counts_per_rev * ratio)),
-            "counts_per_rev × ratio (counts per joint turn) must be 16 … 2^30",
-        )?;
-        let sign = n("sign")?;
-        rule(&sec, "sign", sign == 1.0 || sign == -1.0, "must be 1 or -1")?;
-        let home_count = n("home_count")?;
-        rule(
-            &sec,
-            "home_count",
-            home_count.fract() == 0.0 && home_count.abs() <= i32::MAX as f64,
-            "must be a whole number of counts",
-        )?;
-        let torque_constant_nm_per_a = positive("torque_constant_nm_per_a")?;
-        let max_current_a = positive("max_current_a")?;
-        let continuous_current_a = positive("continuous_current_a")?;
-        rule(
-            &sec,
-            "continuous_current_a",
-            continuous_current_a <= max_current_a,
-            "must be at most max_current_a",
-        )?;
-        let thermal_time_constant_s = n("thermal_time_constant_s")?;
-        rule(
-            &sec,
-            "thermal_time_constant_s",
-            (1.0..=10_000.0).contains(&thermal_time_constant_s),
-            "must be 1 … 10000 s",
-        )?;
-        let angle = |k: &str| -> Result<f64, String> {
-            let v = n(k)?;
-            rule(
-                &sec,
-                k,
-                v.is_finite() && v.abs() <= 180.0,
-                "must be within ±180°",
-            )?;
-            Ok(v)
-        };
-        let home_angle_deg = angle("home_angle_deg")?;
-        let min_angle_deg = angle("min_angle_deg")?;
-        let max_angle_deg = angle("max_angle_deg")?;
-        rule(
-            &sec,
-            "min_angle_deg",
-            min_angle_deg < home_angle_deg && home_angle_deg < max_angle_deg,
-            "must be below home_angle_deg, and max_angle_deg above it",
-        )?;
-        joints.push(JointSpec {
-            counts_per_rev,
-            ratio,
-            sign,
-            home_count: home_count as i32,
-            home_angle_deg,
-            torque_constant_nm_per_a,
-            max_current_a,
-            continuous_current_a,
-            thermal_time_constant_s,
-            min_angle_deg,
-            max_angle_deg,
-        });
+        joints.push(joint(&format!("joint.{j}"), &number, &rule)?);
     }
     let gravity = match section("gravity") {
         None => None,
@@ -295,4 +224,85 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
     };
     spec.validate().map_err(|e| format!("{file}: {e}"))?;
     Ok(spec)
+}
+
+/// A key's number: `(section, key)`, or the line naming why not.
+type NumberAt<'a> = dyn Fn(&str, &str) -> Result<f64, String> + 'a;
+/// A key's range: `(section, key, within, what it must be)`.
+type Rule<'a> = dyn Fn(&str, &str, bool, &str) -> Result<(), String> + 'a;
+
+/// The section `sec` (`joint.a` …) of a device file: each key read by `number` and held
+/// by `rule` to its range, naming the file, line and key.
+fn joint(sec: &str, number: &NumberAt, rule: &Rule) -> Result<JointSpec, String> {
+    let n = |k: &str| number(sec, k);
+    let positive = |k: &str| -> Result<f64, String> {
+        let v = n(k)?;
+        rule(sec, k, v.is_finite() && v > 0.0, "must be > 0")?;
+        Ok(v)
+    };
+    let counts_per_rev = positive("counts_per_rev")?;
+    let ratio = positive("ratio")?;
+    rule(
+        sec,
+        "counts_per_rev",
+        (16.0..=(1u64 << 30) as f64).contains(&(counts_per_rev * ratio)),
+        "counts_per_rev × ratio (counts per joint turn) must be 16 … 2^30",
+    )?;
+    let sign = n("sign")?;
+    rule(sec, "sign", sign == 1.0 || sign == -1.0, "must be 1 or -1")?;
+    let home_count = n("home_count")?;
+    rule(
+        sec,
+        "home_count",
+        home_count.fract() == 0.0 && home_count.abs() <= i32::MAX as f64,
+        "must be a whole number of counts",
+    )?;
+    let torque_constant_nm_per_a = positive("torque_constant_nm_per_a")?;
+    let max_current_a = positive("max_current_a")?;
+    let continuous_current_a = positive("continuous_current_a")?;
+    rule(
+        sec,
+        "continuous_current_a",
+        continuous_current_a <= max_current_a,
+        "must be at most max_current_a",
+    )?;
+    let thermal_time_constant_s = n("thermal_time_constant_s")?;
+    rule(
+        sec,
+        "thermal_time_constant_s",
+        (1.0..=10_000.0).contains(&thermal_time_constant_s),
+        "must be 1 … 10000 s",
+    )?;
+    let angle = |k: &str| -> Result<f64, String> {
+        let v = n(k)?;
+        rule(
+            sec,
+            k,
+            v.is_finite() && v.abs() <= 180.0,
+            "must be within ±180°",
+        )?;
+        Ok(v)
+    };
+    let home_angle_deg = angle("home_angle_deg")?;
+    let min_angle_deg = angle("min_angle_deg")?;
+    let max_angle_deg = angle("max_angle_deg")?;
+    rule(
+        sec,
+        "min_angle_deg",
+        min_angle_deg < home_angle_deg && home_angle_deg < max_angle_deg,
+        "must be below home_angle_deg, and max_angle_deg above it",
+    )?;
+    Ok(JointSpec {
+        counts_per_rev,
+        ratio,
+        sign,
+        home_count: home_count as i32,
+        home_angle_deg,
+        torque_constant_nm_per_a,
+        max_current_a,
+        continuous_current_a,
+        thermal_time_constant_s,
+        min_angle_deg,
+        max_angle_deg,
+    })
 }

@@ -310,22 +310,8 @@ fn budget_test_requested() -> bool {
     #[cfg(not(feature = "rtt"))]
     {
         let mut line = [0u8; 256];
-        // SYS_GET_CMDLINE's block: the buffer and its length, which the host replaces
-        // with the length it wrote.
-        let mut block = [line.as_mut_ptr() as usize, line.len()];
-        // SAFETY: the host writes at most `block[1]` bytes to `block[0]`, a live buffer,
-        // and one word to `block[1]`; the call has no other effect.
-        let failed = unsafe {
-            cortex_m_semihosting::syscall1(
-                cortex_m_semihosting::nr::GET_CMDLINE,
-                block.as_mut_ptr() as usize,
-            )
-        } != 0;
-        let len = block[1].min(line.len());
-        !failed
-            && line[..len]
-                .split(|&b| b == b' ')
-                .any(|word| word == b"budget-test")
+        let asked = mccs_firmware::command_line::words(&mut line).any(|w| w == b"budget-test");
+        asked
     }
     #[cfg(feature = "rtt")]
     false

@@ -178,19 +178,9 @@ fn UsageFault() -> ! {
 #[cfg(board_fault_test)]
 pub fn inject_fault(scb: &mut cortex_m::peripheral::SCB) {
     let mut line = [0u8; 128];
-    // SYS_GET_CMDLINE's block: the buffer and its length, which the host replaces with
-    // the length it wrote.
-    let mut block = [line.as_mut_ptr() as usize, line.len()];
-    // SAFETY: the host writes at most `block[1]` bytes to `block[0]`, a live buffer, and
-    // one word to `block[1]`; the call has no other effect.
-    let failed = unsafe {
-        cortex_m_semihosting::syscall1(
-            cortex_m_semihosting::nr::GET_CMDLINE,
-            block.as_mut_ptr() as usize,
-        )
-    } != 0;
-    let len = if failed { 0 } else { block[1].min(line.len()) };
-    let class = line[..len].split(|&b| b == b' ').nth(1).unwrap_or(b"");
+    let class = mccs_firmware::command_line::words(&mut line)
+        .nth(1)
+        .unwrap_or(b"");
     defmt::info!("fault-test: injecting {=[u8]:a}", class);
     match class {
         b"panic" => panic!("injected"),
