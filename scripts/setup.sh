@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the project needs on a fresh machine and says so: the three thumb
 # targets, rustup's clippy and rustfmt (the test command's lints and format check) and
-# llvm-tools (for the tick-path check), and Debian's qemu-system-arm (as root).
+# llvm-tools (for the tick-path check), and Debian's qemu-system-arm and chromium (as
+# root; chromium for `mccs view`'s browser test).
 # Sourced by scripts/demo.sh and scripts/test.sh.
 set -euo pipefail
 
@@ -37,5 +38,17 @@ if ! command -v qemu-system-arm > /dev/null 2>&1; then
   else
     echo "setup: qemu-system-arm is missing and this is not root: run 'sudo apt-get install qemu-system-arm' and try again" >&2
     exit 1
+  fi
+fi
+
+if ! command -v chromium > /dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ]; then
+    echo "setup: installing Debian's chromium (apt-get, a minute or two: the browser test of mccs view)" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq > /dev/null
+    apt-get install -y -qq --no-install-recommends chromium > /dev/null
+  else
+    # (Only the test command's browser stage needs it: the demo goes on without.)
+    echo "setup: chromium is missing and this is not root: 'sudo apt-get install chromium' for the browser test of mccs view" >&2
   fi
 fi

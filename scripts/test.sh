@@ -261,6 +261,22 @@ link_qemu() {
   return $status
 }
 
+# The simulated arm board in QEMU with its link on the unix socket $1, its log in $2;
+# returns once the socket is there, QEMU's pid in SIM_BOARD_PID.
+sim_board() {
+  local sock=$1 log=$2 waited=0
+  rm -f "$sock"
+  bash scripts/qemu-link.sh --sim "$sock" > "$log" 2>&1 < /dev/null &
+  SIM_BOARD_PID=$!
+  until [ -S "$sock" ]; do
+    sleep 0.5; waited=$((waited + 1))
+    if [ "$waited" -gt 600 ] || ! kill -0 "$SIM_BOARD_PID" 2> /dev/null; then
+      echo "QEMU did not open $sock ($log)"; tail -n 5 "$log"
+      kill "$SIM_BOARD_PID" 2> /dev/null; return 1
+    fi
+  done
+}
+
 # The scene's first lines, as a scene's author builds and runs them (examples/c/scene.c,
 # examples/python/scene.py), against the simulated arm board in QEMU
 # (scripts/qemu-link.sh --sim): the C ABI, the example compiled with gcc as its header
@@ -277,21 +293,28 @@ scene_examples() {
   # (From a copy: setuptools builds in the source tree, its build/ and egg-info.)
   rm -rf target/python-src && cp -r client/python target/python-src || return 1
   "$venv/bin/pip" install --quiet target/python-src > /dev/null || return 1
-  bash scripts/qemu-link.sh --sim "$sock" > target/qemu/scene-firmware.log 2>&1 < /dev/null &
-  qemu_pid=$!
-  local waited=0
-  until [ -S "$sock" ]; do
-    sleep 0.5; waited=$((waited + 1))
-    if [ "$waited" -gt 600 ] || ! kill -0 "$qemu_pid" 2> /dev/null; then
-      echo "QEMU did not open $sock (target/qemu/scene-firmware.log)"; tail -n 5 target/qemu/scene-firmware.log
-      kill "$qemu_pid" 2> /dev/null; return 1
-    fi
-  done
+  sim_board "$sock" target/qemu/scene-firmware.log || return 1
+  qemu_pid=$SIM_BOARD_PID
   echo "C: target/qemu/scene-c unix:$sock"
   LD_LIBRARY_PATH=$lib timeout --foreground 60 target/qemu/scene-c "unix:$sock" || status=1
   echo "Python: examples/python/scene.py unix:$sock"
   MCCS_CLIENT_LIB=$lib/libmccs_client.so timeout --foreground 60 \
     "$venv/bin/python" examples/python/scene.py "unix:$sock" || status=1
+  pkill -f "path=$sock" 2> /dev/null; kill "$qemu_pid" 2> /dev/null; wait "$qemu_pid" 2> /dev/null
+  return $status
+}
+
+# `mccs view` in headless Chromium (host-tests/tests/browser/view.py: each step named):
+# against the demo's soft device, then against the simulated arm board in QEMU.
+view_browser() {
+  local sock=target/qemu/view.sock qemu_pid status=0
+  echo "mccs view --demo"
+  timeout --foreground 120 python3 host-tests/tests/browser/view.py target/debug/mccs --demo || status=1
+  sim_board "$sock" target/qemu/view-firmware.log || return 1
+  qemu_pid=$SIM_BOARD_PID
+  echo "mccs view --connect unix:$sock (the simulated arm board in QEMU)"
+  timeout --foreground 120 python3 host-tests/tests/browser/view.py target/debug/mccs \
+    --connect "unix:$sock" || status=1
   pkill -f "path=$sock" 2> /dev/null; kill "$qemu_pid" 2> /dev/null; wait "$qemu_pid" 2> /dev/null
   return $status
 }
@@ -360,6 +383,7 @@ run_stage board-f405-arm board_f405_arm
 run_stage board-faults board_faults
 run_stage link-qemu link_qemu
 run_stage scene-examples scene_examples
+run_stage view-browser view_browser
 run_stage client-windows client_windows
 run_stage host-tests wait_host_tests
 run_stage docs-figures python3 scripts/figures.py check

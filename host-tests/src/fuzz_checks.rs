@@ -15,7 +15,7 @@ use std::path::Path;
 pub type Check = fn(&[u8]);
 
 /// The targets, by name, with their checks.
-pub const TARGETS: [(&str, Check); 9] = [
+pub const TARGETS: [(&str, Check); 10] = [
     ("param_file", param_file),
     ("fit_data", fit_data),
     ("trajectory", trajectory),
@@ -25,6 +25,7 @@ pub const TARGETS: [(&str, Check); 9] = [
     ("demo_summary", demo_summary),
     ("arm_device_file", arm_device_file),
     ("joints", joints),
+    ("view_request", view_request),
 ];
 
 /// A parameter file: a one-line error naming the file, or parameters that validate,
@@ -410,5 +411,24 @@ pub fn joints(data: &[u8]) {
             assert!(!ticks.is_empty());
         }
         Err(e) => assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}"),
+    }
+}
+
+/// A request to `mccs view` (any bytes from a browser): refused with a status the server
+/// answers (400, 413, 431), or a request whose body fits; its body as a pose and as a
+/// parameter file is a pose, a tissue, or one line why not.
+pub fn view_request(data: &[u8]) {
+    use crate::view::http::{read_request, MAX_BODY};
+    match read_request(data) {
+        Ok(r) => {
+            assert!(r.body.len() <= MAX_BODY && !r.path.contains('?'));
+            if let Err(why) = crate::view::pose_of(&r.body) {
+                assert!(!why.contains('\n'));
+            }
+            if let Err(why) = crate::view::tissue_of(&r.body) {
+                assert!(!why.contains('\n'), "{why}");
+            }
+        }
+        Err(e) => assert!([400, 413, 431].contains(&e.status), "{e:?}"),
     }
 }

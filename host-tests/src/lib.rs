@@ -14,5 +14,6 @@ pub mod reference;
 pub mod replay;
 pub mod roam;
 pub mod stability;
+pub mod view;
 
 pub use mccs_client::{paramfile, trajectory};

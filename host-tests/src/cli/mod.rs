@@ -20,6 +20,7 @@ mod patch_args;
 mod progress;
 mod replay;
 mod table;
+mod view;
 mod watch;
 
 pub use demo::{parse_summary, FirmwareSummary};
@@ -188,6 +189,10 @@ enum Command {
     /// Talk to a device over the host link (docs/link.md): hello, status, load a tissue,
     /// replay a trajectory on the device, watch its live telemetry, pose, arm, disarm.
     Link(link::Args),
+    /// A live view of a device in the browser (docs/view.md): the patch in 3-D, the
+    /// force and flags over the last 10 s, the device's facts and counters, and its
+    /// controls, served on 127.0.0.1 from this binary; `--demo` needs no board.
+    View(view::Args),
 }
 
 /// Runs the parsed command, writing its output to `out`.
@@ -205,6 +210,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Check(a) => check::run(a, out),
         Command::Link(a) => link::run(a, out),
         Command::Arm(a) => arm::run(a, out),
+        Command::View(a) => view::run(a, out),
     }
 }
 

@@ -10,6 +10,7 @@ mod one_table;
 mod patch;
 mod replay;
 mod table;
+mod view;
 mod walks;
 
 use std::io::Write;
