@@ -39,8 +39,15 @@ fn a_view_needs_one_device() {
 
 /// `mccs view --demo --port 0`, and the address it printed.
 fn demo_view() -> (Child, String) {
+    view(&["--demo"])
+}
+
+/// `mccs view ARGS --port 0`, and the address it printed.
+fn view(args: &[&str]) -> (Child, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_mccs"))
-        .args(["view", "--demo", "--port", "0"])
+        .arg("view")
+        .args(args)
+        .args(["--port", "0"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -57,6 +64,26 @@ fn demo_view() -> (Child, String) {
         .unwrap_or_else(|| panic!("no address in {line:?}"))
         .to_string();
     (child, addr)
+}
+
+/// The events of a page until one of `kind` arrives (its data line), within `seconds`.
+fn events_until(addr: &str, kind: &str, seconds: u64) -> String {
+    let mut events = TcpStream::connect(addr).unwrap();
+    events
+        .set_read_timeout(Some(std::time::Duration::from_secs(seconds)))
+        .unwrap();
+    events.write_all(b"GET /events HTTP/1.1\r\n\r\n").unwrap();
+    let mut r = BufReader::new(events);
+    let want = format!("event: {kind}\n");
+    let mut last = String::new();
+    loop {
+        let mut l = String::new();
+        assert!(r.read_line(&mut l).unwrap_or(0) > 0, "no {kind} event");
+        if last == want {
+            return l;
+        }
+        last = l;
+    }
 }
 
 /// One request; the whole answer.
@@ -121,6 +148,24 @@ fn the_demo_serves_its_page_its_events_and_refuses_a_watcher_s_control() {
         armed.starts_with("HTTP/1.1 200") && armed.contains("armed=1"),
         "{armed}"
     );
+    child.kill().unwrap();
+    child.wait().unwrap();
+}
+
+#[test]
+fn a_device_lost_while_serving_is_an_event_and_the_view_goes_on() {
+    let dir = std::env::temp_dir().join(format!("mccs-view-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let socket = dir.join("lost.sock");
+    let table = mccs::ForceTable64::new(&mccs::Params::TABLE2).unwrap();
+    let soft = mccs_host::link::soft::serve(&socket, table).unwrap();
+    let (mut child, addr) = view(&["--connect", soft.addr()]);
+    assert!(events_until(&addr, "status", 10).contains("\"armed\":false"));
+    soft.stop();
+    let lost = events_until(&addr, "device", 20);
+    assert!(lost.starts_with("data: {\"error\":"), "{lost}");
+    // The page is still served.
+    assert!(http(&addr, "GET / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 200"));
     child.kill().unwrap();
     child.wait().unwrap();
 }
