@@ -24,6 +24,8 @@ mod contact;
 mod demo;
 #[path = "device.rs"]
 mod device;
+#[path = "doc_commands.rs"]
+mod doc_commands;
 #[path = "doc_snippets.rs"]
 mod doc_snippets;
 #[path = "docs.rs"]
