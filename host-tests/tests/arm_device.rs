@@ -4,7 +4,7 @@
 
 use mccs::{Arm, Force, Length};
 use mccs_firmware::arm::device::{
-    ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Thermal, Walls,
+    ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Thermal, Trims, Walls,
 };
 use mccs_firmware::arm::encoder::Extended;
 use mccs_firmware::HapticDevice;
@@ -292,6 +292,51 @@ fn a_joint_past_its_wall_is_pushed_back_full_at_the_stop() {
     assert_eq!(walled[0], plain[0]);
     assert_eq!(walled[2], plain[2]);
     assert_eq!(walled[1], (plain[1] + past[1]).clamp(-65_536, 65_536));
+}
+
+/// The amplifiers' trims: none before homing (zero duty), each duty through its joint's
+/// offset and dead band after, and a failed write still ends at zero duty, not the offset.
+#[test]
+fn the_trims_shift_each_duty_once_homed_and_never_before() {
+    let mut spec = wooden();
+    spec.joints[0].duty_offset = 0.02;
+    spec.joints[1].dead_band = 0.05;
+    spec.joints[2].duty_offset = -0.01;
+    spec.joints[2].dead_band = 0.03;
+    let trims = Trims::of(&spec);
+    let push = [
+        Force::from_num(0.5),
+        Force::from_num(-0.5),
+        Force::from_num(0.3),
+    ];
+    let duties = |with: bool, home: bool| {
+        let (r, dev) = rig();
+        let mut dev = if with { dev.with_trims(trims) } else { dev };
+        if home {
+            enable_and_home(&r, &mut dev);
+            at_work(&r);
+        }
+        dev.read_position().unwrap();
+        dev.write_force(push).unwrap();
+        dev.duties()
+    };
+    assert_eq!(
+        duties(true, false),
+        [0; 3],
+        "not homed: zero duty, trims or not"
+    );
+    let (plain, trimmed) = (duties(false, true), duties(true, true));
+    assert_eq!(trimmed, trims.apply(plain), "{plain:?} → {trimmed:?}");
+    assert_ne!(trimmed, plain);
+    let (r, dev) = rig();
+    let mut dev = dev.with_trims(trims);
+    enable_and_home(&r, &mut dev);
+    dev.safe_state().unwrap();
+    assert_eq!(
+        dev.duties(),
+        [0; 3],
+        "the safe state is zero duty, not the offset"
+    );
 }
 
 /// The I²t model: a joint held at 100 % duty folds back to its continuous current within

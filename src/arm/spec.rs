@@ -23,6 +23,12 @@ pub struct JointSpec {
     pub continuous_current_a: f64,
     /// The motor winding's thermal time constant, s (1 … 10,000).
     pub thermal_time_constant_s: f64,
+    /// The amplifier's trim: the duty at which its current is zero, a fraction of full
+    /// duty (−0.2 … 0.2; measured by the locked-rotor sweep of docs/arm.md).
+    pub duty_offset: f64,
+    /// The amplifier's trim: how far past the offset the duty goes before current flows,
+    /// a fraction of full duty (0 … 0.2).
+    pub dead_band: f64,
     /// The joint's range, degrees (`min < max`, within ±180).
     pub min_angle_deg: f64,
     /// See `min_angle_deg`.
@@ -92,6 +98,8 @@ pub enum ArmError {
     /// A continuous current not `0 < x ≤ max_current_a`, or a thermal time constant not
     /// 1 … 10,000 s.
     Thermal(u8),
+    /// A duty offset not −0.2 … 0.2, or a dead band not 0 … 0.2.
+    Trim(u8),
     /// A mass or centre of mass negative or not finite, `g` not finite, or a gravity
     /// torque of 32,768 N·mm or more.
     Gravity,
@@ -108,6 +116,7 @@ impl ArmError {
             Self::Motor(_) => "joint: torque_constant_nm_per_a and max_current_a must be finite and > 0",
             Self::Range(_) => "joint: min_angle_deg < home_angle_deg < max_angle_deg, within ±180",
             Self::Thermal(_) => "joint: 0 < continuous_current_a ≤ max_current_a, thermal_time_constant_s 1 … 10000",
+            Self::Trim(_) => "joint: duty_offset must be -0.2 … 0.2 and dead_band 0 … 0.2",
             Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g finite, the torques under 32768 N·mm",
         }
     }
@@ -119,7 +128,8 @@ impl ArmError {
             | Self::Sign(j)
             | Self::Motor(j)
             | Self::Range(j)
-            | Self::Thermal(j) => Some(*j),
+            | Self::Thermal(j)
+            | Self::Trim(j) => Some(*j),
             _ => None,
         }
     }
@@ -181,6 +191,9 @@ impl ArmSpec {
             let tau = j.thermal_time_constant_s;
             if !(positive(c) && c <= j.max_current_a && (1.0..=10_000.0).contains(&tau)) {
                 return Err(ArmError::Thermal(i));
+            }
+            if !((-0.2..=0.2).contains(&j.duty_offset) && (0.0..=0.2).contains(&j.dead_band)) {
+                return Err(ArmError::Trim(i));
             }
         }
         if let Some(g) = &self.gravity {

@@ -11,7 +11,7 @@ use crate::device::{
 };
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits, Thermal, Walls};
+use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits, Thermal, Trims, Walls};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
 
@@ -83,7 +83,8 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
         .with_speed_limits(limits)
         .with_home_debounce(debounce)
         .with_walls(Walls::of(spec, WALL_MARGIN_DEG))
-        .with_thermal(Thermal::of(spec, config.tick_hz));
+        .with_thermal(Thermal::of(spec, config.tick_hz))
+        .with_trims(Trims::of(spec));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

@@ -21,6 +21,9 @@
 //!   continuous current's square the joint's duty folds back to the continuous current,
 //!   and stays folded until the heat falls to 81 % of it (0.9 of the current); the
 //!   `thermal` status while any joint is folded.
+//! - **Trims** ([`Trims`], [`ArmDevice::with_trims`]): each duty, last, through its
+//!   amplifier's offset and dead band, so that the current is what the force needs
+//!   (zero duty before homing stays zero).
 //! - **Virtual walls** ([`Walls`], [`ArmDevice::with_walls`]; the board's: 3° inside
 //!   each mechanical stop): a homed joint past its wall gets a duty back toward its range,
 //!   proportional to how far past, full duty at the stop, added to the tissue's (the sum
@@ -34,6 +37,7 @@
 
 pub use crate::arm::runaway::SpeedLimits;
 pub use crate::arm::thermal::Thermal;
+pub use crate::arm::trims::Trims;
 pub use crate::arm::walls::Walls;
 
 use crate::arm::encoder::{Extended, JointEncoder};
@@ -136,6 +140,8 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     /// The I²t model (none by default) and each joint's heat.
     thermal: Option<Thermal>,
     heat: [Heat; 3],
+    /// The amplifiers' trims (none by default).
+    trims: Trims,
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -168,7 +174,15 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             walls: None,
             thermal: None,
             heat: [Heat::default(); 3],
+            trims: Trims::default(),
         }
+    }
+
+    /// The device with its amplifiers' trims: each duty written through them once the
+    /// arm is homed (before, zero duty).
+    pub fn with_trims(mut self, trims: Trims) -> Self {
+        self.trims = trims;
+        self
     }
 
     /// The device with an I²t model of its motors.
@@ -381,6 +395,10 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
                 duty[k] = self.heat[k].tick(duty[k], a, l, t);
             }
         }
+        if self.homed && !fresh {
+            // The current each duty stands for, as the amplifiers give it.
+            duty = self.trims.apply(duty);
+        }
         let written = write_joint(&mut self.joints.0, &mut self.forward[0], 0, duty[0])
             .and_then(|()| write_joint(&mut self.joints.1, &mut self.forward[1], 1, duty[1]))
             .and_then(|()| write_joint(&mut self.joints.2, &mut self.forward[2], 2, duty[2]));
@@ -423,6 +441,8 @@ pub const WOODENHAPTICS: mccs::ArmSpec = {
             max_current_a: 3.0,
             continuous_current_a: 1.0,
             thermal_time_constant_s: 41.6,
+            duty_offset: 0.0,
+            dead_band: 0.0,
             min_angle_deg: min,
             max_angle_deg: max,
         }

@@ -6,6 +6,7 @@
 //!   homing and safe state, and the WoodenHaptics constant;
 //! - [`runaway`], [`walls`], [`thermal`]: what keeps the device safe beyond its parts'
 //!   faults — the speed limits, the virtual walls, the I²t model;
+//! - [`trims`]: each amplifier's duty offset and dead band;
 //! - [`encoder`]: a joint's quadrature counter, carried past its 16 bits;
 //! - [`sim`]: the arm's chain on a recorded motion (the demo on the arm);
 //! - [`plant`]: a simulated arm behind the board's own parts (the board's `sim` build);
@@ -18,4 +19,5 @@ pub mod plant;
 pub mod runaway;
 pub mod sim;
 pub mod thermal;
+pub mod trims;
 pub mod walls;

@@ -16,7 +16,7 @@ const ARM: [&str; 4] = [
     "tissue_origin_mm",
 ];
 /// The keys of each `[joint.*]`.
-const JOINT: [&str; 11] = [
+const JOINT: [&str; 13] = [
     "counts_per_rev",
     "ratio",
     "sign",
@@ -26,6 +26,8 @@ const JOINT: [&str; 11] = [
     "max_current_a",
     "continuous_current_a",
     "thermal_time_constant_s",
+    "duty_offset",
+    "dead_band",
     "min_angle_deg",
     "max_angle_deg",
 ];
@@ -273,6 +275,20 @@ fn joint(sec: &str, number: &NumberAt, rule: &Rule) -> Result<JointSpec, String>
         (1.0..=10_000.0).contains(&thermal_time_constant_s),
         "must be 1 … 10000 s",
     )?;
+    let duty_offset = n("duty_offset")?;
+    rule(
+        sec,
+        "duty_offset",
+        (-0.2..=0.2).contains(&duty_offset),
+        "must be -0.2 … 0.2 (of full duty)",
+    )?;
+    let dead_band = n("dead_band")?;
+    rule(
+        sec,
+        "dead_band",
+        (0.0..=0.2).contains(&dead_band),
+        "must be 0 … 0.2 (of full duty)",
+    )?;
     let angle = |k: &str| -> Result<f64, String> {
         let v = n(k)?;
         rule(
@@ -302,6 +318,8 @@ fn joint(sec: &str, number: &NumberAt, rule: &Rule) -> Result<JointSpec, String>
         max_current_a,
         continuous_current_a,
         thermal_time_constant_s,
+        duty_offset,
+        dead_band,
         min_angle_deg,
         max_angle_deg,
     })

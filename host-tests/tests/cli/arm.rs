@@ -22,7 +22,7 @@ fn fk(device: &str, counts: &str, backend: &str) -> std::process::Output {
 fn bad_device_files_name_the_file_line_and_key() {
     let counts = temp_file("arm-counts.csv", "count_a,count_b,count_c\n0,1000,2000\n");
     let c = counts.to_str().unwrap();
-    let cases: [(&str, String, &[&str]); 10] = [
+    let cases: [(&str, String, &[&str]); 13] = [
         (
             "typo.toml",
             WOODEN.replace("upper_arm_mm = 205.0", "upper_arm_mn = 205.0"),
@@ -84,6 +84,21 @@ fn bad_device_files_name_the_file_line_and_key() {
                 1,
             ),
             &["joint.a.thermal_time_constant_s: must be 1 … 10000 s"],
+        ),
+        (
+            "no_trim.toml",
+            WOODEN.replacen("dead_band = 0.0\n", "", 2),
+            &["joint.a.dead_band: missing"],
+        ),
+        (
+            "offset.toml",
+            WOODEN.replacen("duty_offset = 0.0 ", "duty_offset = 0.3 ", 1),
+            &["joint.a.duty_offset: must be -0.2 … 0.2 (of full duty)"],
+        ),
+        (
+            "band.toml",
+            WOODEN.replacen("dead_band = 0.0", "dead_band = -0.01", 1),
+            &["joint.a.dead_band: must be 0 … 0.2 (of full duty)"],
         ),
     ];
     for (name, text, needles) in cases {
