@@ -2,7 +2,7 @@
 //! to 32 bits at any speed the arm reaches, no force before homing, and a fault injected
 //! at every device call ending with every duty at zero and the driver disabled.
 
-use mccs::{Arm, Force, Length};
+use mccs::{Arm, Force, Length, PassivityLimits};
 use mccs_firmware::arm::device::{
     ArmDevice, ArmFault, Joint, PartFailed, SpeedLimits, Thermal, Trims, Walls,
 };
@@ -337,6 +337,50 @@ fn the_trims_shift_each_duty_once_homed_and_never_before() {
         [0; 3],
         "the safe state is zero duty, not the offset"
     );
+}
+
+/// The passivity observer on the device: a force along the probe's motion (energy put
+/// into the hand) is a fault once 2 mJ beyond the credit, zero duty first; the same
+/// force against the motion (a passive tissue) never is.
+#[test]
+fn a_force_along_the_probe_s_motion_trips_the_passivity_observer_zero_duty_first() {
+    let limits = PassivityLimits::new(2.0, 10.0);
+    for (along, trips) in [(-1.0, false), (1.0, true)] {
+        let (r, dev) = rig();
+        let mut dev = dev.with_passivity(limits);
+        enable_and_home(&r, &mut dev);
+        at_work(&r);
+        let mm = |p: [Length; 3]| p.map(|x| x.to_num::<f64>());
+        let mut last = mm(dev.read_position().unwrap());
+        dev.write_force([Force::ZERO; 3]).unwrap();
+        let mut ended = None;
+        for t in 0..2000 {
+            // Joint B creeping a count a tick (64 µm at the probe, about).
+            r.raw[1].set(r.raw[1].get().wrapping_add(1));
+            let p = mm(dev.read_position().unwrap());
+            let d: Vec<f64> = (0..3).map(|i| p[i] - last[i]).collect();
+            let len = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let f = [0, 1, 2].map(|i| Force::from_num(along * 2.0 * d[i] / len));
+            if let Err(e) = dev.write_force(f) {
+                ended = Some((t, e));
+                break;
+            }
+            last = p;
+        }
+        if trips {
+            let (t, e) = ended.expect("tripped");
+            assert_eq!(e, ArmFault::EnergyOut);
+            assert!(t < 30, "tripped at tick {t}");
+            assert_eq!(dev.duties(), [0; 3]);
+            assert!(r.duty.iter().all(|d| d.get() == 0), "zero duty written");
+        } else {
+            assert_eq!(ended, None);
+            assert!(
+                (dev.passivity_mj().unwrap() - 10.0).abs() < 1e-3,
+                "the credit full"
+            );
+        }
+    }
 }
 
 /// The I²t model: a joint held at 100 % duty folds back to its continuous current within

@@ -10,7 +10,7 @@ use crate::device::{
     roaming_controller_with, BoardController, BoardRoaming, DevicePart, StartError, StartFault,
 };
 use embedded_hal::digital::{InputPin, OutputPin};
-use mccs::{Arm, ArmSpec, ForceTable};
+use mccs::{Arm, ArmSpec, ForceTable, PassivityLimits};
 use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits, Thermal, Trims, Walls};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
@@ -39,6 +39,7 @@ impl StartError<ArmFault> {
                 ArmFault::Home => DevicePart::Home,
                 ArmFault::Overspeed(k) => DevicePart::JointSpeed(k),
                 ArmFault::ProbeSpeed => DevicePart::ProbeSpeed,
+                ArmFault::EnergyOut => DevicePart::EnergyOut,
             }),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
@@ -57,6 +58,12 @@ pub const RUNAWAY_TICKS: u8 = 5;
 pub const WALL_MARGIN_DEG: f64 = 3.0;
 /// How long the home input must stay high, with the arm still, before the arm homes, ms.
 pub const HOME_DEBOUNCE_MS: u32 = 50;
+/// The passivity observer: energy put into the hand beyond the credit by this much,
+/// mJ, is a fault (docs/safety.md).
+pub const PASSIVITY_TRIP_MJ: f64 = 2.0;
+/// The most the hand's earlier input may pay for later output, mJ: above what the
+/// tissue stores at the force clamp (3 N over 6 mm: 9 mJ).
+pub const PASSIVITY_CREDIT_MJ: f64 = 10.0;
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input
@@ -84,7 +91,8 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
         .with_home_debounce(debounce)
         .with_walls(Walls::of(spec, WALL_MARGIN_DEG))
         .with_thermal(Thermal::of(spec, config.tick_hz))
-        .with_trims(Trims::of(spec));
+        .with_trims(Trims::of(spec))
+        .with_passivity(PassivityLimits::new(PASSIVITY_TRIP_MJ, PASSIVITY_CREDIT_MJ));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

@@ -147,6 +147,8 @@ pub enum DevicePart {
     JointSpeed(u8),
     /// The arm's probe moved faster than its limit (a runaway).
     ProbeSpeed,
+    /// The arm's force put out energy beyond the passivity observer's trip.
+    EnergyOut,
 }
 
 impl DevicePart {
@@ -193,6 +195,7 @@ impl DevicePart {
                 ],
             ),
             Self::ProbeSpeed => "the probe running away",
+            Self::EnergyOut => "the force putting energy into the hand (passivity)",
         }
     }
 }

@@ -21,6 +21,10 @@
 //!   continuous current's square the joint's duty folds back to the continuous current,
 //!   and stays folded until the heat falls to 81 % of it (0.9 of the current); the
 //!   `thermal` status while any joint is folded.
+//! - **Passivity** ([`ArmDevice::with_passivity`], [`mccs::PassivityObserver`]): the
+//!   work the rendered force does on the probe, tick by tick; energy put out beyond the
+//!   hand's recent input (held to a credit) by more than the trip is
+//!   [`ArmFault::EnergyOut`], zero duty first.
 //! - **Trims** ([`Trims`], [`ArmDevice::with_trims`]): each duty, last, through its
 //!   amplifier's offset and dead band, so that the current is what the force needs
 //!   (zero duty before homing stays zero).
@@ -46,7 +50,7 @@ use crate::device::HapticDevice;
 use embedded_hal::digital::{InputPin, OutputPin};
 use embedded_hal::pwm::SetDutyCycle;
 use mccs::arm::OUTSIDE;
-use mccs::{Arm, ArmPose, Force, Length};
+use mccs::{Arm, ArmPose, Force, Length, PassivityLimits, PassivityObserver};
 
 /// One joint's parts.
 #[derive(Debug)]
@@ -76,6 +80,9 @@ pub enum ArmFault {
     Overspeed(u8),
     /// The probe moved faster than its limit for the ticks [`SpeedLimits`] allows.
     ProbeSpeed,
+    /// The rendered force put energy into the hand beyond what the passivity observer
+    /// allows ([`ArmDevice::with_passivity`]): an unstable tissue, a reversed sign.
+    EnergyOut,
 }
 
 /// A joint's part that failed.
@@ -142,6 +149,8 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     heat: [Heat; 3],
     /// The amplifiers' trims (none by default).
     trims: Trims,
+    /// The passivity observer and its limits (none by default).
+    passivity: Option<(PassivityObserver, PassivityLimits)>,
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -175,7 +184,21 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             thermal: None,
             heat: [Heat::default(); 3],
             trims: Trims::default(),
+            passivity: None,
         }
+    }
+
+    /// The device with a passivity observer on the force it renders: energy put into
+    /// the hand beyond `limits` is [`ArmFault::EnergyOut`] (zero duty first).
+    pub fn with_passivity(mut self, limits: PassivityLimits) -> Self {
+        self.passivity = Some((PassivityObserver::default(), limits));
+        self
+    }
+
+    /// The energy the hand has put in over the observer's window, mJ (None: no
+    /// observer).
+    pub fn passivity_mj(&self) -> Option<f64> {
+        self.passivity.map(|(o, _)| o.energy_mj())
     }
 
     /// The device with its amplifiers' trims: each duty written through them once the
@@ -372,6 +395,14 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), ArmFault> {
         let fresh = core::mem::take(&mut self.fresh_home);
+        if let (Some((observer, limits)), Some(pose), true) =
+            (self.passivity.as_mut(), self.pose, self.homed && !fresh)
+        {
+            if observer.tick(pose.probe, force, *limits) {
+                let _ = self.zero();
+                return Err(ArmFault::EnergyOut);
+            }
+        }
         let mut duty = match (self.homed && !fresh, self.pose) {
             (true, Some(pose)) => self.arm.drive(&pose, force).duty_q16,
             _ => [0; 3],

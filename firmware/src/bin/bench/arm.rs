@@ -6,7 +6,7 @@
 use super::fw_common::exit;
 use super::harness::Harness;
 use core::hint::black_box;
-use mccs::{Arm, Force};
+use mccs::{Arm, Force, Length, PassivityLimits, PassivityObserver};
 use mccs_firmware::arm::device::WOODENHAPTICS;
 use mccs_firmware::arm::float::ArmF32;
 
@@ -29,6 +29,24 @@ pub fn arm_kinematics(h: &Harness) -> u32 {
         counts[0] = counts[0].wrapping_add(1);
         let pose = arm.pose(black_box(counts));
         black_box(arm.drive(&pose, black_box(force)));
+    })
+}
+
+/// One tick of the passivity observer (`case=passivity_observer`), the probe moving and
+/// the force on, averaged over 4.
+#[inline(never)]
+pub fn passivity_observer(h: &Harness) -> u32 {
+    let limits = PassivityLimits::new(2.0, 10.0);
+    let mut observer = PassivityObserver::default();
+    let force = [
+        Force::from_num(0.3),
+        Force::from_num(-0.2),
+        Force::from_num(1.0),
+    ];
+    let mut probe = [Length::from_num(1.5), Length::ZERO, Length::from_num(-0.7)];
+    h.measure(4, || {
+        probe[2] -= Length::from_num(0.01);
+        black_box(observer.tick(black_box(probe), black_box(force), black_box(limits)));
     })
 }
 

@@ -209,6 +209,8 @@ mod firmware {
         // The arm's counts to duties without the solver, fixed point and its f32 peer.
         figs.report("arm_kinematics", arm::arm_kinematics(&h) - empty);
         figs.report("arm_kinematics_f32", arm::arm_kinematics_f32(&h) - empty);
+        // The passivity observer's tick (the arm board's).
+        figs.report("passivity_observer", arm::passivity_observer(&h) - empty);
         // The solver's start-up for the demo's patch, once (millions of instructions).
         let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
         report::startup(&mut figs, grid, ticks::startup(&h, table));
