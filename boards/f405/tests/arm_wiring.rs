@@ -457,3 +457,33 @@ fn start_up_errors_name_the_part_and_the_joint() {
         "joint: counts_per_rev and ratio must be finite and > 0, a joint turn 16 to 2^30 counts (joint C)"
     );
 }
+
+/// The simulated arm board's own loop (its plant palpating, the board's arm device and
+/// roaming controller) never trips the passivity observer: a passive tissue under a hand
+/// that follows its path.
+#[test]
+fn the_simulated_arm_s_palpation_never_trips_the_passivity_observer() {
+    use mccs_firmware::arm::plant::{Plant, PALPATION_TICKS};
+    let path = mccs_firmware::palpation_path(BOARD.tick_hz).unwrap();
+    let plant: &'static Plant = Box::leak(Box::new(Plant::new(&ARM, &path).unwrap()));
+    let (joints, enable, home) = plant.joints();
+    let device =
+        arm_device(&BOARD, &ARM, joints, enable, home).unwrap_or_else(|_| panic!("device"));
+    let mut slot = None;
+    assert!(arm_controller_into(&BOARD, TISSUE, device, &mut slot).is_ok());
+    let mut ctl = slot.unwrap();
+    // Full gain (the link's guard sets it each tick on the board).
+    ctl.device_mut().set_gain(u16::MAX);
+    let mut lowest = 0.0f64;
+    let mut most = 0.0f64;
+    for t in 0..(2000 + 3 * PALPATION_TICKS) {
+        let f = ctl.tick(None);
+        most = most.max(f[2].to_num::<f64>());
+        let e = ctl.device().inner().passivity_mj().unwrap();
+        lowest = lowest.min(e);
+        let fault = ctl.telemetry().fault;
+        assert!(fault.is_none(), "tick {t}: {fault:?}, energy {e} mJ");
+    }
+    assert!(most > 0.5, "the palpation pressed: {most} N");
+    println!("PASSIVITY case=simulated_arm lowest_mj={lowest:.3}");
+}

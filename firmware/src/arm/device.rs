@@ -149,8 +149,10 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     heat: [Heat; 3],
     /// The amplifiers' trims (none by default).
     trims: Trims,
-    /// The passivity observer and its limits (none by default).
+    /// The passivity observer and its limits (none by default), and whether it watches
+    /// (see [`ArmDevice::with_passivity`]).
     passivity: Option<(PassivityObserver, PassivityLimits)>,
+    watching: bool,
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -185,11 +187,17 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             heat: [Heat::default(); 3],
             trims: Trims::default(),
             passivity: None,
+            watching: false,
         }
     }
 
     /// The device with a passivity observer on the force it renders: energy put into
-    /// the hand beyond `limits` is [`ArmFault::EnergyOut`] (zero duty first).
+    /// the hand beyond `limits` is [`ArmFault::EnergyOut`] (zero duty first). It
+    /// watches while the probe is within the tissue frame's range, from the first tick
+    /// there with no force; beyond the range it forgets. (A probe that enters the range
+    /// below the tissue's surface, as the simulated arm's approach does at its edge, is
+    /// met by the contact with a force it did not earn: that pop-through is the
+    /// contact's to mend, and is not taken for the device's own output.)
     pub fn with_passivity(mut self, limits: PassivityLimits) -> Self {
         self.passivity = Some((PassivityObserver::default(), limits));
         self
@@ -398,7 +406,13 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         if let (Some((observer, limits)), Some(pose), true) =
             (self.passivity.as_mut(), self.pose, self.homed && !fresh)
         {
-            if observer.tick(pose.probe, force, *limits) {
+            if pose.flags & OUTSIDE != 0 {
+                self.watching = false;
+            } else if !self.watching && force == [Force::ZERO; 3] {
+                observer.reset();
+                self.watching = true;
+            }
+            if self.watching && observer.tick(pose.probe, force, *limits) {
                 let _ = self.zero();
                 return Err(ArmFault::EnergyOut);
             }
