@@ -243,65 +243,9 @@ fn replay<const S: usize>(
     table: Option<&mccs::ForceTable<S>>,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    // The trajectory, or the arm's: each tick's probe from its counts, and its pose for
-    // the duties.
-    let (traj, arm) = match (&a.probe, &a.joints, &a.device) {
-        (Some(p), _, _) => (
-            trajectory::read(p).map_err(|e| CliError::new(e.to_string()))?,
-            None,
-        ),
-        (None, Some(j), Some(d)) => {
-            let spec = crate::arm::device_file::read(d).map_err(CliError::new)?;
-            let arm = mccs::Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
-            let rows = crate::arm::joints::read(j).map_err(CliError::new)?;
-            let ticks = crate::arm::joints::ticks(&rows, a.patch.rate, &arm);
-            let samples: Vec<(f64, [f64; 3])> = ticks
-                .iter()
-                .map(|(t, _, pose)| (*t, pose.probe.map(|c| c.to_num::<f64>())))
-                .collect();
-            let traj = trajectory::Trajectory::new(samples).map_err(|e| {
-                arg_error(
-                    "--joints",
-                    &format!(
-                        "the arm's probe (--device's fixed kinematics less its tissue origin): {}",
-                        e.what
-                    ),
-                )
-            })?;
-            (
-                traj,
-                Some((
-                    arm,
-                    ticks.into_iter().map(|(_, _, p)| p).collect::<Vec<_>>(),
-                )),
-            )
-        }
-        _ => {
-            return Err(arg_error(
-                "--probe",
-                "give --probe, or --joints with --device",
-            ))
-        }
-    };
+    let (traj, arm) = probe_motion(a)?;
     // With an arm, each row ends with its duties at that tick.
-    let duties = |k: usize, force: [f64; 3]| -> String {
-        match &arm {
-            Some((arm, poses)) => {
-                let d = arm.drive(
-                    &poses[k.min(poses.len() - 1)],
-                    force.map(mccs::Force::saturating_from_num),
-                );
-                let q = |x: i32| x as f64 / 65_536.0;
-                format!(
-                    ",{},{},{}",
-                    q(d.duty_q16[0]),
-                    q(d.duty_q16[1]),
-                    q(d.duty_q16[2])
-                )
-            }
-            None => String::new(),
-        }
-    };
+    let duties = |k: usize, force: [f64; 3]| duty_text(arm.as_ref(), k, force);
     let duty_columns = if arm.is_some() {
         ",duty_a,duty_b,duty_c"
     } else {
@@ -389,6 +333,64 @@ fn replay<const S: usize>(
         eprintln!("{line}");
     }
     done
+}
+
+/// An arm and its pose at each tick of a replay, for the duties.
+type ArmPoses = (mccs::Arm, Vec<mccs::ArmPose>);
+
+/// The probe's motion of `a`: its trajectory, or the arm's (each tick's probe from its
+/// counts, and its pose for the duties).
+fn probe_motion(a: &Args) -> Result<(trajectory::Trajectory, Option<ArmPoses>), CliError> {
+    match (&a.probe, &a.joints, &a.device) {
+        (Some(p), _, _) => Ok((
+            trajectory::read(p).map_err(|e| CliError::new(e.to_string()))?,
+            None,
+        )),
+        (None, Some(j), Some(d)) => {
+            let spec = crate::arm::device_file::read(d).map_err(CliError::new)?;
+            let arm = mccs::Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
+            let rows = crate::arm::joints::read(j).map_err(CliError::new)?;
+            let ticks = crate::arm::joints::ticks(&rows, a.patch.rate, &arm);
+            let samples: Vec<(f64, [f64; 3])> = ticks
+                .iter()
+                .map(|(t, _, pose)| (*t, pose.probe.map(|c| c.to_num::<f64>())))
+                .collect();
+            let traj = trajectory::Trajectory::new(samples).map_err(|e| {
+                arg_error(
+                    "--joints",
+                    &format!(
+                        "the arm's probe (--device's fixed kinematics less its tissue origin): {}",
+                        e.what
+                    ),
+                )
+            })?;
+            let poses = ticks.into_iter().map(|(_, _, p)| p).collect();
+            Ok((traj, Some((arm, poses))))
+        }
+        _ => Err(arg_error(
+            "--probe",
+            "give --probe, or --joints with --device",
+        )),
+    }
+}
+
+/// `,duty_a,duty_b,duty_c` of tick `k` rendering `force` (N) on the arm; nothing without
+/// one.
+fn duty_text(arm: Option<&ArmPoses>, k: usize, force: [f64; 3]) -> String {
+    let Some((arm, poses)) = arm else {
+        return String::new();
+    };
+    let Some(pose) = poses.get(k.min(poses.len().saturating_sub(1))) else {
+        return String::new();
+    };
+    let d = arm.drive(pose, force.map(mccs::Force::saturating_from_num));
+    let q = |x: i32| x as f64 / 65_536.0;
+    format!(
+        ",{},{},{}",
+        q(d.duty_q16[0]),
+        q(d.duty_q16[1]),
+        q(d.duty_q16[2])
+    )
 }
 
 /// A glued tick's CSV line.

@@ -104,10 +104,64 @@ impl<const S: usize> ForceTable<S> {
     #[inline(never)]
     pub fn from_law_best(law: &Law, from: f64, to: f64) -> Result<Self, TableError> {
         let mut best: Option<(f64, Self)> = None;
-        let mut first_err = None;
-        // Without an inner corner inside the table every placement is the same grid
-        // (the same table: its range and index say where every knot is): each distinct
-        // one is measured once.
+        let first_err = Self::uniform_placements(law, (from, to), &mut best);
+        let missed = |best: &Option<(f64, Self)>| best.as_ref().is_none_or(|(b, _)| *b > 1.0);
+        // Where no uniform grid meets the product's bound and the solid point is inside
+        // the domain or a little past its end: a graded corner toward it, over a
+        // fraction of the curved part, under each placement of the uniform grid below it.
+        if missed(&best) {
+            Self::solid_corner(law, (from, to), CORNER_OCTAVES, &mut best);
+        }
+        let e_p = law.delta(law.preload);
+        let lo = libm::fmax(law.strain_t(), from);
+        // A preload's slope kink Δ(P) inside the domain, and room for a corner.
+        let kink_inside = S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to;
+        if missed(&best) && kink_inside {
+            Self::above_kink(law, (from, to), e_p, &mut best);
+        }
+        if missed(&best) && kink_inside {
+            Self::toward_kink(law, (from, to), e_p - lo, &mut best);
+        }
+        // Still missed, with Δ(P) inside the domain: a lower corner, graded toward Δ(P)
+        // from below over the whole curved part under it (down to Δ(F_T) or the domain's
+        // start), the uniform grid above from Δ(P) (`CornerEnd::Lower`): the cone's steep
+        // rise toward its own solid point below the kink, and a law still curved above it.
+        // (This and the two after only where the output formats could meet the bound at
+        // all: not for a spring whose half LSB is over it, `format_floor`, which no knots
+        // serve.)
+        let formats_can = missed(&best) && format_floor(law, from, to).within(&TableBound::PRODUCT);
+        if formats_can && kink_inside {
+            // (One build: the grid's place is the corner's end, whatever the alignment.)
+            let len = (e_p - lo) * LOWER_CORNER_REACH;
+            let end = CornerEnd::Lower;
+            Self::try_corner::<false>(law, (from, to), Align::Off, len, end, &mut best);
+        }
+        if formats_can && missed(&best) {
+            Self::onset_corner(law, (from, to), &mut best);
+        }
+        // Still missed, where the formats could meet the bound: the corner toward the
+        // solid point again with more octaves, its nearest 1/4096 of its length instead
+        // of 1/256 (a stiff series spring whose solid point lies at or just short of the
+        // domain's end rises into it faster than the nearest octave of eight follows).
+        // Last, so that every spring another placement serves keeps its table.
+        if formats_can && missed(&best) {
+            Self::solid_corner(law, (from, to), CORNER_OCTAVES_MAX, &mut best);
+        }
+        // Without a table every placement failed (a duplicate implies one built).
+        match (best, first_err) {
+            (Some((_, t)), _) => Ok(t),
+            (None, e) => Err(e.unwrap_or(TableError::OutOfRange)),
+        }
+    }
+
+    /// Every placement of the uniform grid, each distinct one measured once (without an
+    /// inner corner inside the table every placement is the same grid: its range and
+    /// index say where every knot is); the first error, if any.
+    fn uniform_placements(
+        law: &Law,
+        domain: (f64, f64),
+        best: &mut Option<(f64, Self)>,
+    ) -> Option<TableError> {
         const PLACEMENTS: [Align; 5] = [
             Align::Shortest,
             Align::NearSolid,
@@ -115,6 +169,7 @@ impl<const S: usize> ForceTable<S> {
             Align::Plain,
             Align::FromDomain,
         ];
+        let mut first_err = None;
         let mut tried = [None; PLACEMENTS.len()];
         for (n, align) in PLACEMENTS.into_iter().enumerate() {
             // The placement from the domain's start is its own instance of the builder,
@@ -122,117 +177,78 @@ impl<const S: usize> ForceTable<S> {
             // it.
             let (seen, now) = tried.split_at_mut(n);
             let built = if align == Align::FromDomain {
-                Self::try_uniform::<true>(law, (from, to), align, seen, &mut now[0], &mut best)
+                Self::try_uniform::<true>(law, domain, align, seen, &mut now[0], best)
             } else {
-                Self::try_uniform::<false>(law, (from, to), align, seen, &mut now[0], &mut best)
+                Self::try_uniform::<false>(law, domain, align, seen, &mut now[0], best)
             };
             if let Err(e) = built {
                 first_err.get_or_insert(e);
             }
         }
-        // Where no uniform grid meets the product's bound and the solid point is inside
-        // the domain or a little past its end: a graded corner toward it, over a
-        // fraction of the curved part, under each placement of the uniform grid below it.
-        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
-        let e_c = law.strain_c();
-        let lo = libm::fmax(law.strain_t(), from);
-        let solid_near = solid_near(law, from, to);
-        if missed {
-            Self::solid_corner(law, (from, to), CORNER_OCTAVES, &mut best);
-        }
-        // Still missed, with a preload's slope kink Δ(P) inside the domain (a preload near
-        // F_C: below Δ(P) the cone rises steeply toward its own solid point, which the
-        // corner above, grading toward Δ(F_C) past Δ(P), does not follow). The graded
-        // corner then takes the part above Δ(P), smooth up to the solid point (or the
-        // domain's end, when that comes first), and the uniform grid's segments all go
-        // below a little past Δ(P), with a knot on it.
-        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
-        let e_p = law.delta(law.preload);
-        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
-            let (end, e_end) = if solid_near {
-                (CornerEnd::Solid, e_c)
-            } else {
-                (CornerEnd::DomainEnd, to)
-            };
-            'above_kink: for align in [Align::Shortest, Align::Off] {
-                for margin in ABOVE_KINK_MARGINS {
-                    let len = (e_end - e_p) * (1.0 - margin);
-                    let e = Self::try_corner::<false>(law, (from, to), align, len, end, &mut best);
-                    if e <= 1.0 {
-                        break 'above_kink;
-                    }
+        first_err
+    }
+
+    /// Still missed, with a preload's slope kink Δ(P) = `e_p` inside the domain (a
+    /// preload near F_C: below Δ(P) the cone rises steeply toward its own solid point,
+    /// which the corner toward the solid point, grading toward Δ(F_C) past Δ(P), does
+    /// not follow). The graded corner then takes the part above Δ(P), smooth up to the
+    /// solid point (or the domain's end, when that comes first), and the uniform grid's
+    /// segments all go below a little past Δ(P), with a knot on it.
+    fn above_kink(law: &Law, (from, to): (f64, f64), e_p: f64, best: &mut Option<(f64, Self)>) {
+        let (end, e_end) = if solid_near(law, from, to) {
+            (CornerEnd::Solid, law.strain_c())
+        } else {
+            (CornerEnd::DomainEnd, to)
+        };
+        for align in [Align::Shortest, Align::Off] {
+            for margin in ABOVE_KINK_MARGINS {
+                let len = (e_end - e_p) * (1.0 - margin);
+                if Self::try_corner::<false>(law, (from, to), align, len, end, best) <= 1.0 {
+                    return;
                 }
             }
         }
-        // Still missed, with Δ(P) inside the domain: the corner graded toward Δ(P) from
-        // below, over a fraction of the curved part under it, and the law's tangent from
-        // above as the line past it (`CornerEnd::Kink`).
-        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0);
-        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
-            'to_kink: for align in [Align::Shortest, Align::Off] {
-                for fraction in CORNER_FRACTIONS {
-                    let len = fraction * (e_p - lo);
-                    let end = CornerEnd::Kink;
-                    let e = Self::try_corner::<false>(law, (from, to), align, len, end, &mut best);
-                    if e <= 1.0 {
-                        break 'to_kink;
-                    }
-                }
-            }
-        }
-        // Still missed, with Δ(P) inside the domain: a lower corner, graded toward Δ(P)
-        // from below over the whole curved part under it (down to Δ(F_T) or the domain's
-        // start), the uniform grid above from Δ(P) (`CornerEnd::Lower`): the cone's steep
-        // rise toward its own solid point below the kink, and a law still curved above it.
-        // (These two only where the output formats could meet the bound at all: not for
-        // a spring whose half LSB is over it, `format_floor`, which no knots serve.)
-        let missed = best.as_ref().is_none_or(|(b, _)| *b > 1.0)
-            && format_floor(law, from, to).within(&TableBound::PRODUCT);
-        if missed && S >= 2 * CORNER_SEGMENTS && law.preload > law.f_t && e_p > lo && e_p < to {
-            // (One build: the grid's place is the corner's end, whatever the alignment.)
-            let len = (e_p - lo) * LOWER_CORNER_REACH;
-            let end = CornerEnd::Lower;
-            Self::try_corner::<false>(law, (from, to), Align::Off, len, end, &mut best);
-        }
-        // Still missed: a corner graded toward the law's first kink from above, under the
-        // grid (`CornerEnd::Onset`), over a fraction of the curved part, and then the
-        // lengths that put one of its knots on the cone's own transition Δ(F_T) where a
-        // preload just below F_T puts the first kink Δ(P) under it.
-        let missed = missed && best.as_ref().is_none_or(|(b, _)| *b > 1.0);
-        let e_first = law.strain_t();
-        let curved = libm::fmin(e_c, to) - e_first;
-        // (The kink inside the domain, as every other placement's table starts.)
-        if missed && S >= 2 * CORNER_SEGMENTS && e_first >= from && curved > 0.0 {
-            let e_ft = law.delta(law.f_t);
-            let on_transition = (0..CORNER_OCTAVES as u32)
-                .flat_map(|z| [(z, 0), (z, 2)])
-                .filter_map(|knot| {
-                    let len = kink_on_knot(e_ft - e_first, knot, CORNER_OCTAVES)?;
-                    (law.preload < law.f_t && e_ft > e_first && len < curved).then_some(len)
-                });
-            let lens = ONSET_FRACTIONS.map(|f| f * curved);
-            for len in lens.into_iter().chain(on_transition) {
-                let end = CornerEnd::Onset;
-                if Self::try_corner::<false>(law, (from, to), Align::Off, len, end, &mut best)
-                    <= 1.0
+    }
+
+    /// Still missed, with Δ(P) inside the domain: the corner graded toward Δ(P) from
+    /// below, over a fraction of the curved part under it (`below`: its length), and the
+    /// law's tangent from above as the line past it (`CornerEnd::Kink`).
+    fn toward_kink(law: &Law, domain: (f64, f64), below: f64, best: &mut Option<(f64, Self)>) {
+        for align in [Align::Shortest, Align::Off] {
+            for fraction in CORNER_FRACTIONS {
+                let len = fraction * below;
+                if Self::try_corner::<false>(law, domain, align, len, CornerEnd::Kink, best) <= 1.0
                 {
-                    break;
+                    return;
                 }
             }
         }
-        // Still missed, where the formats could meet the bound: the corner toward the
-        // solid point again with more octaves, its nearest 1/4096 of its length instead
-        // of 1/256 (a stiff series spring whose solid point lies at or just short of the
-        // domain's end rises into it faster than the nearest octave of eight follows).
-        // Last, so that every spring another placement serves keeps its table.
-        let missed = missed && best.as_ref().is_none_or(|(b, _)| *b > 1.0);
-        if missed {
-            Self::solid_corner(law, (from, to), CORNER_OCTAVES_MAX, &mut best);
+    }
+
+    /// Still missed: a corner graded toward the law's first kink from above, under the
+    /// grid (`CornerEnd::Onset`), over a fraction of the curved part, and then the
+    /// lengths that put one of its knots on the cone's own transition Δ(F_T) where a
+    /// preload just below F_T puts the first kink Δ(P) under it. (The kink inside the
+    /// domain, as every other placement's table starts.)
+    fn onset_corner(law: &Law, (from, to): (f64, f64), best: &mut Option<(f64, Self)>) {
+        let e_first = law.strain_t();
+        let curved = libm::fmin(law.strain_c(), to) - e_first;
+        if !(S >= 2 * CORNER_SEGMENTS && e_first >= from && curved > 0.0) {
+            return;
         }
-        // Without a table every placement failed (a duplicate implies one built).
-        match (best, first_err) {
-            (Some((_, t)), _) => Ok(t),
-            (None, e) => Err(e.unwrap_or(TableError::OutOfRange)),
+        let e_ft = law.delta(law.f_t);
+        let on_transition = (0..CORNER_OCTAVES as u32)
+            .flat_map(|z| [(z, 0), (z, 2)])
+            .filter_map(|knot| {
+                let len = kink_on_knot(e_ft - e_first, knot, CORNER_OCTAVES)?;
+                (law.preload < law.f_t && e_ft > e_first && len < curved).then_some(len)
+            });
+        let lens = ONSET_FRACTIONS.map(|f| f * curved);
+        for len in lens.into_iter().chain(on_transition) {
+            let end = CornerEnd::Onset;
+            if Self::try_corner::<false>(law, (from, to), Align::Off, len, end, best) <= 1.0 {
+                return;
+            }
         }
     }
 
