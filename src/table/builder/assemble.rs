@@ -111,86 +111,109 @@ impl<const S: usize> ForceTable<S> {
             segments: [[0; 4]; S],
         };
         if let (Some(c), Some(ends)) = (corner, corner_ends) {
-            // The corner starts inside the uniform grid's last segment (its coordinate
-            // below 2³² there) and ends past it; a lower one ends on the grid's first
-            // strain (its coordinate at least 2^(32 − octaves) there) and starts below it.
-            let pre = corner_pre_signed(c.pre) as i64;
-            let d = |e: i32| (c.anchor as i64 - e as i64) * pre;
-            let inner = 1i64 << (32 - octaves);
-            let fits = if c.above_anchor() {
-                d(grid.strain_lo) < 1 << 32 && d(c.lo + 1) >= inner && c.lo < grid.strain_lo
-            } else if c.under_grid() {
-                d(grid.strain_lo) >= inner && c.lo < grid.strain_lo
-            } else {
-                d(grid.strain_hi) < 1 << 32 && grid.strain_hi < c.hi
-            };
-            if !fits {
-                return Err(TableError::TooNarrow);
-            }
-            fill_corner(ends, shift, &mut segs.coefficients[n..])?;
-            let (scale, post) = corner_scale(c.pre, shift)?;
-            raw.corner_hi = if c.under_grid() { c.lo } else { c.hi };
-            raw.corner_anchor = c.anchor;
-            raw.corner_pre = c.pre;
+            put_corner(
+                law,
+                &grid,
+                (c, ends),
+                octaves,
+                shift,
+                &mut raw,
+                &mut segs.coefficients[n..],
+            )?;
             raw.corner_base = n as u32;
-            raw.corner_scale = scale;
-            raw.corner_post = post;
-            // Past the solid point the law's own k_p line; past the domain's end the
-            // law's tangent at the last knot, as a grid that ends there has.
-            // (Above a lower corner the grid's own line, from `lines`.)
-            let above = match c.end {
-                CornerEnd::Solid => Some(law.k_p),
-                CornerEnd::DomainEnd => {
-                    Some(1.0 / law.compliance(law.force(c.strain(octaves - 1, 0))))
-                }
-                CornerEnd::Kink => Some(1.0 / law.compliance_above(law.preload)),
-                CornerEnd::Lower | CornerEnd::Onset => None,
-            };
-            if let Some(above) = above {
-                (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
-            }
         }
-        // The line above passes through (corner_hi, force_hi): from the law's force at
-        // corner_hi itself, not the last knot's (as the segments round it), which lies up
-        // to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
-        // Along a steep line that LSB is many force LSBs: k_p = 222 N per unit strain
-        // makes it 14, all along the line (`the_line_above_starts_where_it_is_anchored`).
-        // Its anchor cannot move (corner_hi ends the table), so the floor of the line's
-        // product is balanced in its force instead: `⌊F + 1⌋` LSBs, which puts the line
-        // within (−1, 1) LSB of the law where the nearest Q20 value put it within
-        // [−1.5, 0.5) (the anchor below is placed for a true rounding: `rounding_anchor`).
-        // Under a lower corner the table ends at strain_hi, and the line's anchor
-        // corner_hi lies below it: force_hi is the line extrapolated there in the
-        // evaluation's own terms, `⌊v + 1 − frac(a)⌋ − ⌊a⌋` for the law's force `v`
-        // (LSBs) at strain_hi and the product `a = slope_hi · (strain_hi − corner_hi)`
-        // (LSBs), so that from strain_hi up the line is `⌊v + 1 − frac(a)⌋ + ⌊frac(a) +
-        // b⌋` for the rise `b` beyond it: within (−1, 1] LSB of the law, as above. At
-        // least −1024 N, so that the line is exact up to 1024 N at least: beyond
-        // `2048 N + force_hi` its product is held (`line_at`), and so is the force.
-        let end = if lower.is_some() {
-            raw.strain_hi
-        } else {
-            raw.corner_hi
-        };
-        let v = law.force(end as f64 / (1u64 << STRAIN_FRAC) as f64) * (1u64 << FORCE_FRAC) as f64;
-        let f_hi = if lower.is_some() {
-            let p = slope_frac(raw.stiffness_hi) + STRAIN_FRAC - FORCE_FRAC;
-            let a = raw.slope_hi as i64 * (raw.strain_hi as i64 - raw.corner_hi as i64);
-            let frac = (a & ((1i64 << p) - 1)) as f64 / (1u64 << p) as f64;
-            let f = libm::floor(v + 1.0 - frac) - (a >> p) as f64;
-            // (Also when it is NaN.)
-            if f.is_nan() || f < -((1u64 << 30) as f64) {
-                return Err(TableError::OutOfRange);
-            }
-            f
-        } else {
-            libm::floor(v) + 1.0
-        };
-        if !(f_hi >= i32::MIN as f64 && f_hi <= i32::MAX as f64) {
-            return Err(TableError::OutOfRange);
-        }
-        raw.force_hi = f_hi as i32;
+        raw.force_hi = force_hi(law, &raw, lower.is_some())?;
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
     }
+}
+
+/// The graded corner `c` (its segments' `ends`) put into `raw` and its `coefficients`
+/// (the table's last segments): where it lies against the uniform grid checked, its
+/// index, and the line past it. The caller sets `corner_base`.
+fn put_corner<const S: usize>(
+    law: &Law,
+    grid: &Grid,
+    (c, ends): (Corner, &[[f64; 4]]),
+    octaves: usize,
+    shift: u32,
+    raw: &mut RawTable<S>,
+    coefficients: &mut [[i32; 4]],
+) -> Result<(), TableError> {
+    // The corner starts inside the uniform grid's last segment (its coordinate
+    // below 2³² there) and ends past it; a lower one ends on the grid's first
+    // strain (its coordinate at least 2^(32 − octaves) there) and starts below it.
+    let pre = corner_pre_signed(c.pre) as i64;
+    let d = |e: i32| (c.anchor as i64 - e as i64) * pre;
+    let inner = 1i64 << (32 - octaves);
+    let fits = if c.above_anchor() {
+        d(grid.strain_lo) < 1 << 32 && d(c.lo + 1) >= inner && c.lo < grid.strain_lo
+    } else if c.under_grid() {
+        d(grid.strain_lo) >= inner && c.lo < grid.strain_lo
+    } else {
+        d(grid.strain_hi) < 1 << 32 && grid.strain_hi < c.hi
+    };
+    if !fits {
+        return Err(TableError::TooNarrow);
+    }
+    fill_corner(ends, shift, coefficients)?;
+    let (scale, post) = corner_scale(c.pre, shift)?;
+    raw.corner_hi = if c.under_grid() { c.lo } else { c.hi };
+    raw.corner_anchor = c.anchor;
+    raw.corner_pre = c.pre;
+    raw.corner_scale = scale;
+    raw.corner_post = post;
+    // Past the solid point the law's own k_p line; past the domain's end the
+    // law's tangent at the last knot, as a grid that ends there has.
+    // (Above a lower corner the grid's own line, from `lines`.)
+    let above = match c.end {
+        CornerEnd::Solid => Some(law.k_p),
+        CornerEnd::DomainEnd => Some(1.0 / law.compliance(law.force(c.strain(octaves - 1, 0)))),
+        CornerEnd::Kink => Some(1.0 / law.compliance_above(law.preload)),
+        CornerEnd::Lower | CornerEnd::Onset => None,
+    };
+    if let Some(above) = above {
+        (raw.stiffness_hi, raw.slope_hi) = line_slopes(above, libm::round)?;
+    }
+    Ok(())
+}
+
+/// The force where the line above is anchored, Q20 (`lower`: under a lower corner).
+fn force_hi<const S: usize>(law: &Law, raw: &RawTable<S>, lower: bool) -> Result<i32, TableError> {
+    // The line above passes through (corner_hi, force_hi): from the law's force at
+    // corner_hi itself, not the last knot's (as the segments round it), which lies up
+    // to a strain LSB below corner_hi (a knot is rarely a Q24 strain).
+    // Along a steep line that LSB is many force LSBs: k_p = 222 N per unit strain
+    // makes it 14, all along the line (`the_line_above_starts_where_it_is_anchored`).
+    // Its anchor cannot move (corner_hi ends the table), so the floor of the line's
+    // product is balanced in its force instead: `⌊F + 1⌋` LSBs, which puts the line
+    // within (−1, 1) LSB of the law where the nearest Q20 value put it within
+    // [−1.5, 0.5) (the anchor below is placed for a true rounding: `rounding_anchor`).
+    // Under a lower corner the table ends at strain_hi, and the line's anchor
+    // corner_hi lies below it: force_hi is the line extrapolated there in the
+    // evaluation's own terms, `⌊v + 1 − frac(a)⌋ − ⌊a⌋` for the law's force `v`
+    // (LSBs) at strain_hi and the product `a = slope_hi · (strain_hi − corner_hi)`
+    // (LSBs), so that from strain_hi up the line is `⌊v + 1 − frac(a)⌋ + ⌊frac(a) +
+    // b⌋` for the rise `b` beyond it: within (−1, 1] LSB of the law, as above. At
+    // least −1024 N, so that the line is exact up to 1024 N at least: beyond
+    // `2048 N + force_hi` its product is held (`line_at`), and so is the force.
+    let end = if lower { raw.strain_hi } else { raw.corner_hi };
+    let v = law.force(end as f64 / (1u64 << STRAIN_FRAC) as f64) * (1u64 << FORCE_FRAC) as f64;
+    let f_hi = if lower {
+        let p = slope_frac(raw.stiffness_hi) + STRAIN_FRAC - FORCE_FRAC;
+        let a = raw.slope_hi as i64 * (raw.strain_hi as i64 - raw.corner_hi as i64);
+        let frac = (a & ((1i64 << p) - 1)) as f64 / (1u64 << p) as f64;
+        let f = libm::floor(v + 1.0 - frac) - (a >> p) as f64;
+        // (Also when it is NaN.)
+        if f.is_nan() || f < -((1u64 << 30) as f64) {
+            return Err(TableError::OutOfRange);
+        }
+        f
+    } else {
+        libm::floor(v) + 1.0
+    };
+    if !(f_hi >= i32::MIN as f64 && f_hi <= i32::MAX as f64) {
+        return Err(TableError::OutOfRange);
+    }
+    Ok(f_hi as i32)
 }
