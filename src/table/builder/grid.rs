@@ -109,82 +109,16 @@ impl Grid {
         // kink, which the first knot must not leave), so that the knot near Δ(F_T) lies
         // within the narrowed step's drift of it and is an ordinary knot; no aligned
         // grid, no knot on it (moving the first knot below Δ(P) would cost more).
-        let kink_force = inner_corner(law);
         let slope_kink = law.preload > law.f_t;
-        let e_p = law.delta(kink_force);
-        let mut kink_knot = None;
-        let mut lo_grid = lo;
-        let mut width = hi - lo;
-        let mut aligned = false;
-        // The strain the aligned knot sits on: Δ(P) (Δ(F_T) without a preload, where
-        // P = F_T) from the domain's start, else the inner corner.
-        let mut knot_at = e_p;
-        if let Some((_, on_kink)) = start {
-            // Above a lower corner: the first knot where the corner ends (on Δ(P), for
-            // one graded toward it), the grid uniform from there.
-            knot_at = lo;
-            kink_knot = on_kink.then_some(0);
-        } else if from_domain {
-            // j segments from the domain's start to that knot, the most that still
-            // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
-            knot_at = law.delta(law.preload);
-            let most = libm::floor(n as f64 * (knot_at - lo) / (hi - lo));
-            if !(most >= 1.0 && knot_at < hi) {
-                return Err(TableError::TooNarrow);
-            }
-            width = n as f64 * (knot_at - lo) / most;
-            kink_knot = Some(most as usize);
-            aligned = true;
-        } else if !matches!(align, Align::Plain | Align::FromDomain)
-            && kink_force > law.first_kink()
-            && e_p > lo
-            && e_p < hi
-        {
-            let most = libm::floor(n as f64 * (e_p - lo) / (hi - lo));
-            if align != Align::Off && most >= 1.0 {
-                let fit = if at_solid && align == Align::NearSolid {
-                    aligned_on_solid(e_p - lo, hi - lo, most)
-                } else {
-                    most
-                };
-                width = n as f64 * (e_p - lo) / fit;
-                kink_knot = Some(fit as usize);
-                aligned = true;
-            } else if slope_kink {
-                let mut step = width / n as f64;
-                let j = libm::ceil((e_p - lo) / step);
-                if j < n as f64 {
-                    step = libm::fmax(step, (hi - e_p) / (n as f64 - j));
-                    lo_grid = e_p - j * step;
-                    width = n as f64 * step;
-                    kink_knot = Some(j as usize);
-                }
-            }
-        }
+        let Alignment {
+            lo_grid,
+            width,
+            kink_knot,
+            aligned,
+            knot_at,
+        } = Alignment::of(law, (lo, hi, from_domain, at_solid), align, n, start)?;
         let grid_moved = lo_grid < lo;
-        // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
-        // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
-        // scale keeps about 21 significant bits.
-        let span = libm::ceil(width * (1u64 << STRAIN_FRAC) as f64) + 2.0;
-        if span.is_nan() || span >= (1u64 << 32) as f64 {
-            return Err(TableError::BadDomain);
-        }
-        let mut index_shift = 0u32;
-        while index_shift < 31 && span * (2u64 << index_shift) as f64 <= (1u64 << 32) as f64 {
-            index_shift += 1;
-        }
-        let scale = libm::floor(n as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
-        // At most 31 significant bits (the narrow index keeps 15 of them), and each segment
-        // at least one strain LSB wide (below that the knots are not strains the format
-        // holds).
-        if !(scale >= 1.0 && scale < (1u64 << 31) as f64) || span - 2.0 < n as f64 {
-            return Err(TableError::TooNarrow);
-        }
-        // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index
-        // ([`crate::arith::narrow::table_force`]: two 32-bit multiplies) is the same number.
-        let index_scale = narrow_scale(scale as u32);
-        // The evaluation places knot i at lo + i · step: build at exactly those strains.
-        let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
+        let (index_shift, index_scale, step) = index(width, n)?;
         // That step is a little longer than the one asked for (the scale's low bits are
         // cut, up to 6e-5 of it): with a kink, the first knot is placed from this step so
         // that the kink's knot stays on Δ(P), to a strain LSB (the table still reaches
@@ -310,4 +244,119 @@ pub(super) fn inner_corner(law: &Law) -> f64 {
 pub(super) const fn narrow_scale(x: u32) -> u32 {
     let k = (32 - x.leading_zeros()).saturating_sub(15);
     (x >> k) << k
+}
+
+/// Where the uniform grid's knots go against a kink inside it (see [`Grid::place`]).
+struct Alignment {
+    /// The grid's first knot before the step is rounded to the index.
+    lo_grid: f64,
+    /// The grid's width (`n` steps).
+    width: f64,
+    /// The knot on the kink, if any.
+    kink_knot: Option<usize>,
+    /// Aligned on two strains: fewer than `n` segments may be in use.
+    aligned: bool,
+    /// The strain the aligned knot sits on.
+    knot_at: f64,
+}
+
+impl Alignment {
+    /// The alignment of `n` segments over `[lo, hi]` (`from_domain`: from the domain's
+    /// start; `at_solid`: up to the solid point), from `start` above a lower corner.
+    fn of(
+        law: &Law,
+        (lo, hi, from_domain, at_solid): (f64, f64, bool, bool),
+        align: Align,
+        n: usize,
+        start: Option<(i32, bool)>,
+    ) -> Result<Self, TableError> {
+        let kink_force = inner_corner(law);
+        let slope_kink = law.preload > law.f_t;
+        let e_p = law.delta(kink_force);
+        let mut kink_knot = None;
+        let mut lo_grid = lo;
+        let mut width = hi - lo;
+        let mut aligned = false;
+        // The strain the aligned knot sits on: Δ(P) (Δ(F_T) without a preload, where
+        // P = F_T) from the domain's start, else the inner corner.
+        let mut knot_at = e_p;
+        if let Some((_, on_kink)) = start {
+            // Above a lower corner: the first knot where the corner ends (on Δ(P), for
+            // one graded toward it), the grid uniform from there.
+            knot_at = lo;
+            kink_knot = on_kink.then_some(0);
+        } else if from_domain {
+            // j segments from the domain's start to that knot, the most that still
+            // reach `hi` with S; the step grows by at most a factor 1 + 1/j.
+            knot_at = law.delta(law.preload);
+            let most = libm::floor(n as f64 * (knot_at - lo) / (hi - lo));
+            if !(most >= 1.0 && knot_at < hi) {
+                return Err(TableError::TooNarrow);
+            }
+            width = n as f64 * (knot_at - lo) / most;
+            kink_knot = Some(most as usize);
+            aligned = true;
+        } else if !matches!(align, Align::Plain | Align::FromDomain)
+            && kink_force > law.first_kink()
+            && e_p > lo
+            && e_p < hi
+        {
+            let most = libm::floor(n as f64 * (e_p - lo) / (hi - lo));
+            if align != Align::Off && most >= 1.0 {
+                let fit = if at_solid && align == Align::NearSolid {
+                    aligned_on_solid(e_p - lo, hi - lo, most)
+                } else {
+                    most
+                };
+                width = n as f64 * (e_p - lo) / fit;
+                kink_knot = Some(fit as usize);
+                aligned = true;
+            } else if slope_kink {
+                let mut step = width / n as f64;
+                let j = libm::ceil((e_p - lo) / step);
+                if j < n as f64 {
+                    step = libm::fmax(step, (hi - e_p) / (n as f64 - j));
+                    lo_grid = e_p - j * step;
+                    width = n as f64 * step;
+                    kink_knot = Some(j as usize);
+                }
+            }
+        }
+        Ok(Self {
+            lo_grid,
+            width,
+            kink_knot,
+            aligned,
+            knot_at,
+        })
+    }
+}
+
+/// The evaluation's index for `n` segments over `width`: `(index_shift, index_scale,
+/// step)`, the step the index implies.
+fn index(width: f64, n: usize) -> Result<(u32, u32, f64), TableError> {
+    // The segment coordinate is ((e − strain_lo) << index_shift) · index_scale / 2³²
+    // in Q15 segments: the shift puts the table's width at the top of a `u32`, so the
+    // scale keeps about 21 significant bits.
+    let span = libm::ceil(width * (1u64 << STRAIN_FRAC) as f64) + 2.0;
+    if span.is_nan() || span >= (1u64 << 32) as f64 {
+        return Err(TableError::BadDomain);
+    }
+    let mut index_shift = 0u32;
+    while index_shift < 31 && span * (2u64 << index_shift) as f64 <= (1u64 << 32) as f64 {
+        index_shift += 1;
+    }
+    let scale = libm::floor(n as f64 / width * libm::ldexp(1.0, 23 - index_shift as i32));
+    // At most 31 significant bits (the narrow index keeps 15 of them), and each segment
+    // at least one strain LSB wide (below that the knots are not strains the format
+    // holds).
+    if !(scale >= 1.0 && scale < (1u64 << 31) as f64) || span - 2.0 < n as f64 {
+        return Err(TableError::TooNarrow);
+    }
+    // Kept to 15 significant bits (the low bits zero), so that the M0's narrow index
+    // ([`crate::arith::narrow::table_force`]: two 32-bit multiplies) is the same number.
+    let index_scale = narrow_scale(scale as u32);
+    // The evaluation places knot i at lo + i · step: build at exactly those strains.
+    let step = libm::ldexp(1.0, 23 - index_shift as i32) / index_scale as f64;
+    Ok((index_shift, index_scale, step))
 }
