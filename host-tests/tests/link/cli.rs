@@ -337,22 +337,30 @@ fn a_script_holds_the_device_armed_as_long_as_it_says() {
         1,
         "one header"
     );
-    let gain_col = rows[0].split(',').position(|c| c == "gain").unwrap();
-    let armed_col = rows[0].split(',').position(|c| c == "armed").unwrap();
-    // From the arm on, armed in every row until the disarm, and no gap over 50 ms.
-    let mut t_last = None;
+    let col = |name: &str| rows[0].split(',').position(|c| c == name).unwrap();
+    let (armed_col, seq_col, tick_col, dropped_col) =
+        (col("armed"), col("seq"), col("tick"), col("dropped"));
+    // The stream whole, in the device's own counts (not the host's clock, which a loaded
+    // machine stalls): each sample follows the last by one `seq`, or the device counted
+    // what it dropped between, at a later tick; armed in every row until the disarm.
+    let mut last: Option<(u64, u64, u64)> = None;
     let mut armed_rows = 0;
     for r in &rows[1..] {
         let v: Vec<&str> = r.split(',').collect();
         if v[armed_col] == "1" {
             armed_rows += 1;
         }
-        let t: f64 = v[0].parse().unwrap();
-        if let Some(l) = t_last {
-            assert!(t - l < 0.05, "a gap of {} s at {t}", t - l);
+        let n = |k: usize| v[k].parse::<u64>().unwrap();
+        let (seq, tick, dropped) = (n(seq_col), n(tick_col), n(dropped_col));
+        if let Some((s, t, d)) = last {
+            assert_eq!(seq - s, 1 + dropped - d, "a sample lost at seq {seq}: {r}");
+            assert_eq!(
+                tick - t,
+                10 * (seq - s),
+                "ticks between samples at seq {seq}"
+            );
         }
-        t_last = Some(t);
-        let _ = v[gain_col];
+        last = Some((seq, tick, dropped));
     }
     assert!(armed_rows > 150, "{armed_rows} armed rows");
     // A bad line: exit 2 naming it, before the device is reached.
