@@ -63,8 +63,7 @@ real!(f64, libm::sqrt);
 fn sqrt_f32(x: f32) -> f32 {
     #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
     {
-        // SAFETY: the Cortex-M4F has the single-precision FPU this instruction needs.
-        unsafe { vsqrt(x) }
+        vsqrt(x)
     }
     #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
     {
@@ -92,8 +91,9 @@ unsafe extern "C" {
 }
 
 #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
-unsafe fn vsqrt(x: f32) -> f32 {
-    // SAFETY: the function above reads s0 and returns in s0, nothing else.
+fn vsqrt(x: f32) -> f32 {
+    // SAFETY: the Cortex-M4F (eabihf: this cfg) has the single-precision FPU the function
+    // above needs; it reads s0 and returns in s0, nothing else.
     unsafe { mccs_vsqrtf(x) }
 }
 

@@ -41,10 +41,14 @@ impl<T> Mailbox<T> {
     pub fn post(&self, value: T) -> Option<T> {
         critical_section::with(|cs| {
             let full = self.full.borrow(cs);
-            // SAFETY: inside the critical section; the value is read only when full.
-            let slot = unsafe { &mut *self.value.get() };
-            let old = full.get().then(|| unsafe { slot.assume_init_read() });
-            slot.write(value);
+            // SAFETY: inside the critical section, so no other context holds the slot;
+            // the old value is read (once) only when full, as `post` wrote it.
+            let old = unsafe {
+                let slot = &mut *self.value.get();
+                let old = full.get().then(|| slot.assume_init_read());
+                slot.write(value);
+                old
+            };
             full.set(true);
             old
         })
@@ -66,10 +70,8 @@ impl<T> Mailbox<T> {
 
 impl<T> Drop for Mailbox<T> {
     fn drop(&mut self) {
-        if *self.full.get_mut().get_mut() {
-            // SAFETY: full: the value was written and not taken.
-            unsafe { self.value.get_mut().assume_init_drop() };
-        }
+        // A value posted and never taken is dropped with the mailbox.
+        drop(self.take());
     }
 }
 

@@ -50,9 +50,7 @@ impl<T> Slot<T> {
 
 impl<T> Drop for Slot<T> {
     fn drop(&mut self) {
-        if self.written {
-            // SAFETY: written (see `option`), and dropped only here.
-            unsafe { self.value.assume_init_drop() };
-        }
+        // The value moves out and drops; the `None` left behind owns nothing.
+        drop(self.option().take());
     }
 }

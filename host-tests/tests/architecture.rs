@@ -324,3 +324,51 @@ fn only_add_edge_writes_an_edges_ends() {
         }
     }
 }
+
+/// The `unsafe` blocks of the firmware and the board: at most 15, each argued by a
+/// `// SAFETY:` comment in the lines just above it (issue 59: one pattern for `'static`
+/// buffers, `Slot`, and no hand-rolled ones).
+#[test]
+fn the_firmware_s_unsafe_blocks_are_few_and_each_argued() {
+    let mut blocks = Vec::new();
+    for dir in ["firmware/src", "boards"] {
+        for path in files(&root().join(dir)) {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let lines: Vec<&str> = text.lines().collect();
+            for (i, line) in lines.iter().enumerate() {
+                if line.trim_start().starts_with("//") || !line.contains("unsafe {") {
+                    continue;
+                }
+                let argued = lines[i.saturating_sub(4)..i]
+                    .iter()
+                    .any(|l| l.contains("// SAFETY:"));
+                blocks.push((format!("{}:{}", path.display(), i + 1), argued));
+            }
+        }
+    }
+    let unargued: Vec<&String> = blocks.iter().filter(|b| !b.1).map(|b| &b.0).collect();
+    assert!(unargued.is_empty(), "unsafe without a SAFETY comment: {unargued:?}");
+    assert!(
+        blocks.len() <= 15,
+        "{} unsafe blocks in firmware/ and boards/ (at most 15): {:?}",
+        blocks.len(),
+        blocks.iter().map(|b| &b.0).collect::<Vec<_>>()
+    );
+}
+
+/// The board's platform facts come from `build.rs` as cfgs (`qemu_run`, `link_on`,
+/// `simulated_plant`, …), not as feature tests scattered over the code: at most 8
+/// `#[cfg(feature` in `boards/`.
+#[test]
+fn the_board_tests_few_features_directly() {
+    let count: usize = files(&root().join("boards"))
+        .iter()
+        .map(|p| {
+            std::fs::read_to_string(p)
+                .unwrap()
+                .matches("cfg(feature")
+                .count()
+        })
+        .sum();
+    assert!(count <= 8, "{count} `cfg(feature` in boards/ (at most 8)");
+}

@@ -35,7 +35,7 @@ mod firmware {
     use mccs::{DefaultArith, ParamSet};
     use mccs_firmware::demo::{self, DemoSpec};
     use mccs_firmware::target::{Core, CORE};
-    use mccs_firmware::{Mailbox, Shared, Telemetry};
+    use mccs_firmware::{Mailbox, Shared, Slot, Telemetry};
 
     /// SysTick clock (the core clock as each QEMU machine models it).
     const SYSTICK_HZ: u32 = match CORE {
@@ -206,17 +206,10 @@ mod firmware {
 
     #[exception]
     fn SysTick() {
-        // The controller in `.bss`: an `Option<Ctl>` static is initialised data (its
-        // `None` is a niche value), its image in flash as large as the controller.
-        // Written `None` once.
-        static mut CTL: core::mem::MaybeUninit<Option<Ctl>> = core::mem::MaybeUninit::uninit();
-        static mut CTL_WRITTEN: bool = false;
-        if !*CTL_WRITTEN {
-            CTL.write(None);
-            *CTL_WRITTEN = true;
-        }
-        // SAFETY: written above before its first read.
-        let slot = unsafe { CTL.assume_init_mut() };
+        // The controller in `.bss` (a `Slot`: an `Option<Ctl>` static would be
+        // initialised data, its image in flash as large as the controller).
+        static mut CTL: Slot<Ctl> = Slot::new();
+        let slot = CTL.option();
         let Some(ctl) = slot.as_mut() else {
             init(slot);
             return;

@@ -2,6 +2,7 @@
 //! loop of known instruction count, so that its counts become instructions under QEMU's
 //! `-icount`.
 
+use core::cell::RefCell;
 use core::hint::black_box;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
@@ -23,6 +24,8 @@ fn SysTick() {
 pub struct Harness {
     /// SysTick counts per 1024 instructions.
     pub cpk: u32,
+    /// SysTick, owned: [`Harness::measure_long`] turns its exception on and off.
+    syst: RefCell<SYST>,
 }
 
 /// `n` iterations of a two-instruction loop.
@@ -55,6 +58,7 @@ pub fn start(mut syst: SYST) -> Harness {
     // 20000 more instructions in the large run.
     Harness {
         cpk: ((large - small) as u64 * 1024 / 20000) as u32,
+        syst: RefCell::new(syst),
     }
 }
 
@@ -74,12 +78,9 @@ impl Harness {
     /// (start-up work: millions of instructions): its wraps counted by its exception,
     /// enabled for the run. Within a few instructions of [`Harness::measure`]'s figure.
     pub fn measure_long(&self, f: impl FnOnce()) -> u64 {
-        // SAFETY: the bench owns SysTick ([`start`]); only its TICKINT bit changes.
-        let syst = unsafe { &*SYST::PTR };
         WRAPS.store(0, Ordering::Relaxed);
         let t0 = now();
-        // SAFETY: as above.
-        unsafe { syst.csr.modify(|c| c | 0b10) };
+        self.syst.borrow_mut().enable_interrupt();
         f();
         // The counter and its wraps, read so that a wrap between the two reads is seen.
         let (mut wraps, mut t1);
@@ -90,8 +91,7 @@ impl Harness {
                 break;
             }
         }
-        // SAFETY: as above.
-        unsafe { syst.csr.modify(|c| c & !0b10) };
+        self.syst.borrow_mut().disable_interrupt();
         // (A wrap after `t1` and before the exception was disabled is not in the count:
         // it happened after the run.)
         let counts = (wraps as u64) * 0x100_0000 + t0 as u64 - t1 as u64;
