@@ -146,38 +146,6 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         substeps: u32,
     ) -> Self {
         let raw = table.raw();
-        // C0 … C3 carry 1, 2, 4, 8 times c0 … c3, in Q(20 + shift) N.
-        let unit = (1u64 << (FORCE_FRAC + raw.shift)) as f64;
-        let mut seg = [[T::ZERO; 4]; S];
-        // C0 less the knots' rounding bias (`mccs::table::knot_bias`).
-        let bias = mccs::table::knot_bias(raw.shift) as f64;
-        for (s, c) in seg.iter_mut().zip(raw.segments.iter()) {
-            *s = core::array::from_fn(|j| {
-                let v = if j == 0 {
-                    c[0] as f64 - bias
-                } else {
-                    c[j] as f64
-                };
-                T::of(v / unit / (1u32 << j) as f64)
-            });
-        }
-        let mut springs = [Spring {
-            a: 0,
-            b: 0,
-            rest: [T::ZERO; 3],
-            l0: T::ZERO,
-            inv_l0: T::ZERO,
-        }; E];
-        for (s, e) in springs.iter_mut().zip(topo.edges()) {
-            let l0 = Topology::<N, E>::rest_length(e);
-            *s = Spring {
-                a: e.a,
-                b: e.b,
-                rest: e.dir.map(|d| T::of(to_f64(d, DIR_FRAC) * l0)),
-                l0: T::of(l0),
-                inv_l0: T::of(1.0 / l0),
-            };
-        }
         let h = 1.0 / (cfg.tick_hz * substeps as f64);
         // The line below's slope as its force uses it (`RawTable::slope_lo`).
         let k_lo = to_f64(raw.slope_lo, raw.slope_lo_frac());
@@ -188,11 +156,11 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         // the line in float is the floor's argument less that half.
         let half_lsb = 0.5 / (1u64 << FORCE_FRAC) as f64;
         Self {
-            springs,
+            springs: Self::springs_of(topo),
             n_springs: topo.edges().len(),
             n_nodes: topo.node_count(),
             contact: topo.contact() as usize,
-            seg,
+            seg: Self::segments_of(table),
             strain_lo: T::of(to_f64(raw.strain_lo, STRAIN_FRAC)),
             strain_hi: T::of(to_f64(raw.strain_hi, STRAIN_FRAC)),
             per_strain: T::of(raw.index_scale as f64 * raw.index_pre as f64 / (1u64 << 23) as f64),
@@ -219,6 +187,48 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             v: [[T::ZERO; 3]; N],
             f: [[T::ZERO; 3]; N],
         }
+    }
+
+    /// The table's cubic segments in float: C0 … C3 carry 1, 2, 4, 8 times c0 … c3, in
+    /// Q(20 + shift) N; C0 less the knots' rounding bias (`mccs::table::knot_bias`).
+    fn segments_of(table: &ForceTable<S>) -> [[T; 4]; S] {
+        let raw = table.raw();
+        let unit = (1u64 << (FORCE_FRAC + raw.shift)) as f64;
+        let bias = mccs::table::knot_bias(raw.shift) as f64;
+        let mut seg = [[T::ZERO; 4]; S];
+        for (s, c) in seg.iter_mut().zip(raw.segments.iter()) {
+            *s = core::array::from_fn(|j| {
+                let v = if j == 0 {
+                    c[0] as f64 - bias
+                } else {
+                    c[j] as f64
+                };
+                T::of(v / unit / (1u32 << j) as f64)
+            });
+        }
+        seg
+    }
+
+    /// The topology's springs: ends, rest vector, rest length and its inverse.
+    fn springs_of(topo: &Topology<N, E>) -> [Spring<T>; E] {
+        let mut springs = [Spring {
+            a: 0,
+            b: 0,
+            rest: [T::ZERO; 3],
+            l0: T::ZERO,
+            inv_l0: T::ZERO,
+        }; E];
+        for (s, e) in springs.iter_mut().zip(topo.edges()) {
+            let l0 = Topology::<N, E>::rest_length(e);
+            *s = Spring {
+                a: e.a,
+                b: e.b,
+                rest: e.dir.map(|d| T::of(to_f64(d, DIR_FRAC) * l0)),
+                l0: T::of(l0),
+                inv_l0: T::of(1.0 / l0),
+            };
+        }
+        springs
     }
 
     #[inline(always)]

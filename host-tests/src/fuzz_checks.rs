@@ -265,23 +265,11 @@ pub fn encoder_frames(data: &[u8]) {
     let _ = enc.errors();
 }
 
-/// The device's side of the link on any bytes: the board's own server, link state and
-/// glued controller on the N = 3 patch, a tick between polls of at most 64 bytes; no
-/// panic; a valid `Hello` after them is answered.
-pub fn link_device(data: &[u8]) {
-    use mccs_firmware::link::{
-        Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Live, Session, TickBudget, Work,
-    };
-    use mccs_firmware::{Controller, SimulatedDevice};
-    use mccs_link::{
-        encode, parse, ContactKind, Core, Decoder, DeviceKind, ToDevice, ToHost, MAX_FRAME,
-    };
-    const N: usize = mccs::topology::standard_capacity(3).0;
-    const E: usize = mccs::topology::standard_capacity(3).1;
-    static TABLE: std::sync::OnceLock<mccs::ForceTable64> = std::sync::OnceLock::new();
-    let table = *TABLE.get_or_init(|| mccs::ForceTable64::new(&Params::TABLE2).expect("Table 2"));
-    let config = mccs::SolverConfig::default();
-    let live = Live {
+/// What the fuzzed device says it is: the simulated 1-DOF board, glued, N = 3.
+fn fuzzed_device_facts(config: mccs::SolverConfig) -> mccs_firmware::link::Live {
+    use mccs_firmware::link::{Live, TickBudget};
+    use mccs_link::{ContactKind, Core, DeviceKind};
+    Live {
         device: DeviceKind::OneDof,
         simulated: true,
         core: Core::M4f,
@@ -300,7 +288,24 @@ pub fn link_device(data: &[u8]) {
             per_substep: 5_000,
         },
         narrow: false,
+    }
+}
+
+/// The device's side of the link on any bytes: the board's own server, link state and
+/// glued controller on the N = 3 patch, a tick between polls of at most 64 bytes; no
+/// panic; a valid `Hello` after them is answered.
+pub fn link_device(data: &[u8]) {
+    use mccs_firmware::link::{
+        Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Session, Work,
     };
+    use mccs_firmware::{Controller, SimulatedDevice};
+    use mccs_link::{encode, parse, Decoder, ToDevice, ToHost, MAX_FRAME};
+    const N: usize = mccs::topology::standard_capacity(3).0;
+    const E: usize = mccs::topology::standard_capacity(3).1;
+    static TABLE: std::sync::OnceLock<mccs::ForceTable64> = std::sync::OnceLock::new();
+    let table = *TABLE.get_or_init(|| mccs::ForceTable64::new(&Params::TABLE2).expect("Table 2"));
+    let config = mccs::SolverConfig::default();
+    let live = fuzzed_device_facts(config);
     let state: LinkState<N, 64, mccs::Wide> =
         LinkState::new(Guard::new(GuardTimes::at_rate(1000, 500)));
     let mut work: Box<Work<N, E, 64, mccs::Wide, 16>> = Box::default();

@@ -347,7 +347,10 @@ fn the_firmware_s_unsafe_blocks_are_few_and_each_argued() {
         }
     }
     let unargued: Vec<&String> = blocks.iter().filter(|b| !b.1).map(|b| &b.0).collect();
-    assert!(unargued.is_empty(), "unsafe without a SAFETY comment: {unargued:?}");
+    assert!(
+        unargued.is_empty(),
+        "unsafe without a SAFETY comment: {unargued:?}"
+    );
     assert!(
         blocks.len() <= 15,
         "{} unsafe blocks in firmware/ and boards/ (at most 15): {:?}",

@@ -145,6 +145,28 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
             worst.stiffness = libm::fmax(worst.stiffness, ek);
         }
     };
+    visit_points(table, law, (from, to), &kinks, &mut at);
+    // A NaN anywhere (it cannot come from a valid law) must not pass for zero.
+    if worst.force.is_nan() || worst.stiffness.is_nan() || scale.is_nan() || scale <= 0.0 {
+        worst = TableBound {
+            force: f64::INFINITY,
+            stiffness: f64::INFINITY,
+        };
+    }
+    worst
+}
+
+/// Where [`measure`] compares: the lines beyond the table over `[from, to]`, every
+/// segment, the graded corner's segments, [`POINTS_PER_SEGMENT`] apart; densely round the
+/// cone's transition and just outside the margin round each of `kinks`.
+fn visit_points<const S: usize>(
+    table: &ForceTable<S>,
+    law: &Law,
+    (from, to): (f64, f64),
+    kinks: &[f64; 3],
+    at: &mut dyn FnMut(f64),
+) {
+    let u_strain = 1.0 / (1u64 << STRAIN_FRAC) as f64;
     let r = table.raw();
     let (lo, hi) = (r.strain_lo as f64 * u_strain, r.strain_hi as f64 * u_strain);
     let (bottom, top) = table.tabulated_range();
@@ -187,7 +209,7 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
     // Just outside the margin round each kink, where a corner the grid cannot follow
     // leaves its largest stiffness error, changing fast: densely over the first 5 % of a
     // margin beyond it (2 n points, 1.6e-6 strain apart), then out to 2.3 margins.
-    for x in kinks {
+    for &x in kinks {
         for j in 0..2 * n {
             for side in [-1.0, 1.0] {
                 at(x + side * KINK_MARGIN * (1.0 + 1e-6 + 0.05 * j as f64 / (2 * n) as f64));
@@ -197,12 +219,4 @@ pub fn measure<const S: usize>(table: &ForceTable<S>, law: &Law, from: f64, to: 
             }
         }
     }
-    // A NaN anywhere (it cannot come from a valid law) must not pass for zero.
-    if worst.force.is_nan() || worst.stiffness.is_nan() || scale.is_nan() || scale <= 0.0 {
-        worst = TableBound {
-            force: f64::INFINITY,
-            stiffness: f64::INFINITY,
-        };
-    }
-    worst
 }

@@ -350,31 +350,7 @@ impl BoardConfig {
     /// Checks every constant against the parts' limits, at the clock tree it sets.
     pub fn check(&self) -> Result<(), BoardConfigError> {
         use BoardConfigError as E;
-        if !(4_000_000..=26_000_000).contains(&self.hse_hz) {
-            return Err(E::Hse);
-        }
-        if !(24_000_000..=168_000_000).contains(&self.sysclk_hz) {
-            return Err(E::Sysclk);
-        }
-        if !(100..=10_000).contains(&self.tick_hz) || !TICK_COUNTER_HZ.is_multiple_of(self.tick_hz)
-        {
-            return Err(E::Tick);
-        }
-        let clocks = Clocks::for_sysclk(self.sysclk_hz);
-        let spi = spi_clock_hz(clocks.pclk2_hz, self.spi_request_hz);
-        if spi == 0 || spi > AS5047P_MAX_SPI_HZ {
-            return Err(E::SpiTooFast);
-        }
-        if pwm_max_duty(clocks.tim1_hz, self.pwm_hz) < 1000 {
-            return Err(E::PwmResolution);
-        }
-        if tick_timer(clocks.tim2_hz, self.tick_hz).is_none() {
-            return Err(E::Tick);
-        }
-        let tick_ms = 1000.0 / self.tick_hz as f64;
-        if (self.watchdog_ms as f64) < 10.0 * tick_ms || self.watchdog_ms > 10_000 {
-            return Err(E::Watchdog);
-        }
+        self.check_clocks()?;
         let mpc = self.mm_per_count;
         if self.encoder_zero > 0x3FFF || !mpc.is_finite() || mpc == 0.0 || libm::fabs(mpc) >= 0.01 {
             return Err(E::Encoder);
@@ -402,11 +378,6 @@ impl BoardConfig {
         if self.max_force > self.force_at_full_duty {
             return Err(E::ForceClamp);
         }
-        if !(9_600..=2_625_000).contains(&self.baud)
-            || usart_error_ppm(clocks.pclk1_hz, self.baud) > 10_000
-        {
-            return Err(E::Baud);
-        }
         if self.ramp_ms > 5_000
             || !(1..=1_000).contains(&self.max_overruns_in_row)
             || !(1..=1_000).contains(&self.pose_speed_mm_s)
@@ -414,6 +385,58 @@ impl BoardConfig {
         {
             return Err(E::Link);
         }
+        self.check_tissue()?;
+        if self.tick_budget == 0
+            || self.tick_base_cost == 0
+            || self.substep_cost == 0
+            || self.check_steps_per_poll == 0
+            || self.tick_base_cost.saturating_add(self.substep_cost) > self.tick_budget
+        {
+            return Err(E::Budget);
+        }
+        Ok(())
+    }
+
+    /// The clock tree's checks: the crystal, the system clock, the tick, the SPI, PWM and
+    /// UART rates it gives, and the watchdog against the tick.
+    fn check_clocks(&self) -> Result<(), BoardConfigError> {
+        use BoardConfigError as E;
+        if !(4_000_000..=26_000_000).contains(&self.hse_hz) {
+            return Err(E::Hse);
+        }
+        if !(24_000_000..=168_000_000).contains(&self.sysclk_hz) {
+            return Err(E::Sysclk);
+        }
+        if !(100..=10_000).contains(&self.tick_hz) || !TICK_COUNTER_HZ.is_multiple_of(self.tick_hz)
+        {
+            return Err(E::Tick);
+        }
+        let clocks = Clocks::for_sysclk(self.sysclk_hz);
+        let spi = spi_clock_hz(clocks.pclk2_hz, self.spi_request_hz);
+        if spi == 0 || spi > AS5047P_MAX_SPI_HZ {
+            return Err(E::SpiTooFast);
+        }
+        if pwm_max_duty(clocks.tim1_hz, self.pwm_hz) < 1000 {
+            return Err(E::PwmResolution);
+        }
+        if tick_timer(clocks.tim2_hz, self.tick_hz).is_none() {
+            return Err(E::Tick);
+        }
+        let tick_ms = 1000.0 / self.tick_hz as f64;
+        if (self.watchdog_ms as f64) < 10.0 * tick_ms || self.watchdog_ms > 10_000 {
+            return Err(E::Watchdog);
+        }
+        if !(9_600..=2_625_000).contains(&self.baud)
+            || usart_error_ppm(clocks.pclk1_hz, self.baud) > 10_000
+        {
+            return Err(E::Baud);
+        }
+        Ok(())
+    }
+
+    /// The tissue's checks: its workspace within ±100 mm, its sides from the patch's
+    /// grid to 64 nodes and within ±100 mm, and 0 ≤ μk ≤ μs ≤ 2.
+    fn check_tissue(&self) -> Result<(), BoardConfigError> {
         let [lo, hi] = self.workspace_mm;
         let half_w = (self.tissue_nodes[0] / 2) as f64 * SPACING_MM;
         let half_h = (self.tissue_nodes[1] / 2) as f64 * SPACING_MM;
@@ -429,15 +452,7 @@ impl BoardConfig {
             && self.mu_k <= self.mu_s
             && self.mu_s <= 2.0;
         if !(workspace && sides && friction) {
-            return Err(E::Tissue);
-        }
-        if self.tick_budget == 0
-            || self.tick_base_cost == 0
-            || self.substep_cost == 0
-            || self.check_steps_per_poll == 0
-            || self.tick_base_cost.saturating_add(self.substep_cost) > self.tick_budget
-        {
-            return Err(E::Budget);
+            return Err(BoardConfigError::Tissue);
         }
         Ok(())
     }

@@ -140,68 +140,79 @@ mod firmware {
             let t = TELEMETRY.get();
             if t.ticks >= next_trace && t.ticks > 0 {
                 next_trace = t.ticks + TRACE_EVERY;
-                defmt::info!(
-                    "tick={=u32} force_n=({=f32}, {=f32}, {=f32}) window_shifts={=u32}",
-                    t.ticks,
-                    t.force[0].to_num::<f32>(),
-                    t.force[1].to_num::<f32>(),
-                    t.force[2].to_num::<f32>(),
-                    t.window_shifts
-                );
-                #[cfg(feature = "arm")]
-                {
-                    let (d, ..) = DUTIES.get();
-                    defmt::info!(
-                        "tick={=u32} duty=({=f32}, {=f32}, {=f32})",
-                        t.ticks,
-                        q16(d[0]),
-                        q16(d[1]),
-                        q16(d[2])
-                    );
-                }
+                trace(&t);
             }
             if let Some(fault) = t.fault {
                 defmt::error!("safe state: {}", defmt::Debug2Format(&fault));
             }
             if t.ticks >= SPEC.ticks() {
                 syst.disable_interrupt();
-                // Counts → instructions under -icount: SYSTICK_HZ · 2^shift / 1e9 per one.
-                let per_instruction = SYSTICK_HZ as f32 * (1u32 << SPEC.icount_shift) as f32 / 1e9;
-                defmt::info!(
-                    "longest tick: {=u32} SysTick counts = {=f32} instructions under -icount shift={=u32} (budget {=u32})",
-                    WORST_TICK.get(),
-                    WORST_TICK.get() as f32 / per_instruction,
-                    SPEC.icount_shift,
-                    SPEC.budget()
-                );
-                #[cfg(not(feature = "arm"))]
-                defmt::println!(
-                    "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32}",
-                    t.ticks,
-                    t.overruns,
-                    t.max_force.to_num::<f32>(),
-                    t.steady_force.to_num::<f32>(),
-                    t.window_shifts
-                );
-                #[cfg(feature = "arm")]
-                {
-                    let (_, steady, max) = DUTIES.get();
-                    defmt::println!(
-                        "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32} steady_duty_a={=f32} steady_duty_b={=f32} steady_duty_c={=f32} max_duty={=f32}",
-                        t.ticks,
-                        t.overruns,
-                        t.max_force.to_num::<f32>(),
-                        t.steady_force.to_num::<f32>(),
-                        t.window_shifts,
-                        q16(steady[0]),
-                        q16(steady[1]),
-                        q16(steady[2]),
-                        q16(max)
-                    );
-                }
-                exit(t.fault.is_none());
+                finish(&t);
             }
         }
+    }
+
+    /// The trace line of telemetry `t` (and, with the arm, its duties).
+    fn trace(t: &Telemetry) {
+        defmt::info!(
+            "tick={=u32} force_n=({=f32}, {=f32}, {=f32}) window_shifts={=u32}",
+            t.ticks,
+            t.force[0].to_num::<f32>(),
+            t.force[1].to_num::<f32>(),
+            t.force[2].to_num::<f32>(),
+            t.window_shifts
+        );
+        #[cfg(feature = "arm")]
+        {
+            let (d, ..) = DUTIES.get();
+            defmt::info!(
+                "tick={=u32} duty=({=f32}, {=f32}, {=f32})",
+                t.ticks,
+                q16(d[0]),
+                q16(d[1]),
+                q16(d[2])
+            );
+        }
+    }
+
+    /// The run's last lines (the longest tick, the `SUMMARY`), then the exit: success
+    /// unless telemetry `t` holds a fault.
+    fn finish(t: &Telemetry) -> ! {
+        // Counts → instructions under -icount: SYSTICK_HZ · 2^shift / 1e9 per one.
+        let per_instruction = SYSTICK_HZ as f32 * (1u32 << SPEC.icount_shift) as f32 / 1e9;
+        defmt::info!(
+            "longest tick: {=u32} SysTick counts = {=f32} instructions under -icount shift={=u32} (budget {=u32})",
+            WORST_TICK.get(),
+            WORST_TICK.get() as f32 / per_instruction,
+            SPEC.icount_shift,
+            SPEC.budget()
+        );
+        #[cfg(not(feature = "arm"))]
+        defmt::println!(
+            "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32}",
+            t.ticks,
+            t.overruns,
+            t.max_force.to_num::<f32>(),
+            t.steady_force.to_num::<f32>(),
+            t.window_shifts
+        );
+        #[cfg(feature = "arm")]
+        {
+            let (_, steady, max) = DUTIES.get();
+            defmt::println!(
+                "SUMMARY ticks={=u32} overruns={=u32} max_force_n={=f32} steady_force_n={=f32} window_shifts={=u32} steady_duty_a={=f32} steady_duty_b={=f32} steady_duty_c={=f32} max_duty={=f32}",
+                t.ticks,
+                t.overruns,
+                t.max_force.to_num::<f32>(),
+                t.steady_force.to_num::<f32>(),
+                t.window_shifts,
+                q16(steady[0]),
+                q16(steady[1]),
+                q16(steady[2]),
+                q16(max)
+            );
+        }
+        exit(t.fault.is_none());
     }
 
     #[exception]

@@ -163,6 +163,9 @@ impl<const S: usize> Session<S> {
     }
 
     /// Handles one message; answers go to `out`. `armed`: the guard's state before it.
+    // Whole on purpose (over 80 lines): one arm per message of docs/protocol.md, in its
+    // order, so the page and the device's one handler read side by side; each arm's work
+    // is a call of its own.
     #[allow(clippy::too_many_arguments)]
     pub fn handle<const N: usize, const E: usize, A: Arith, const P: usize>(
         &mut self,

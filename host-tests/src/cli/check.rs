@@ -120,35 +120,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "must be a whole number of Hz, 1 … 100000",
         ));
     }
-    let symplectic = a.integrator == IntegratorArg::SymplecticDamped;
-    let suffix = if symplectic { "_symplectic" } else { "" };
-    let substep_case = format!("substep_n{n}{suffix}");
-    let Some(substep) = figure(core.name(), &substep_case, "instructions") else {
-        let measured: Vec<String> = (3..=12)
-            .filter(|k| {
-                figure(
-                    core.name(),
-                    &format!("substep_n{k}{suffix}"),
-                    "instructions",
-                )
-                .is_some()
-            })
-            .map(|k| k.to_string())
-            .collect();
-        return Err(arg_error(
-            "--grid",
-            &format!(
-                "the bench measures the {} substep{} for N = {} only, not {n}",
-                core.name(),
-                if symplectic {
-                    " of --integrator symplectic-damped"
-                } else {
-                    ""
-                },
-                measured.join(", ")
-            ),
-        ));
-    };
+    let substep = substep_figure(core, n, a.integrator)?;
     let cfg = SolverConfig {
         integrator: a.integrator.into(),
         ..a.tuning.config(rate)?
@@ -166,9 +138,74 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     let springs = mccs::topology::standard_capacity(n).1 as u64;
     let spread = figure(core.name(), "spring_path_spread", "instructions").unwrap_or(0);
     let patch_tick = substeps as u64 * (substep + springs * spread);
-    let roaming = figure(core.name(), "tick_roaming_bound", "instructions").unwrap_or(0);
     let budget = core.mhz() * 1_000_000 / (2 * rate as u64);
-    let (tick, how) = match a.device {
+    let (tick, how) = device_share(core, a.device, patch_tick);
+    let fits = tick <= budget;
+
+    eprintln!(
+        "mccs check: tick_instructions estimated from the bench's measured costs on the {} (bench/baseline.txt): {substeps} substeps × ({substep} per substep + {springs} springs × {spread}, their spread over every state); {how}; budget: half a {} Hz tick at {} MHz, one instruction per cycle",
+        core.name(),
+        rate as u64,
+        core.mhz()
+    );
+    writeln!(
+        out,
+        "substeps={substeps} tick_instructions={tick} budget={budget} fits={}",
+        if fits { "yes" } else { "no" }
+    )
+    .map_err(io_error)?;
+    out.flush().map_err(io_error)?;
+    if fits {
+        Ok(())
+    } else {
+        Err(CliError::check_failed(format!(
+            "the tick would take {tick} instructions, over its budget of {budget}: a smaller --grid, a lower --rate or a heavier --node-mass"
+        )))
+    }
+}
+
+/// The bench's measured substep cost for the `n × n` patch on `core` with `integrator`,
+/// or the `--grid` error naming the sizes it measures.
+fn substep_figure(core: CoreArg, n: usize, integrator: IntegratorArg) -> Result<u64, CliError> {
+    let symplectic = integrator == IntegratorArg::SymplecticDamped;
+    let suffix = if symplectic { "_symplectic" } else { "" };
+    if let Some(substep) = figure(
+        core.name(),
+        &format!("substep_n{n}{suffix}"),
+        "instructions",
+    ) {
+        return Ok(substep);
+    }
+    let measured: Vec<String> = (3..=12)
+        .filter(|k| {
+            figure(
+                core.name(),
+                &format!("substep_n{k}{suffix}"),
+                "instructions",
+            )
+            .is_some()
+        })
+        .map(|k| k.to_string())
+        .collect();
+    Err(arg_error(
+        "--grid",
+        &format!(
+            "the bench measures the {} substep{} for N = {} only, not {n}",
+            core.name(),
+            if symplectic {
+                " of --integrator symplectic-damped"
+            } else {
+                ""
+            },
+            measured.join(", ")
+        ),
+    ))
+}
+
+/// The tick's cost beyond the patch's for `device`, and how it was reckoned.
+fn device_share(core: CoreArg, device: DeviceArg, patch_tick: u64) -> (u64, String) {
+    let roaming = figure(core.name(), "tick_roaming_bound", "instructions").unwrap_or(0);
+    match device {
         DeviceArg::Patch => (
             patch_tick,
             format!(
@@ -191,27 +228,6 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 ),
             )
         }
-    };
-    let fits = tick <= budget;
-    eprintln!(
-        "mccs check: tick_instructions estimated from the bench's measured costs on the {} (bench/baseline.txt): {substeps} substeps × ({substep} per substep + {springs} springs × {spread}, their spread over every state); {how}; budget: half a {} Hz tick at {} MHz, one instruction per cycle",
-        core.name(),
-        rate as u64,
-        core.mhz()
-    );
-    writeln!(
-        out,
-        "substeps={substeps} tick_instructions={tick} budget={budget} fits={}",
-        if fits { "yes" } else { "no" }
-    )
-    .map_err(io_error)?;
-    out.flush().map_err(io_error)?;
-    if fits {
-        Ok(())
-    } else {
-        Err(CliError::check_failed(format!(
-            "the tick would take {tick} instructions, over its budget of {budget}: a smaller --grid, a lower --rate or a heavier --node-mass"
-        )))
     }
 }
 

@@ -31,6 +31,46 @@ pub(super) struct Args {
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
+    let kinds = models_asked(&a)?;
+    let (points, note) = fit::read_data_noted(&a.data).map_err(|e| CliError::new(e.to_string()))?;
+    if let Some(note) = note {
+        eprintln!("mccs: {note}");
+    }
+    if points.len() > fit::FIT_ROWS {
+        eprintln!(
+            "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
+            a.data.display(),
+            points.len(),
+            fit::FIT_ROWS
+        );
+    }
+    let fits = fit_all(&a.data, &points, kinds)?;
+    print_fits(&fits, &points, out)?;
+    let fits: Vec<fit::Fit> = fits.into_iter().map(|(_, f)| f).collect();
+    let mccs_params = fits.iter().find_map(|f| match f.model {
+        fit::Fitted::Mccs(p) => Some(p),
+        _ => None,
+    });
+    if let (Some(path), Some(p)) = (a.out, mccs_params) {
+        let text = format!(
+            "# MCCS parameters fitted by `mccs fit` to {}\n{}",
+            a.data.display(),
+            paramfile::to_toml(&p)
+        );
+        std::fs::write(&path, text)
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
+    }
+    if let Some(path) = a.plot {
+        let title = format!("{}: fitted models", a.data.display());
+        fit::plot(&path, &points, &fits, &title)
+            .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", path.display())))?;
+    }
+    Ok(())
+}
+
+/// The models `--model` names, with `--out` and `--plot` checked against them and
+/// writable, before any fitting.
+fn models_asked(a: &Args) -> Result<Vec<ModelKind>, CliError> {
     let kinds: Vec<ModelKind> = match a.model.as_str() {
         "all" => ModelKind::ALL.to_vec(),
         name => vec![ModelKind::ALL
@@ -60,18 +100,17 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         }
         check_writable("--plot", p)?;
     }
-    let (points, note) = fit::read_data_noted(&a.data).map_err(|e| CliError::new(e.to_string()))?;
-    if let Some(note) = note {
-        eprintln!("mccs: {note}");
-    }
-    if points.len() > fit::FIT_ROWS {
-        eprintln!(
-            "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
-            a.data.display(),
-            points.len(),
-            fit::FIT_ROWS
-        );
-    }
+    Ok(kinds)
+}
+
+/// Every model fitted before anything is printed: a model that cannot be fitted leaves
+/// stdout empty, as every other error does, and its line says which did fit. A progress
+/// line every few seconds on stderr.
+fn fit_all(
+    data: &Path,
+    points: &[fit::Point],
+    kinds: Vec<ModelKind>,
+) -> Result<Vec<(ModelKind, fit::Fit)>, CliError> {
     let mut ticker = Ticker::new();
     let mut progress = |p: Progress| {
         if let Some(t) = ticker.due() {
@@ -84,20 +123,27 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             );
         }
     };
-    // Every model is fitted before anything is printed: a model that cannot be fitted
-    // leaves stdout empty, as every other error does, and its line says which did fit.
     let mut fits = Vec::new();
     let mut failed = Vec::new();
     for kind in kinds {
-        match fit::fit_rows(kind, &points, &mut progress) {
+        match fit::fit_rows(kind, points, &mut progress) {
             Some(f) => fits.push((kind, f)),
             None => failed.push(kind),
         }
     }
     if !failed.is_empty() {
-        return Err(not_fitted(&a.data, &points, &failed, &fits));
+        return Err(not_fitted(data, points, &failed, &fits));
     }
-    for (kind, f) in &fits {
+    Ok(fits)
+}
+
+/// The `FIT` and `PARAMS` lines of each fit, and its warnings on stderr.
+fn print_fits(
+    fits: &[(ModelKind, fit::Fit)],
+    points: &[fit::Point],
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    for (kind, f) in fits {
         let m = f.metrics;
         writeln!(
             out,
@@ -115,31 +161,11 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             .map(|(k, v)| format!("{k}={}", fmt_param(*v)))
             .collect();
         writeln!(out, "PARAMS model={} {}", kind.name(), params.join(" ")).map_err(io_error)?;
-        for warning in warnings(&f.model, &points) {
+        for warning in warnings(&f.model, points) {
             eprintln!("mccs: warning: the {} fit: {warning}", kind.name());
         }
     }
-    out.flush().map_err(io_error)?;
-    let fits: Vec<fit::Fit> = fits.into_iter().map(|(_, f)| f).collect();
-    let mccs_params = fits.iter().find_map(|f| match f.model {
-        fit::Fitted::Mccs(p) => Some(p),
-        _ => None,
-    });
-    if let (Some(path), Some(p)) = (a.out, mccs_params) {
-        let text = format!(
-            "# MCCS parameters fitted by `mccs fit` to {}\n{}",
-            a.data.display(),
-            paramfile::to_toml(&p)
-        );
-        std::fs::write(&path, text)
-            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
-    }
-    if let Some(path) = a.plot {
-        let title = format!("{}: fitted models", a.data.display());
-        fit::plot(&path, &points, &fits, &title)
-            .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", path.display())))?;
-    }
-    Ok(())
+    out.flush().map_err(io_error)
 }
 
 /// The one line for models that could not be fitted: which, why (no starting point

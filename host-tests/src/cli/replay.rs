@@ -245,13 +245,11 @@ fn replay<const S: usize>(
 ) -> Result<(), CliError> {
     let (traj, arm) = probe_motion(a)?;
     // With an arm, each row ends with its duties at that tick.
-    let duties = |k: usize, force: [f64; 3]| duty_text(arm.as_ref(), k, force);
     let duty_columns = if arm.is_some() {
         ",duty_a,duty_b,duty_c"
     } else {
         ""
     };
-    let mut tick = 0usize;
     let replay = Replay {
         grid: a.patch.grid,
         spacing: a.patch.spacing,
@@ -259,54 +257,27 @@ fn replay<const S: usize>(
         engine: a.patch.engine(),
     };
     let w = std::io::BufWriter::new(out);
-    // Progress lines on stderr for a replay that takes long (a long trajectory on a large
-    // reference patch: 600 s on the 8 × 8 twin takes 14 s).
-    let mut progress = Simulated::new("replay", traj.span().1);
     // The reference backend's substeps are the twin's, under its own cap.
     let limits = match replay.engine {
         Engine::Reference => twin_limits(&cfg),
         _ => cfg,
     };
-    let fail = |e| match e {
-        ReplayError::Solver(s) => config_error(s, &limits),
-        ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
-        ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
-        ReplayError::Topology(e) => topology_error(e),
-        other => file_error(&a.params, other),
-    };
+    let fail = |e| replay_error(e, &limits, &a.params);
     let substeps = replay.substeps(p, table).map_err(fail)?;
     let tissue = roaming.as_ref().map(|r| r.tissue);
-    // Said with the first row: a configuration the core refuses when the run starts (a
-    // cap's window) gets its one error line alone.
-    let mut setup = Some(setup_line(
-        "replay",
-        &a.patch,
-        tissue.as_ref(),
-        &cfg,
-        substeps,
-        true,
-    ));
-    let mut watch = Watch::new(
-        "replay",
-        a.patch.grid,
-        a.patch.spacing,
-        tissue,
-        cfg.coupling.max_force,
-    );
+    let mut seen = RowsSeen::new(a, tissue, &cfg, substeps, traj.span().1, arm);
+    let mut observe = |time: f64, probe, force: [f64; 3]| seen.row_end(time, probe, force);
     let done = match roaming {
         Some(roaming) => csv(
             w,
             &format!("{}{duty_columns}", header(true)),
             |row| {
                 replay.roam_with(p, table, &traj, &roaming, |r: RoamRow| {
-                    if let Some(line) = setup.take() {
-                        eprintln!("{line}");
-                    }
-                    progress.at(r.time);
-                    watch.see(r.time, r.probe, r.force);
-                    let k = tick;
-                    tick += 1;
-                    row(format!("{}{}", roam_line(&r), duties(k, r.force)))
+                    row(format!(
+                        "{}{}",
+                        roam_line(&r),
+                        observe(r.time, r.probe, r.force)
+                    ))
                 })
             },
             fail,
@@ -316,23 +287,92 @@ fn replay<const S: usize>(
             &format!("{}{duty_columns}", header(false)),
             |row| {
                 replay.run_with(p, table, &traj, |r| {
-                    if let Some(line) = setup.take() {
-                        eprintln!("{line}");
-                    }
-                    progress.at(r.time);
-                    watch.see(r.time, r.probe, r.force);
-                    let k = tick;
-                    tick += 1;
-                    row(format!("{}{}", glued_line(&r), duties(k, r.force)))
+                    row(format!(
+                        "{}{}",
+                        glued_line(&r),
+                        observe(r.time, r.probe, r.force)
+                    ))
                 })
             },
             fail,
         ),
     };
-    for line in watch.warnings() {
+    for line in seen.watch.warnings() {
         eprintln!("{line}");
     }
     done
+}
+
+/// What a replay does with each row as it goes: the setup line before the first, the
+/// progress, the watch over force and depth, and the row's duties (with an arm).
+struct RowsSeen {
+    setup: Option<String>,
+    progress: Simulated,
+    watch: Watch,
+    tick: usize,
+    arm: Option<ArmPoses>,
+}
+
+impl RowsSeen {
+    /// For the replay of `a` over `duration_s` on `tissue` (roaming) with `cfg` at
+    /// `substeps` per tick, with `arm`'s poses for the duties.
+    fn new(
+        a: &Args,
+        tissue: Option<crate::roam::Tissue>,
+        cfg: &SolverConfig,
+        substeps: u32,
+        duration_s: f64,
+        arm: Option<ArmPoses>,
+    ) -> Self {
+        Self {
+            // Said with the first row: a configuration the core refuses when the run starts
+            // (a cap's window) gets its one error line alone.
+            setup: Some(setup_line(
+                "replay",
+                &a.patch,
+                tissue.as_ref(),
+                cfg,
+                substeps,
+                true,
+            )),
+            // Progress lines on stderr for a replay that takes long (a long trajectory on a
+            // large reference patch: 600 s on the 8 × 8 twin takes 14 s).
+            progress: Simulated::new("replay", duration_s),
+            watch: Watch::new(
+                "replay",
+                a.patch.grid,
+                a.patch.spacing,
+                tissue,
+                cfg.coupling.max_force,
+            ),
+            tick: 0,
+            arm,
+        }
+    }
+
+    /// Sees the row at `time`, and returns the end of its line: its duties, if any.
+    fn row_end(&mut self, time: f64, probe: [f64; 3], force: [f64; 3]) -> String {
+        if let Some(line) = self.setup.take() {
+            eprintln!("{line}");
+        }
+        self.progress.at(time);
+        self.watch.see(time, probe, force);
+        let k = self.tick;
+        self.tick += 1;
+        duty_text(self.arm.as_ref(), k, force)
+    }
+}
+
+/// A replay's error as the CLI says it: a solver configuration against the `limits` it
+/// ran under, a cap or tissue argument, a topology, or else the parameter file's.
+fn replay_error(e: ReplayError, limits: &SolverConfig, params: &std::path::Path) -> CliError {
+    match e {
+        ReplayError::Solver(s) => config_error(s, limits),
+        ReplayError::Proxy(e @ ProxyError::Cap) => arg_error("--cap-radius", &e.to_string()),
+        ReplayError::Proxy(e) => arg_error("--tissue", &e.to_string()),
+        ReplayError::Topology(e) => topology_error(e),
+        other => file_error(params, other),
+    }
 }
 
 /// An arm and its pose at each tick of a replay, for the duties.

@@ -374,6 +374,9 @@ struct StepCoeffs {
 /// the loop for every patch's capacity (monomorphised per capacity, it was five copies
 /// of 10 KB in the bench firmware). `dv` is scratch, as long as `x`. False where a
 /// component grew past [`STATE_LIMIT`] (the step is unstable).
+// Whole on purpose (over 80 lines): the kernel mirrors the solver's substep line by line
+// (springs, then nodes, then the coupling), which is what the stability proof relies on;
+// split, it would no longer read against the substep in `solver/step.rs`.
 #[inline(never)]
 fn step_once(
     edges: &[Edge],

@@ -18,6 +18,9 @@ impl<const S: usize> ForceTable<S> {
     /// [`Align::FromDomain`]). With `CORNER`, the last `4 · octaves` segments are a
     /// graded corner of `corner_len` strain ending at the solid point ([`Corner`]), and
     /// the uniform grid ends where it starts.
+    // Whole on purpose (over 80 lines): the table's fields are filled in the order they
+    // depend on one another (grid → shift → segments → lines → corner → line above), and
+    // `RawTable` is built once, in one literal, so that no field is left to a default.
     #[inline(never)]
     pub(super) fn on_grid<const TENSION: bool, const CORNER: bool>(
         law: &Law,
@@ -30,10 +33,7 @@ impl<const S: usize> ForceTable<S> {
     ) -> Result<Self, TableError> {
         let corner_segments = octaves * CORNER_PER_OCTAVE;
         let corner = if CORNER {
-            if octaves == 0 || octaves > CORNER_OCTAVES_MAX || S < 2 * corner_segments {
-                return Err(TableError::TooNarrow);
-            }
-            Some(Corner::place(law, to, corner_len, corner_end, octaves)?)
+            Some(Self::corner_of(law, to, corner_len, corner_end, octaves)?)
         } else {
             None
         };
@@ -64,19 +64,7 @@ impl<const S: usize> ForceTable<S> {
         // line above on the law at the first strain past the table (below).
         // Under a lower corner the line below meets the corner's first knot instead.
         let l = match (&lower, &corner_ends) {
-            (Some(c), Some(ends)) => {
-                // The corner's lowest knot: (0, 4), or (octaves − 1, 0) where it lies
-                // above its anchor.
-                let lowest = if c.above_anchor() {
-                    ends[corner_segments - CORNER_PER_OCTAVE][0]
-                } else {
-                    ends[CORNER_PER_OCTAVE - 1][1]
-                };
-                let first = knot_units(lowest, shift) as i32;
-                let unit = (1u64 << STRAIN_FRAC) as f64;
-                let at_kink = c.lo as f64 / unit <= law.strain_t();
-                lines::<S>(law, &grid, (at_kink, c.lo), first >> shift)?
-            }
+            (Some(c), Some(ends)) => Self::lines_under_corner(law, &grid, c, ends, shift)?,
             _ => lines::<S>(
                 law,
                 &grid,
@@ -125,6 +113,43 @@ impl<const S: usize> ForceTable<S> {
         raw.force_hi = force_hi(law, &raw, lower.is_some())?;
         raw.segments = segs.coefficients;
         Ok(Self::from_raw(raw))
+    }
+
+    /// The graded corner of `octaves` octaves and `corner_len` strain ending at `to`'s
+    /// side `corner_end`; too narrow a table (or octaves out of 1 …
+    /// [`CORNER_OCTAVES_MAX`]) refused.
+    fn corner_of(
+        law: &Law,
+        to: f64,
+        corner_len: f64,
+        corner_end: CornerEnd,
+        octaves: usize,
+    ) -> Result<Corner, TableError> {
+        if octaves == 0 || octaves > CORNER_OCTAVES_MAX || S < 2 * octaves * CORNER_PER_OCTAVE {
+            return Err(TableError::TooNarrow);
+        }
+        Corner::place(law, to, corner_len, corner_end, octaves)
+    }
+
+    /// The lines of a table whose lower corner `c` (its segments' `ends`) lies under the
+    /// grid: the line below meets the corner's lowest knot — (0, 4), or (octaves − 1, 0)
+    /// where it lies above its anchor.
+    fn lines_under_corner(
+        law: &Law,
+        grid: &Grid,
+        c: &Corner,
+        ends: &[[f64; 4]],
+        shift: u32,
+    ) -> Result<super::lines::Lines, TableError> {
+        let lowest = if c.above_anchor() {
+            ends[ends.len() - CORNER_PER_OCTAVE][0]
+        } else {
+            ends[CORNER_PER_OCTAVE - 1][1]
+        };
+        let first = knot_units(lowest, shift) as i32;
+        let unit = (1u64 << STRAIN_FRAC) as f64;
+        let at_kink = c.lo as f64 / unit <= law.strain_t();
+        lines::<S>(law, grid, (at_kink, c.lo), first >> shift)
     }
 }
 

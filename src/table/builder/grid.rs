@@ -51,29 +51,35 @@ pub(super) struct Grid {
     pub(super) index_scale: u32,
 }
 
-impl Grid {
-    /// Places `S` segments over the law's curved part inside `[from, to]` (with
-    /// `TENSION` and [`Align::FromDomain`], from `from` instead; from `start`, a Q24
-    /// strain on a preload's kink `Δ(P)` with a knot on it, above a lower corner; up to
-    /// `end`, below a graded corner).
-    pub(super) fn place<const TENSION: bool>(
+/// The strains a grid must cover, before they are rounded to the strain format.
+#[derive(Clone, Copy)]
+struct Span {
+    /// From here (the kink, the domain's start, or a lower corner's knot on `Δ(P)`).
+    lo: f64,
+    /// To here (the solid point, the domain's end, or a graded corner's start).
+    hi: f64,
+    /// `TENSION` with [`Align::FromDomain`] below the kink: the grid starts at `from`.
+    from_domain: bool,
+    /// The table starts at the kink, with the exact line below.
+    at_kink: bool,
+    /// The table ends at the solid point, with the exact line above.
+    at_solid: bool,
+}
+
+impl Span {
+    /// The span over `[from, to]` (a finite domain inside ±127 strain), from `start`
+    /// and up to `end` as [`Grid::place`] takes them.
+    fn of<const TENSION: bool>(
         law: &Law,
-        from: f64,
-        to: f64,
+        (from, to): (f64, f64),
         align: Align,
-        n: usize,
         start: Option<(i32, bool)>,
         end: Option<f64>,
     ) -> Result<Self, TableError> {
-        if n == 0 {
-            return Err(TableError::NoSegments);
-        }
         if !(from.is_finite() && to.is_finite() && from < to && from > -127.0 && to < 127.0) {
             return Err(TableError::BadDomain);
         }
         let (e_t, e_c) = (law.strain_t(), law.strain_c());
-        // Whether the table starts at the kink and ends at the solid point (exact lines
-        // beyond), decided before the ends are rounded to the strain format.
         let from_domain = TENSION && align == Align::FromDomain && from < e_t;
         // With a graded corner (`end`), the uniform grid ends where the corner starts.
         let at_kink = from <= e_t && !from_domain && start.is_none();
@@ -91,24 +97,42 @@ impl Grid {
         if hi <= lo {
             return Err(TableError::NoNonlinearPhase);
         }
-        // A preload above F_T puts the law's one slope kink, Δ(P), inside the table. The
-        // grid is then placed so that a knot falls on it, and the two segments meeting
-        // there get the two one-sided slopes. With `align` on, and Δ(P) at least a segment
-        // above the table's start (the cone's own transition Δ(F_T), a jump in curvature
-        // that a cubic across it follows only to second order; or the domain's edge), the
-        // step is chosen so that a whole number j of segments spans the two, and both
-        // are knots. The step grows by at most a factor 1 + 1/j, which costs less than
-        // that corner (the smooth parts' fourth-order error grows at most 16×, from
-        // ~1e-7), and the table ends at the first knot at or above `hi`, with fewer than
-        // `S` segments in use. Otherwise the first knot moves down (into the exact linear
-        // phase, or below the domain) by less than a segment, and the step grows only if
-        // the table would otherwise end short of `hi`.
-        // A preload below F_T puts the cone's own transition Δ(F_T) inside instead, above
-        // the slope kink Δ(P) where the table starts: a jump in curvature only. The
-        // grid is aligned on both as above, but anchored on the table's start (a slope
-        // kink, which the first knot must not leave), so that the knot near Δ(F_T) lies
-        // within the narrowed step's drift of it and is an ordinary knot; no aligned
-        // grid, no knot on it (moving the first knot below Δ(P) would cost more).
+        Ok(Self {
+            lo,
+            hi,
+            from_domain,
+            at_kink,
+            at_solid,
+        })
+    }
+}
+
+impl Grid {
+    /// Places `S` segments over the law's curved part inside `[from, to]` (with
+    /// `TENSION` and [`Align::FromDomain`], from `from` instead; from `start`, a Q24
+    /// strain on a preload's kink `Δ(P)` with a knot on it, above a lower corner; up to
+    /// `end`, below a graded corner).
+    pub(super) fn place<const TENSION: bool>(
+        law: &Law,
+        from: f64,
+        to: f64,
+        align: Align,
+        n: usize,
+        start: Option<(i32, bool)>,
+        end: Option<f64>,
+    ) -> Result<Self, TableError> {
+        if n == 0 {
+            return Err(TableError::NoSegments);
+        }
+        let span = Span::of::<TENSION>(law, (from, to), align, start, end)?;
+        let Span {
+            lo,
+            hi,
+            from_domain,
+            at_kink,
+            at_solid,
+        } = span;
+        // Where the grid's knots fall round the law's kinks: [`Alignment::of`].
         let slope_kink = law.preload > law.f_t;
         let Alignment {
             lo_grid,
@@ -116,7 +140,7 @@ impl Grid {
             kink_knot,
             aligned,
             knot_at,
-        } = Alignment::of(law, (lo, hi, from_domain, at_solid), align, n, start)?;
+        } = Alignment::of(law, &span, align, n, start)?;
         let grid_moved = lo_grid < lo;
         let (index_shift, index_scale, step) = index(width, n)?;
         // That step is a little longer than the one asked for (the scale's low bits are
@@ -261,15 +285,40 @@ struct Alignment {
 }
 
 impl Alignment {
-    /// The alignment of `n` segments over `[lo, hi]` (`from_domain`: from the domain's
-    /// start; `at_solid`: up to the solid point), from `start` above a lower corner.
+    /// The alignment of `n` segments over `span`, from `start` above a lower corner.
+    ///
+    /// A preload above F_T puts the law's one slope kink, Δ(P), inside the table. The
+    /// grid is then placed so that a knot falls on it, and the two segments meeting
+    /// there get the two one-sided slopes. With `align` on, and Δ(P) at least a segment
+    /// above the table's start (the cone's own transition Δ(F_T), a jump in curvature
+    /// that a cubic across it follows only to second order; or the domain's edge), the
+    /// step is chosen so that a whole number j of segments spans the two, and both
+    /// are knots. The step grows by at most a factor 1 + 1/j, which costs less than
+    /// that corner (the smooth parts' fourth-order error grows at most 16×, from
+    /// ~1e-7), and the table ends at the first knot at or above `hi`, with fewer than
+    /// `S` segments in use. Otherwise the first knot moves down (into the exact linear
+    /// phase, or below the domain) by less than a segment, and the step grows only if
+    /// the table would otherwise end short of `hi`.
+    /// A preload below F_T puts the cone's own transition Δ(F_T) inside instead, above
+    /// the slope kink Δ(P) where the table starts: a jump in curvature only. The
+    /// grid is aligned on both as above, but anchored on the table's start (a slope
+    /// kink, which the first knot must not leave), so that the knot near Δ(F_T) lies
+    /// within the narrowed step's drift of it and is an ordinary knot; no aligned
+    /// grid, no knot on it (moving the first knot below Δ(P) would cost more).
     fn of(
         law: &Law,
-        (lo, hi, from_domain, at_solid): (f64, f64, bool, bool),
+        span: &Span,
         align: Align,
         n: usize,
         start: Option<(i32, bool)>,
     ) -> Result<Self, TableError> {
+        let Span {
+            lo,
+            hi,
+            from_domain,
+            at_solid,
+            ..
+        } = *span;
         let kink_force = inner_corner(law);
         let slope_kink = law.preload > law.f_t;
         let e_p = law.delta(kink_force);

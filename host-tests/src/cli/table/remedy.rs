@@ -87,60 +87,11 @@ fn search(
         }
     }
     // Lower `to`, and raise `from`: each a remedy of its own.
-    let (bends_from, bends_to) = (from.max(bends.0), to.min(bends.1));
-    let span = bends_to - bends_from;
     let mut found = Vec::new();
     for lower_to in [true, false] {
-        // The bend's end first, where the domain reaches past it.
-        let (end, start) = if lower_to {
-            (to, bends_to)
-        } else {
-            (from, bends_from)
-        };
-        let first = if start == end { 1 } else { 0 };
-        let sign = if lower_to { -1.0 } else { 1.0 };
-        let at = |x: f64| {
-            let r = if lower_to {
-                (x * 1000.0).floor()
-            } else {
-                (x * 1000.0).ceil()
-            };
-            r / 1000.0
-        };
-        let domain = |x: f64| if lower_to { (from, x) } else { (x, to) };
-        let mut last_bad = end;
-        let mut good = None;
-        for k in first..STEPS {
-            let x = at(start + sign * span * k as f64 / STEPS as f64);
-            if x == last_bad {
-                continue;
-            }
-            let (a, b) = domain(x);
-            match tried(segments, a, b) {
-                Tried::Meets(r) => {
-                    good = Some((x, r));
-                    break;
-                }
-                Tried::Misses => last_bad = x,
-                Tried::Stop => break,
-            }
-        }
-        let Some((mut x, mut r)) = good else {
+        let Some((x, r)) = narrow_one_end(&mut tried, segments, (from, to), bends, lower_to) else {
             continue;
         };
-        // Halve the step between the last that missed and the first that met.
-        for _ in 0..HALVINGS {
-            let mid = at(0.5 * (x + last_bad));
-            if mid == x || mid == last_bad {
-                break;
-            }
-            let (a, b) = domain(mid);
-            match tried(segments, a, b) {
-                Tried::Meets(m) => (x, r) = (mid, m),
-                Tried::Misses => last_bad = mid,
-                Tried::Stop => break,
-            }
-        }
         found.push(if lower_to {
             measured(&format!("mccs table --to {x}"), &r, x)
         } else {
@@ -156,6 +107,69 @@ fn search(
         "no"
     };
     format!("{knots} narrower domain it tried (mccs table: lowering --to, raising --from) meets it")
+}
+
+/// The narrowest step of one end of the domain (`to` lowered, or `from` raised) that
+/// meets the bound, by sixths of the span where the law bends, then halved: the end's
+/// value and its measured bound, or `None` where no step met it.
+fn narrow_one_end(
+    tried: &mut dyn FnMut(usize, f64, f64) -> Tried,
+    segments: usize,
+    (from, to): (f64, f64),
+    bends: (f64, f64),
+    lower_to: bool,
+) -> Option<(f64, TableBound)> {
+    let (bends_from, bends_to) = (from.max(bends.0), to.min(bends.1));
+    let span = bends_to - bends_from;
+    // The bend's end first, where the domain reaches past it.
+    let (end, start) = if lower_to {
+        (to, bends_to)
+    } else {
+        (from, bends_from)
+    };
+    let first = if start == end { 1 } else { 0 };
+    let sign = if lower_to { -1.0 } else { 1.0 };
+    let at = |x: f64| {
+        let r = if lower_to {
+            (x * 1000.0).floor()
+        } else {
+            (x * 1000.0).ceil()
+        };
+        r / 1000.0
+    };
+    let domain = |x: f64| if lower_to { (from, x) } else { (x, to) };
+    let mut last_bad = end;
+    let mut good = None;
+    for k in first..STEPS {
+        let x = at(start + sign * span * k as f64 / STEPS as f64);
+        if x == last_bad {
+            continue;
+        }
+        let (a, b) = domain(x);
+        match tried(segments, a, b) {
+            Tried::Meets(r) => {
+                good = Some((x, r));
+                break;
+            }
+            Tried::Misses => last_bad = x,
+            Tried::Stop => break,
+        }
+    }
+    let (mut x, mut r) = good?;
+    // Halve the step between the last that missed and the first that met.
+    for _ in 0..HALVINGS {
+        let mid = at(0.5 * (x + last_bad));
+        if mid == x || mid == last_bad {
+            break;
+        }
+        let (a, b) = domain(mid);
+        match tried(segments, a, b) {
+            Tried::Meets(m) => (x, r) = (mid, m),
+            Tried::Misses => last_bad = mid,
+            Tried::Stop => break,
+        }
+    }
+    Some((x, r))
 }
 
 #[cfg(test)]

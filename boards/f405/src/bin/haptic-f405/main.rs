@@ -120,23 +120,7 @@ mod firmware {
         };
         // TIM1's PWM is set up, every duty zero: the stop chain's break input armed.
         haptic_f405::safe_stop::arm_break_input(BOARD.break_input);
-        let Some((psc, arr)) = tick_timer(platform::timer_clock(&clocks), BOARD.tick_hz) else {
-            fail_with(StartFault::Config(config::BoardConfigError::Tick))
-        };
-        let tick = TickTimer::new(Timer::new(dp.TIM2, &clocks).release(), psc, arr);
-        let watchdog = IndependentWatchdog::new(dp.IWDG);
-        watchdog.stop_on_debug(&dp.DBGMCU, true);
-        if HARDWARE
-            .post(Hardware {
-                device,
-                tick,
-                watchdog,
-                period: platform::tick_period_cycles(&clocks),
-            })
-            .is_some()
-        {
-            fail("hardware posted twice");
-        }
+        post_hardware(device, dp.TIM2, dp.IWDG, &dp.DBGMCU, &clocks);
         let work: &'static mut BoardWork = WORK.insert(BoardWork::new());
         let session = Session::new(live(), TISSUE, friction());
         let mut link =
@@ -158,6 +142,64 @@ mod firmware {
             Start::Failed(fault) => fail_with(fault),
             Start::Pending => fail("the tick's first run did not start"),
         };
+        log_start(&clocks, max_duty, springs, substeps);
+        let mut next_log = BOARD.tick_hz;
+        loop {
+            if !link.poll() {
+                cortex_m::asm::wfi();
+            }
+            let t = TELEMETRY.get();
+            if t.run.ticks >= next_log {
+                next_log = next_log.saturating_add(BOARD.tick_hz);
+                log_second(&t);
+            }
+            #[cfg(board_fault_test)]
+            if t.run.ticks >= 100 {
+                platform::inject_fault(&mut cp.SCB);
+            }
+            #[cfg(board_run_ends)]
+            if t.run.ticks >= BOARD.qemu_ticks {
+                qemu_end(&t);
+            }
+        }
+    }
+
+    /// The tick's hardware, handed to the tick through its mailbox: the device (in its
+    /// safe state), TIM2 at the tick rate, and the independent watchdog (frozen while a
+    /// debugger halts the core, as TIM1's outputs are cut: `safe_stop`).
+    fn post_hardware(
+        device: Device,
+        tim2: pac::TIM2,
+        iwdg: pac::IWDG,
+        dbgmcu: &pac::DBGMCU,
+        clocks: &stm32f4xx_hal::rcc::Clocks,
+    ) {
+        let Some((psc, arr)) = tick_timer(platform::timer_clock(clocks), BOARD.tick_hz) else {
+            fail_with(StartFault::Config(config::BoardConfigError::Tick))
+        };
+        let tick = TickTimer::new(Timer::new(tim2, clocks).release(), psc, arr);
+        let watchdog = IndependentWatchdog::new(iwdg);
+        watchdog.stop_on_debug(dbgmcu, true);
+        if HARDWARE
+            .post(Hardware {
+                device,
+                tick,
+                watchdog,
+                period: platform::tick_period_cycles(clocks),
+            })
+            .is_some()
+        {
+            fail("hardware posted twice");
+        }
+    }
+
+    /// The start-up lines: the board, its rates and its patch, and the table's error.
+    fn log_start(
+        clocks: &stm32f4xx_hal::rcc::Clocks,
+        max_duty: u16,
+        springs: usize,
+        substeps: u32,
+    ) {
         defmt::info!(
             "mccs haptic-f405 ({=str}): sysclk={=u32} Hz, device={=str}, pwm={=u32} Hz ({=u16} steps), tick={=u32} Hz, watchdog={=u32} ms, link={=u32} baud; N={=usize} patch, {=usize} springs, {=u32} substeps per tick",
             Variant::NAME,
@@ -180,25 +222,6 @@ mod firmware {
                 e.force as f32,
                 e.stiffness as f32
             );
-        }
-        let mut next_log = BOARD.tick_hz;
-        loop {
-            if !link.poll() {
-                cortex_m::asm::wfi();
-            }
-            let t = TELEMETRY.get();
-            if t.run.ticks >= next_log {
-                next_log = next_log.saturating_add(BOARD.tick_hz);
-                log_second(&t);
-            }
-            #[cfg(board_fault_test)]
-            if t.run.ticks >= 100 {
-                platform::inject_fault(&mut cp.SCB);
-            }
-            #[cfg(board_run_ends)]
-            if t.run.ticks >= BOARD.qemu_ticks {
-                qemu_end(&t);
-            }
         }
     }
 
