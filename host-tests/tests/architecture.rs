@@ -375,3 +375,122 @@ fn the_board_tests_few_features_directly() {
         .sum();
     assert!(count <= 8, "{count} `cfg(feature` in boards/ (at most 8)");
 }
+
+/// The functions of non-test source (`src/`, `firmware/`, `boards/`, `client/`, `link/`,
+/// `host-tests/src/`; not `#[cfg(test)]` items) and their lengths in lines, from `fn` to
+/// its closing brace, each with the few lines above it.
+fn function_lengths() -> Vec<(String, usize, String)> {
+    let mut out = Vec::new();
+    let dirs = [
+        "src",
+        "firmware/src",
+        "boards",
+        "client/src",
+        "link/src",
+        "host-tests/src",
+    ];
+    for dir in dirs {
+        for path in files(&root().join(dir)) {
+            let p = path.to_string_lossy();
+            if ["/tests/", "/benches/", "/fuzz/", "/examples/"]
+                .iter()
+                .any(|d| p.contains(d))
+            {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let lines: Vec<&str> = text.lines().collect();
+            let mut i = 0;
+            while i < lines.len() {
+                let l = lines[i].trim_start();
+                let skip_test = l.starts_with("#[cfg(test)]");
+                let is_fn = !skip_test && is_fn_line(l);
+                if !(skip_test || is_fn) {
+                    i += 1;
+                    continue;
+                }
+                let first = if skip_test { i + 1 } else { i };
+                let (end, braced) = item_end(&lines, first);
+                if is_fn && braced {
+                    let above = lines[i.saturating_sub(8)..i].join("\n");
+                    out.push((format!("{}:{}", path.display(), i + 1), end - i + 1, above));
+                }
+                i = if braced { end + 1 } else { i + 1 };
+            }
+        }
+    }
+    out
+}
+
+/// Whether a trimmed line starts a function item.
+fn is_fn_line(l: &str) -> bool {
+    let mut rest = l;
+    for prefix in [
+        "pub(crate) ",
+        "pub(super) ",
+        "pub ",
+        "const ",
+        "async ",
+        "unsafe ",
+        "extern \"C\" ",
+    ] {
+        rest = rest.strip_prefix(prefix).unwrap_or(rest);
+    }
+    rest.starts_with("fn ")
+}
+
+/// The line that closes the item starting at `first` (braces counted, comments aside),
+/// and whether it had a body at all.
+fn item_end(lines: &[&str], first: usize) -> (usize, bool) {
+    let mut depth = 0i32;
+    let mut started = false;
+    for (j, line) in lines.iter().enumerate().skip(first) {
+        let code = line.split("//").next().unwrap_or("");
+        depth += code.matches('{').count() as i32 - code.matches('}').count() as i32;
+        started |= code.contains('{');
+        if started && depth <= 0 {
+            return (j, true);
+        }
+        if !started && code.trim_end().ends_with(';') {
+            return (j, false);
+        }
+    }
+    (lines.len() - 1, started)
+}
+
+/// Short functions (issue 59): none over 120 lines, and at most 3 over 80, each with a
+/// comment above it that says why it stays whole (`Whole on purpose`).
+#[test]
+fn functions_are_short_and_the_long_ones_say_why() {
+    let all = function_lengths();
+    assert!(
+        all.len() > 1000,
+        "the scan found only {} functions",
+        all.len()
+    );
+    let over_120: Vec<_> = all
+        .iter()
+        .filter(|f| f.1 > 120)
+        .map(|f| (&f.0, f.1))
+        .collect();
+    assert!(
+        over_120.is_empty(),
+        "functions over 120 lines: {over_120:?}"
+    );
+    let over_80: Vec<_> = all.iter().filter(|f| f.1 > 80).collect();
+    let unexplained: Vec<_> = over_80
+        .iter()
+        .filter(|f| !f.2.contains("Whole on purpose"))
+        .map(|f| (&f.0, f.1))
+        .collect();
+    assert!(
+        unexplained.is_empty(),
+        "over 80 lines without a reason: {unexplained:?}"
+    );
+    assert!(
+        over_80.len() <= 3,
+        "{} functions over 80 lines (at most 3): {:?}",
+        over_80.len(),
+        over_80.iter().map(|f| (&f.0, f.1)).collect::<Vec<_>>()
+    );
+}
