@@ -25,6 +25,7 @@ extern crate self as mccs;
 pub mod arith;
 pub mod arm;
 pub mod coupling;
+pub mod fnv;
 pub mod law;
 pub mod params;
 pub mod passivity;

@@ -316,12 +316,8 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
     /// set prepared for one topology is refused by a solver on another (start-up only:
     /// a loop over the edges).
     pub fn fingerprint(&self) -> u32 {
-        let mut h: u32 = 0x811c_9dc5;
-        let mut eat = |x: u32| {
-            for b in x.to_le_bytes() {
-                h = (h ^ b as u32).wrapping_mul(0x0100_0193);
-            }
-        };
+        let mut h = crate::fnv::Fnv1a::new();
+        let mut eat = |x: u32| h.update(&x.to_le_bytes());
         eat(self.rest.len() as u32);
         eat(self.contact as u32);
         for e in self.edges.iter() {
@@ -329,7 +325,7 @@ impl<const NODES: usize, const EDGES: usize> Topology<NODES, EDGES> {
             e.dir.iter().for_each(|&d| eat(d as u32));
             eat(e.inv_len as u32);
         }
-        h
+        h.value()
     }
 
     /// Rest length of edge `e` (mm), from its stored `1/l0`.

@@ -155,12 +155,20 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
         // into their anchors so that the floor rounds (`mccs::table`, `rounding_anchor`):
         // the line in float is the floor's argument less that half.
         let half_lsb = 0.5 / (1u64 << FORCE_FRAC) as f64;
-        Self {
-            springs: Self::springs_of(topo),
+        // The springs and the segments are filled in place (built apart and moved in,
+        // their copies overflowed the M0's 16 KiB of stack in the f64 bench case).
+        let mut patch = Self {
+            springs: [Spring {
+                a: 0,
+                b: 0,
+                rest: [T::ZERO; 3],
+                l0: T::ZERO,
+                inv_l0: T::ZERO,
+            }; E],
             n_springs: topo.edges().len(),
             n_nodes: topo.node_count(),
             contact: topo.contact() as usize,
-            seg: Self::segments_of(table),
+            seg: [[T::ZERO; 4]; S],
             strain_lo: T::of(to_f64(raw.strain_lo, STRAIN_FRAC)),
             strain_hi: T::of(to_f64(raw.strain_hi, STRAIN_FRAC)),
             per_strain: T::of(raw.index_scale as f64 * raw.index_pre as f64 / (1u64 << 23) as f64),
@@ -186,17 +194,19 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
             x: [[T::ZERO; 3]; N],
             v: [[T::ZERO; 3]; N],
             f: [[T::ZERO; 3]; N],
-        }
+        };
+        patch.fill_springs(topo);
+        patch.fill_segments(table);
+        patch
     }
 
     /// The table's cubic segments in float: C0 … C3 carry 1, 2, 4, 8 times c0 … c3, in
     /// Q(20 + shift) N; C0 less the knots' rounding bias (`mccs::table::knot_bias`).
-    fn segments_of(table: &ForceTable<S>) -> [[T; 4]; S] {
+    fn fill_segments(&mut self, table: &ForceTable<S>) {
         let raw = table.raw();
         let unit = (1u64 << (FORCE_FRAC + raw.shift)) as f64;
         let bias = mccs::table::knot_bias(raw.shift) as f64;
-        let mut seg = [[T::ZERO; 4]; S];
-        for (s, c) in seg.iter_mut().zip(raw.segments.iter()) {
+        for (s, c) in self.seg.iter_mut().zip(raw.segments.iter()) {
             *s = core::array::from_fn(|j| {
                 let v = if j == 0 {
                     c[0] as f64 - bias
@@ -206,19 +216,11 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
                 T::of(v / unit / (1u32 << j) as f64)
             });
         }
-        seg
     }
 
     /// The topology's springs: ends, rest vector, rest length and its inverse.
-    fn springs_of(topo: &Topology<N, E>) -> [Spring<T>; E] {
-        let mut springs = [Spring {
-            a: 0,
-            b: 0,
-            rest: [T::ZERO; 3],
-            l0: T::ZERO,
-            inv_l0: T::ZERO,
-        }; E];
-        for (s, e) in springs.iter_mut().zip(topo.edges()) {
+    fn fill_springs(&mut self, topo: &Topology<N, E>) {
+        for (s, e) in self.springs.iter_mut().zip(topo.edges()) {
             let l0 = Topology::<N, E>::rest_length(e);
             *s = Spring {
                 a: e.a,
@@ -228,7 +230,6 @@ impl<T: Real, const N: usize, const E: usize, const S: usize> FloatPatch<T, N, E
                 inv_l0: T::of(1.0 / l0),
             };
         }
-        springs
     }
 
     #[inline(always)]

@@ -21,7 +21,8 @@
 
 pub mod crc;
 pub mod flags;
-pub mod fnv;
+/// FNV-1a, the core's ([`mccs::fnv`]): the one hash.
+pub use mccs::fnv;
 pub mod frame;
 pub mod info;
 pub mod message;

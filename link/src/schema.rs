@@ -22,7 +22,7 @@ pub const TO_HOST_KEY: Key = Key::for_path::<ToHost>("mccs/ToHost");
 
 /// The schema's hash: FNV-1a over the two keys' bytes.
 pub const SCHEMA: u32 = {
-    let mut h = crate::fnv::Fnv1a::new();
+    let mut h = mccs::fnv::Fnv1a::new();
     let (a, b) = (TO_DEVICE_KEY.to_bytes(), TO_HOST_KEY.to_bytes());
     let mut i = 0;
     while i < 8 {

@@ -6,7 +6,7 @@
 //! The field order is written once, in [`fields!`]: [`write`], [`hash`] and the
 //! [`Assembler`] that a device fills as the bytes arrive all read it from there.
 
-use crate::fnv::Fnv1a;
+use mccs::fnv::Fnv1a;
 use mccs::{ForceTable, RawTable};
 
 /// The header's fields in wire order, each with how its `i32` word maps to the field.
@@ -117,7 +117,7 @@ pub fn hash<const S: usize>(table: &ForceTable<S>) -> u32 {
 
 /// The hash of bytes as they arrive ([`hash`] of the table they hold).
 pub fn hash_bytes(bytes: &[u8]) -> u32 {
-    crate::fnv::fnv1a(bytes)
+    mccs::fnv::fnv1a(bytes)
 }
 
 /// A table's bytes put together as they arrive, a byte at a time, with their running

@@ -38,11 +38,9 @@ impl ArmPose {
     }
 }
 
-/// The high word of a 32 × 32-bit product: `a b / 2³²` (one `smmul` on the M4F).
-#[inline(always)]
-pub(super) fn hi(a: i32, b: i32) -> i32 {
-    ((a as i64 * b as i64) >> 32) as i32
-}
+/// The high word of a 32 × 32-bit product, `⌊a b / 2³²⌋`: the core's one
+/// [`crate::q::mulhi`] (one `smull` on the M3/M4F, four 16-bit products on the M0).
+pub(super) use crate::q::mulhi as hi;
 
 /// 128 mm in Q16, the tissue frame's end.
 const HOLD_Q16: i32 = (1 << 23) - 1;

@@ -1,6 +1,7 @@
-//! FNV-1a, 32 bits: the one hash of the link — a tissue's table bytes (`Ack`, `Hello`,
-//! the `.bin` file's header) — as a value fed in pieces ([`Fnv1a`]) or over a slice in
-//! one call ([`fnv1a`], also at compile time).
+//! FNV-1a, 32 bits: the project's one hash — a topology's fingerprint
+//! ([`crate::Topology::fingerprint`]), and on the link a tissue's table bytes (`Ack`,
+//! `Hello`, the `.bin` file's header) and the schema — as a value fed in pieces
+//! ([`Fnv1a`]) or over a slice in one call ([`fnv1a`], also at compile time).
 
 /// The offset basis.
 const BASIS: u32 = 0x811C_9DC5;
