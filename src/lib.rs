@@ -44,7 +44,7 @@ pub mod window;
 mod defmt;
 
 pub use arith::{Arith, DefaultArith, Integrator, Narrow, Wide};
-pub use arm::{Arm, ArmError, ArmPose, ArmSpec, Drive, GravitySpec, JointSpec};
+pub use arm::{Arm, ArmError, ArmFieldError, ArmPose, ArmSpec, Drive, GravitySpec, JointSpec};
 pub use coupling::Coupling;
 pub use law::Law;
 pub use params::{Cone, Derived, Linear, ParamError, ParamKey, Params};

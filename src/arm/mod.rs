@@ -39,7 +39,7 @@ mod spec;
 
 pub use drive::Drive;
 pub use pose::{ArmPose, LIMITS, LIMIT_A, LIMIT_B, LIMIT_C, OUTSIDE};
-pub use spec::{ArmError, ArmSpec, GravitySpec, JointSpec};
+pub use spec::{ArmError, ArmFieldError, ArmSpec, GravitySpec, JointSpec};
 
 /// A full turn in phase units (2³²), as `f64`.
 const TURN: f64 = 4_294_967_296.0;

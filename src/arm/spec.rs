@@ -100,8 +100,8 @@ pub enum ArmError {
     Thermal(u8),
     /// A duty offset not −0.2 … 0.2, or a dead band not 0 … 0.2.
     Trim(u8),
-    /// A mass or centre of mass negative or not finite, `g` not finite, or a gravity
-    /// torque of 32,768 N·mm or more.
+    /// A mass or centre of mass negative or not finite, `g` not within ±100 m/s², or a
+    /// gravity torque of 32,768 N·mm or more.
     Gravity,
 }
 
@@ -117,7 +117,7 @@ impl ArmError {
             Self::Range(_) => "joint: min_angle_deg < home_angle_deg < max_angle_deg, within ±180",
             Self::Thermal(_) => "joint: 0 < continuous_current_a ≤ max_current_a, thermal_time_constant_s 1 … 10000",
             Self::Trim(_) => "joint: duty_offset must be -0.2 … 0.2 and dead_band 0 … 0.2",
-            Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g finite, the torques under 32768 N·mm",
+            Self::Gravity => "gravity: masses and centres of mass must be finite and ≥ 0, g within ±100 m/s², the torques under 32768 N·mm",
         }
     }
 
@@ -143,77 +143,214 @@ impl core::fmt::Display for ArmError {
 
 impl core::error::Error for ArmError {}
 
+/// What [`ArmSpec::check`] refuses, down to the key: the rule broken, and the device
+/// file's key that breaks it (docs/arm.md), so that a reader of the file can name its
+/// line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ArmFieldError {
+    /// The rule, as [`ArmSpec::validate`] reports it.
+    pub error: ArmError,
+    /// The key within its section ([`ArmFieldError::section`]): `upper_arm_mm`,
+    /// `min_angle_deg`, …
+    pub key: &'static str,
+    /// What the key must be: `must be > 0`, …
+    pub rule: &'static str,
+}
+
+impl ArmFieldError {
+    /// The device file's section of the key: `arm`, `joint.a`, `joint.b`, `joint.c` or
+    /// `gravity`.
+    pub const fn section(&self) -> &'static str {
+        match (self.error, self.error.joint()) {
+            (ArmError::Gravity, _) => "gravity",
+            (_, Some(0)) => "joint.a",
+            (_, Some(1)) => "joint.b",
+            (_, Some(_)) => "joint.c",
+            (_, None) => "arm",
+        }
+    }
+}
+
+/// `Err` of `error` at `key` where `ok` fails.
+fn rule(
+    ok: bool,
+    error: ArmError,
+    key: &'static str,
+    rule: &'static str,
+) -> Result<(), ArmFieldError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ArmFieldError { error, key, rule })
+    }
+}
+
+/// Finite and > 0.
+fn positive(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
 impl ArmSpec {
-    /// Checks the ranges [`ArmError`] names.
+    /// Checks the ranges [`ArmError`] names (see [`ArmSpec::check`] for the key).
     pub fn validate(&self) -> Result<(), ArmError> {
-        let len = |x: f64, zero_ok: bool| {
+        self.check().map_err(|e| e.error)
+    }
+
+    /// Checks every field against its range: the project's one statement of an arm's
+    /// rules, which the device-file reader maps to its file, line and key.
+    pub fn check(&self) -> Result<(), ArmFieldError> {
+        use ArmError as E;
+        let within = |x: f64, zero_ok: bool| {
             x.is_finite() && x <= 1000.0 && (x > 0.0 || zero_ok && x == 0.0)
         };
-        if !(len(self.base_height_mm, true)
-            && len(self.upper_arm_mm, false)
-            && len(self.forearm_mm, false))
-        {
-            return Err(ArmError::Length);
-        }
-        if !self
-            .tissue_origin_mm
-            .iter()
-            .all(|v| v.is_finite() && v.abs() <= 2000.0)
-        {
-            return Err(ArmError::Origin);
-        }
+        rule(
+            within(self.base_height_mm, true),
+            E::Length,
+            "base_height_mm",
+            "must be 0 … 1000 mm",
+        )?;
+        let arm = "must be > 0 and ≤ 1000 mm";
+        rule(
+            within(self.upper_arm_mm, false),
+            E::Length,
+            "upper_arm_mm",
+            arm,
+        )?;
+        rule(within(self.forearm_mm, false), E::Length, "forearm_mm", arm)?;
+        rule(
+            self.tissue_origin_mm
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= 2000.0),
+            E::Origin,
+            "tissue_origin_mm",
+            "must be [x, y, z]: three numbers of mm, each within ±2000",
+        )?;
         for (i, j) in self.joints.iter().enumerate() {
-            let i = i as u8;
-            let per_turn = j.counts_per_rev * j.ratio;
-            let positive = |x: f64| x.is_finite() && x > 0.0;
-            if !(positive(j.counts_per_rev)
-                && positive(j.ratio)
-                && (16.0..=(1u64 << 30) as f64).contains(&per_turn))
-            {
-                return Err(ArmError::Transmission(i));
-            }
-            if j.sign != 1.0 && j.sign != -1.0 {
-                return Err(ArmError::Sign(i));
-            }
-            if !(positive(j.torque_constant_nm_per_a) && positive(j.max_current_a)) {
-                return Err(ArmError::Motor(i));
-            }
-            let within = |d: f64| d.is_finite() && d.abs() <= 180.0;
-            if !(within(j.min_angle_deg)
-                && within(j.max_angle_deg)
-                && within(j.home_angle_deg)
-                && j.min_angle_deg < j.home_angle_deg
-                && j.home_angle_deg < j.max_angle_deg)
-            {
-                return Err(ArmError::Range(i));
-            }
-            let c = j.continuous_current_a;
-            let tau = j.thermal_time_constant_s;
-            if !(positive(c) && c <= j.max_current_a && (1.0..=10_000.0).contains(&tau)) {
-                return Err(ArmError::Thermal(i));
-            }
-            if !((-0.2..=0.2).contains(&j.duty_offset) && (0.0..=0.2).contains(&j.dead_band)) {
-                return Err(ArmError::Trim(i));
-            }
+            j.check(i as u8)?;
         }
         if let Some(g) = &self.gravity {
-            let ok = |x: f64| x.is_finite() && x >= 0.0;
-            if !(ok(g.upper_arm_mass_kg)
-                && ok(g.upper_arm_com_mm)
-                && ok(g.forearm_mass_kg)
-                && ok(g.forearm_com_mm)
-                && g.g.is_finite())
-            {
-                return Err(ArmError::Gravity);
-            }
-            let b = g.g
-                * (g.upper_arm_mass_kg * g.upper_arm_com_mm
-                    + g.forearm_mass_kg * self.upper_arm_mm);
-            let c = g.g * g.forearm_mass_kg * g.forearm_com_mm;
-            if !(b.abs() < 32_768.0 && c.abs() < 32_768.0) {
-                return Err(ArmError::Gravity);
-            }
+            g.check(self.upper_arm_mm)?;
         }
         Ok(())
+    }
+}
+
+impl JointSpec {
+    /// Joint `i`'s (0: A, 1: B, 2: C) ranges.
+    fn check(&self, i: u8) -> Result<(), ArmFieldError> {
+        use ArmError as E;
+        let t = E::Transmission(i);
+        rule(
+            positive(self.counts_per_rev),
+            t,
+            "counts_per_rev",
+            "must be > 0",
+        )?;
+        rule(positive(self.ratio), t, "ratio", "must be > 0")?;
+        rule(
+            (16.0..=(1u64 << 30) as f64).contains(&(self.counts_per_rev * self.ratio)),
+            t,
+            "counts_per_rev",
+            "counts_per_rev × ratio (counts per joint turn) must be 16 … 2^30",
+        )?;
+        rule(
+            self.sign == 1.0 || self.sign == -1.0,
+            E::Sign(i),
+            "sign",
+            "must be 1 or -1",
+        )?;
+        let m = E::Motor(i);
+        rule(
+            positive(self.torque_constant_nm_per_a),
+            m,
+            "torque_constant_nm_per_a",
+            "must be > 0",
+        )?;
+        rule(
+            positive(self.max_current_a),
+            m,
+            "max_current_a",
+            "must be > 0",
+        )?;
+        let th = E::Thermal(i);
+        let c = self.continuous_current_a;
+        rule(positive(c), th, "continuous_current_a", "must be > 0")?;
+        rule(
+            c <= self.max_current_a,
+            th,
+            "continuous_current_a",
+            "must be at most max_current_a",
+        )?;
+        let tau = self.thermal_time_constant_s;
+        rule(
+            (1.0..=10_000.0).contains(&tau),
+            th,
+            "thermal_time_constant_s",
+            "must be 1 … 10000 s",
+        )?;
+        let tr = E::Trim(i);
+        let offset = (-0.2..=0.2).contains(&self.duty_offset);
+        rule(
+            offset,
+            tr,
+            "duty_offset",
+            "must be -0.2 … 0.2 (of full duty)",
+        )?;
+        let band = (0.0..=0.2).contains(&self.dead_band);
+        rule(band, tr, "dead_band", "must be 0 … 0.2 (of full duty)")?;
+        let r = E::Range(i);
+        let angle = |d: f64| d.is_finite() && d.abs() <= 180.0;
+        let deg = "must be within ±180°";
+        rule(angle(self.home_angle_deg), r, "home_angle_deg", deg)?;
+        rule(angle(self.min_angle_deg), r, "min_angle_deg", deg)?;
+        rule(angle(self.max_angle_deg), r, "max_angle_deg", deg)?;
+        rule(
+            self.min_angle_deg < self.home_angle_deg && self.home_angle_deg < self.max_angle_deg,
+            r,
+            "min_angle_deg",
+            "must be below home_angle_deg, and max_angle_deg above it",
+        )
+    }
+}
+
+impl GravitySpec {
+    /// The masses' ranges, `g` within ±100 m/s², and the torques they ask of the
+    /// shoulder and the elbow (with the upper arm `upper_arm_mm` long) under 32,768 N·mm
+    /// (the drive's Q16 gravity terms).
+    fn check(&self, upper_arm_mm: f64) -> Result<(), ArmFieldError> {
+        let ok = |x: f64| x.is_finite() && x >= 0.0;
+        let g = ArmError::Gravity;
+        rule(
+            ok(self.upper_arm_mass_kg),
+            g,
+            "upper_arm_mass_kg",
+            "must be ≥ 0",
+        )?;
+        rule(
+            ok(self.upper_arm_com_mm),
+            g,
+            "upper_arm_com_mm",
+            "must be ≥ 0",
+        )?;
+        rule(
+            ok(self.forearm_mass_kg),
+            g,
+            "forearm_mass_kg",
+            "must be ≥ 0",
+        )?;
+        rule(ok(self.forearm_com_mm), g, "forearm_com_mm", "must be ≥ 0")?;
+        rule(
+            self.g.is_finite() && self.g.abs() <= 100.0,
+            g,
+            "g",
+            "must be within ±100 m/s²",
+        )?;
+        let torque = "with the other masses, asks a gravity torque of 32768 N·mm or more";
+        let b = self.g
+            * (self.upper_arm_mass_kg * self.upper_arm_com_mm
+                + self.forearm_mass_kg * upper_arm_mm);
+        rule(b.abs() < 32_768.0, g, "upper_arm_mass_kg", torque)?;
+        let c = self.g * self.forearm_mass_kg * self.forearm_com_mm;
+        rule(c.abs() < 32_768.0, g, "forearm_mass_kg", torque)
     }
 }

@@ -68,21 +68,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
         table: &table,
     };
     doc.known_keys_only()?;
-    let length = |key: &str, zero_ok: bool| -> Result<f64, String> {
-        let v = doc.number("arm", key)?;
-        let ok = v.is_finite() && v <= 1000.0 && (v > 0.0 || (zero_ok && v == 0.0));
-        let what = if zero_ok {
-            "must be 0 … 1000 mm"
-        } else {
-            "must be > 0 and ≤ 1000 mm"
-        };
-        doc.rule("arm", key, ok, what)?;
-        Ok(v)
-    };
     let spec = ArmSpec {
-        base_height_mm: length("base_height_mm", true)?,
-        upper_arm_mm: length("upper_arm_mm", false)?,
-        forearm_mm: length("forearm_mm", false)?,
+        base_height_mm: doc.number("arm", "base_height_mm")?,
+        upper_arm_mm: doc.number("arm", "upper_arm_mm")?,
+        forearm_mm: doc.number("arm", "forearm_mm")?,
         tissue_origin_mm: doc.tissue_origin()?,
         joints: [
             doc.joint("joint.a")?,
@@ -91,7 +80,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
         ],
         gravity: doc.gravity()?,
     };
-    spec.validate().map_err(|e| format!("{file}: {e}"))?;
+    // The ranges are the core's (`ArmSpec::check`, the one statement of them); the
+    // reader names the file, line and key of the value that breaks one.
+    spec.check()
+        .map_err(|e| format!("{}: {}", doc.at(e.section(), e.key), e.rule))?;
     Ok(spec)
 }
 
@@ -200,29 +192,7 @@ impl Doc<'_> {
         }
     }
 
-    /// `ok`, or the line naming the key and `what` it must be.
-    fn rule(&self, sec: &str, key: &str, ok: bool, what: &str) -> Result<(), String> {
-        if ok {
-            Ok(())
-        } else {
-            Err(format!("{}: {what}", self.at(sec, key)))
-        }
-    }
-
-    /// A key's number held to `ok`, or the line naming `what` it must be.
-    fn ruled(
-        &self,
-        sec: &str,
-        key: &str,
-        ok: impl Fn(f64) -> bool,
-        what: &str,
-    ) -> Result<f64, String> {
-        let v = self.number(sec, key)?;
-        self.rule(sec, key, ok(v), what)?;
-        Ok(v)
-    }
-
-    /// `arm.tissue_origin_mm`: three numbers of mm, each within ±2000.
+    /// `arm.tissue_origin_mm`: three numbers of mm (their range: `ArmSpec::check`).
     fn tissue_origin(&self) -> Result<[f64; 3], String> {
         let origin = self
             .section("arm")
@@ -236,16 +206,12 @@ impl Doc<'_> {
                     .collect()
             })
             .unwrap_or_default();
-        origin
-            .try_into()
-            .ok()
-            .filter(|o: &[f64; 3]| o.iter().all(|v| v.is_finite() && v.abs() <= 2000.0))
-            .ok_or_else(|| {
-                format!(
-                    "{}: must be [x, y, z]: three numbers of mm, each within ±2000",
-                    self.at("arm", "tissue_origin_mm")
-                )
-            })
+        origin.try_into().map_err(|_| {
+            format!(
+                "{}: must be [x, y, z]: three numbers of mm, each within ±2000",
+                self.at("arm", "tissue_origin_mm")
+            )
+        })
     }
 
     /// `[gravity]`, if there (`g` optional: 9.81 m/s²).
@@ -253,107 +219,40 @@ impl Doc<'_> {
         let Some(t) = self.section("gravity") else {
             return Ok(None);
         };
-        let m = |k: &str| self.ruled("gravity", k, |v| v.is_finite() && v >= 0.0, "must be ≥ 0");
-        let g = if t.contains_key("g") {
-            self.number("gravity", "g")?
-        } else {
-            9.81
-        };
-        let ok = g.is_finite() && g.abs() <= 100.0;
-        self.rule("gravity", "g", ok, "must be within ±100 m/s²")?;
+        let m = |k: &str| self.number("gravity", k);
         Ok(Some(GravitySpec {
             upper_arm_mass_kg: m("upper_arm_mass_kg")?,
             upper_arm_com_mm: m("upper_arm_com_mm")?,
             forearm_mass_kg: m("forearm_mass_kg")?,
             forearm_com_mm: m("forearm_com_mm")?,
-            g,
+            g: if t.contains_key("g") { m("g")? } else { 9.81 },
         }))
     }
 
-    /// The section `sec` (`joint.a` …): each key held to its range.
+    /// The section `sec` (`joint.a` …): each key a number, `home_count` a whole one.
     fn joint(&self, sec: &str) -> Result<JointSpec, String> {
-        let positive = |k: &str| self.ruled(sec, k, |v| v.is_finite() && v > 0.0, "must be > 0");
-        let counts_per_rev = positive("counts_per_rev")?;
-        let ratio = positive("ratio")?;
-        let turn = counts_per_rev * ratio;
-        let what = "counts_per_rev × ratio (counts per joint turn) must be 16 … 2^30";
-        self.rule(
-            sec,
-            "counts_per_rev",
-            (16.0..=(1u64 << 30) as f64).contains(&turn),
-            what,
-        )?;
-        let sign = self.ruled(sec, "sign", |s| s == 1.0 || s == -1.0, "must be 1 or -1")?;
-        let whole = |c: f64| c.fract() == 0.0 && c.abs() <= i32::MAX as f64;
-        let home_count =
-            self.ruled(sec, "home_count", whole, "must be a whole number of counts")?;
-        let torque_constant_nm_per_a = positive("torque_constant_nm_per_a")?;
-        let max_current_a = positive("max_current_a")?;
-        let (continuous_current_a, thermal_time_constant_s) = self.thermal(sec, max_current_a)?;
-        let duty_offset = self.ruled(
-            sec,
-            "duty_offset",
-            |v| (-0.2..=0.2).contains(&v),
-            "must be -0.2 … 0.2 (of full duty)",
-        )?;
-        let dead_band = self.ruled(
-            sec,
-            "dead_band",
-            |v| (0.0..=0.2).contains(&v),
-            "must be 0 … 0.2 (of full duty)",
-        )?;
-        let angle = |k: &str| {
-            self.ruled(
-                sec,
-                k,
-                |v| v.is_finite() && v.abs() <= 180.0,
-                "must be within ±180°",
-            )
-        };
-        let home_angle_deg = angle("home_angle_deg")?;
-        let min_angle_deg = angle("min_angle_deg")?;
-        let max_angle_deg = angle("max_angle_deg")?;
-        let ordered = min_angle_deg < home_angle_deg && home_angle_deg < max_angle_deg;
-        let what = "must be below home_angle_deg, and max_angle_deg above it";
-        self.rule(sec, "min_angle_deg", ordered, what)?;
+        let n = |k: &str| self.number(sec, k);
+        let home_count = n("home_count")?;
+        if !(home_count.fract() == 0.0 && home_count.abs() <= i32::MAX as f64) {
+            return Err(format!(
+                "{}: must be a whole number of counts",
+                self.at(sec, "home_count")
+            ));
+        }
         Ok(JointSpec {
-            counts_per_rev,
-            ratio,
-            sign,
+            counts_per_rev: n("counts_per_rev")?,
+            ratio: n("ratio")?,
+            sign: n("sign")?,
             home_count: home_count as i32,
-            home_angle_deg,
-            torque_constant_nm_per_a,
-            max_current_a,
-            continuous_current_a,
-            thermal_time_constant_s,
-            duty_offset,
-            dead_band,
-            min_angle_deg,
-            max_angle_deg,
+            home_angle_deg: n("home_angle_deg")?,
+            torque_constant_nm_per_a: n("torque_constant_nm_per_a")?,
+            max_current_a: n("max_current_a")?,
+            continuous_current_a: n("continuous_current_a")?,
+            thermal_time_constant_s: n("thermal_time_constant_s")?,
+            duty_offset: n("duty_offset")?,
+            dead_band: n("dead_band")?,
+            min_angle_deg: n("min_angle_deg")?,
+            max_angle_deg: n("max_angle_deg")?,
         })
-    }
-
-    /// A joint's I²t data: its continuous current (`0 < x ≤ max`) and its winding's time
-    /// constant (1 … 10,000 s).
-    fn thermal(&self, sec: &str, max_current_a: f64) -> Result<(f64, f64), String> {
-        let c = self.ruled(
-            sec,
-            "continuous_current_a",
-            |v| v.is_finite() && v > 0.0,
-            "must be > 0",
-        )?;
-        self.rule(
-            sec,
-            "continuous_current_a",
-            c <= max_current_a,
-            "must be at most max_current_a",
-        )?;
-        let tau = self.ruled(
-            sec,
-            "thermal_time_constant_s",
-            |v| (1.0..=10_000.0).contains(&v),
-            "must be 1 … 10000 s",
-        )?;
-        Ok((c, tau))
     }
 }

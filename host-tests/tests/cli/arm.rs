@@ -22,7 +22,7 @@ fn fk(device: &str, counts: &str, backend: &str) -> std::process::Output {
 fn bad_device_files_name_the_file_line_and_key() {
     let counts = temp_file("arm-counts.csv", "count_a,count_b,count_c\n0,1000,2000\n");
     let c = counts.to_str().unwrap();
-    let cases: [(&str, String, &[&str]); 13] = [
+    let cases: [(&str, String, &[&str]); 16] = [
         (
             "typo.toml",
             WOODEN.replace("upper_arm_mm = 205.0", "upper_arm_mn = 205.0"),
@@ -99,6 +99,24 @@ fn bad_device_files_name_the_file_line_and_key() {
             "band.toml",
             WOODEN.replacen("dead_band = 0.0", "dead_band = -0.01", 1),
             &["joint.a.dead_band: must be 0 … 0.2 (of full duty)"],
+        ),
+        // The core's rules (`ArmSpec::check`) reach the file's line too: `g` within
+        // ±100 m/s², and the gravity torques under 32768 N·mm, which only the core
+        // checked before (with no line).
+        (
+            "g.toml",
+            WOODEN.replace("g = 9.81", "g = 981"),
+            &["line 71: gravity.g: must be within ±100 m/s²"],
+        ),
+        (
+            "heavy.toml",
+            WOODEN.replace("forearm_com_mm = 91.0", "forearm_com_mm = 40000.0"),
+            &["line 69: gravity.forearm_mass_kg: with the other masses, asks a gravity torque of 32768 N·mm or more"],
+        ),
+        (
+            "range.toml",
+            WOODEN.replacen("min_angle_deg = ", "min_angle_deg = 170 #", 1),
+            &["joint.a.min_angle_deg: must be below home_angle_deg, and max_angle_deg above it"],
         ),
     ];
     for (name, text, needles) in cases {
