@@ -23,7 +23,8 @@
 //! - [`Error`]: every error, typed; a device's refusal is [`Error::Refused`];
 //! - [`Addr`]: where a device is (`unix:PATH` on Unix, `tcp:HOST:PORT`, a serial port);
 //! - [`replay`]: a probe path replayed on the device's solver;
-//! - [`paramfile`], [`trajectory`]: the parameter and probe-path files;
+//! - [`paramfile`], [`trajectory`]: the parameter and probe-path files; [`pose_text`]: a
+//!   pose as comma-separated numbers;
 //! - `ffi`: the C ABI (`include/mccs.h`), which the Python module uses.
 
 pub mod addr;
@@ -32,6 +33,7 @@ pub mod error;
 mod ffi;
 pub mod mesh;
 pub mod paramfile;
+pub mod pose_text;
 pub mod replay;
 mod session;
 pub mod substeps;

@@ -22,7 +22,7 @@ pub struct Trims {
 }
 
 /// 100 % duty, Q16.
-const FULL: i32 = 1 << 16;
+const FULL_DUTY_Q16: i32 = 1 << 16;
 /// The trims' bound, Q16: 0.2 of full duty (what `validate` admits), held here too.
 const TRIM_MAX: i32 = 13_108;
 
@@ -51,7 +51,7 @@ impl Trims {
 /// One joint's duty through its trims.
 #[inline(always)]
 fn trim(duty: i32, offset: i32, band: i32) -> i32 {
-    let d = duty.clamp(-FULL, FULL);
+    let d = duty.clamp(-FULL_DUTY_Q16, FULL_DUTY_Q16);
     // (Saturating: the fields are public, whatever `of` holds them to.)
     let past = if d >= band {
         d.saturating_add(band)
@@ -60,7 +60,8 @@ fn trim(duty: i32, offset: i32, band: i32) -> i32 {
     } else {
         2 * d
     };
-    past.saturating_add(offset).clamp(-FULL, FULL)
+    past.saturating_add(offset)
+        .clamp(-FULL_DUTY_Q16, FULL_DUTY_Q16)
 }
 
 #[cfg(test)]
@@ -70,7 +71,7 @@ mod tests {
     #[test]
     fn no_trims_change_nothing() {
         let t = Trims::default();
-        for d in [-FULL, -1, 0, 1, 12_345, FULL] {
+        for d in [-FULL_DUTY_Q16, -1, 0, 1, 12_345, FULL_DUTY_Q16] {
             assert_eq!(t.apply([d, d, d]), [d, d, d]);
         }
     }
@@ -81,21 +82,25 @@ mod tests {
         assert_eq!(trim(0, offset, band), offset);
         assert_eq!(trim(10_000, offset, band), 10_000 + band + offset);
         assert_eq!(trim(-10_000, offset, band), -10_000 - band + offset);
-        assert_eq!(trim(FULL, offset, band), FULL, "held to 100 %");
-        assert_eq!(trim(-FULL, -offset, band), -FULL);
+        assert_eq!(
+            trim(FULL_DUTY_Q16, offset, band),
+            FULL_DUTY_Q16,
+            "held to 100 %"
+        );
+        assert_eq!(trim(-FULL_DUTY_Q16, -offset, band), -FULL_DUTY_Q16);
     }
 
     #[test]
     fn the_map_is_continuous_and_monotonic_over_the_whole_domain() {
         for (offset, band) in [(0, 0), (1_311, 655), (-TRIM_MAX, TRIM_MAX), (TRIM_MAX, 1)] {
-            let mut last = trim(-FULL - 5, offset, band);
-            for d in -FULL - 4..=FULL + 4 {
+            let mut last = trim(-FULL_DUTY_Q16 - 5, offset, band);
+            for d in -FULL_DUTY_Q16 - 4..=FULL_DUTY_Q16 + 4 {
                 let y = trim(d, offset, band);
                 assert!(
                     y >= last && y - last <= 2,
                     "d={d} {last}→{y} ({offset}, {band})"
                 );
-                assert!((-FULL..=FULL).contains(&y));
+                assert!((-FULL_DUTY_Q16..=FULL_DUTY_Q16).contains(&y));
                 last = y;
             }
         }
@@ -109,8 +114,8 @@ mod tests {
             (0, i32::MIN),
             (i32::MIN, i32::MAX),
         ] {
-            for d in [i32::MIN, -FULL, -1, 0, 1, FULL, i32::MAX] {
-                assert!((-FULL..=FULL).contains(&trim(d, offset, band)));
+            for d in [i32::MIN, -FULL_DUTY_Q16, -1, 0, 1, FULL_DUTY_Q16, i32::MAX] {
+                assert!((-FULL_DUTY_Q16..=FULL_DUTY_Q16).contains(&trim(d, offset, band)));
             }
         }
     }

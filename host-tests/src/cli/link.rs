@@ -9,6 +9,7 @@ use super::replay::{glued_line, header, roam_line, RoamArgs};
 use super::{arg_error, fmt_given, io_error, Backend, CliError};
 use crate::replay::{RoamRow, Row};
 use crate::trajectory;
+use mccs_client::pose_text::numbers;
 use mccs_client::{Device, Error, Pose, TelemetrySample, Tissue};
 use mccs_link::{Flags, ReplaySpec, RoamSpec};
 use std::io::Write;
@@ -178,25 +179,16 @@ pub(super) fn device_error(e: Error) -> CliError {
     CliError::new(e.to_string())
 }
 
-/// `X,Y,Z[,…]` as `n` numbers.
-pub(super) fn numbers(text: &str) -> Option<Vec<f64>> {
-    text.split(',')
-        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-        .collect()
-}
-
 /// The pose of `--origin` and `--rotation`.
 fn pose_of(origin: &str, rotation: Option<&str>) -> Result<Pose, CliError> {
-    let o = numbers(origin)
-        .filter(|v| v.len() == 3)
+    let o = numbers::<3>(origin)
         .ok_or_else(|| arg_error("--origin", "must be X,Y,Z: three numbers of mm"))?;
     let r = match rotation {
-        None => vec![0.0; 3],
-        Some(t) => numbers(t)
-            .filter(|v| v.len() == 3)
+        None => [0.0; 3],
+        Some(t) => numbers::<3>(t)
             .ok_or_else(|| arg_error("--rotation", "must be RX,RY,RZ: three numbers of degrees"))?,
     };
-    Ok(Pose::from_mm_deg([o[0], o[1], o[2]], [r[0], r[1], r[2]]))
+    Ok(Pose::from_mm_deg(o, r))
 }
 
 /// `pose origin=X,Y,Z rotation=RX,RY,RZ`, as the device holds it.
@@ -224,10 +216,9 @@ pub(super) fn tissue_of(
     match friction {
         None => Ok(t),
         Some(f) => {
-            let v = numbers(f)
-                .filter(|v| v.len() == 2)
-                .ok_or_else(|| arg_error(arg, "must be MU_S,MU_K: two numbers"))?;
-            t.with_friction(v[0], v[1])
+            let [mu_s, mu_k] =
+                numbers::<2>(f).ok_or_else(|| arg_error(arg, "must be MU_S,MU_K: two numbers"))?;
+            t.with_friction(mu_s, mu_k)
                 .map_err(|e| arg_error(arg, &e.to_string()))
         }
     }

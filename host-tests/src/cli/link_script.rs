@@ -18,8 +18,9 @@
 //! and checked whole before the device is reached: a bad line is exit 2 with its line
 //! number; a refusal at run time is exit 2 with the step's line number, after a disarm.
 
-use super::link::{device_error, numbers, pose_line, telemetry_row, tissue_of, TELEMETRY_COLUMNS};
+use super::link::{device_error, pose_line, telemetry_row, tissue_of, TELEMETRY_COLUMNS};
 use super::{io_error, CliError};
+use mccs_client::pose_text::{self, numbers};
 use mccs_client::{Device, Pose, Tissue};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -124,13 +125,13 @@ impl Script {
                     .map_err(|e| e.message)
             }
             "pose" => {
-                let v = match rest {
-                    [p] => numbers(p).filter(|v| v.len() == 3 || v.len() == 6),
+                let pose = match rest {
+                    [p] => pose_text::pose(p)
+                        .or_else(|| numbers::<3>(p).map(|o| Pose::from_mm_deg(o, [0.0; 3]))),
                     _ => None,
-                }
-                .ok_or("pose X,Y,Z[,RX,RY,RZ]: three or six numbers (mm, degrees)")?;
-                let r = if v.len() == 6 { [v[3], v[4], v[5]] } else { [0.0; 3] };
-                Ok(Step::Pose(Pose::from_mm_deg([v[0], v[1], v[2]], r)))
+                };
+                let what = "pose X,Y,Z[,RX,RY,RZ]: three or six numbers (mm, degrees)";
+                Ok(Step::Pose(pose.ok_or(what)?))
             }
             "telemetry" | "mesh" => {
                 let on = match rest.first().copied() {

@@ -262,15 +262,7 @@ impl View {
 pub fn pose_of(body: &[u8]) -> Result<Pose, &'static str> {
     const WHAT: &str = "a pose is X,Y,Z,RX,RY,RZ: six numbers, mm and degrees";
     let text = std::str::from_utf8(body).map_err(|_| WHAT)?;
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-        .collect::<Option<_>>()
-        .ok_or(WHAT)?;
-    let [x, y, z, rx, ry, rz] = v[..] else {
-        return Err(WHAT);
-    };
-    Ok(Pose::from_mm_deg([x, y, z], [rx, ry, rz]))
+    mccs_client::pose_text::pose(text).ok_or(WHAT)
 }
 
 /// A parameter file's text (the TOML of docs/model.md) as a tissue; why not, in one
