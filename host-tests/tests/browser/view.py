@@ -168,9 +168,13 @@ def start_view(mccs, device_args):
 
 
 def step_draws(tab, png_path):
-    # Paused (the page's Pause button), the picture holds still while it is read.
+    # Paused (the page's Pause button), the picture holds still while it is read; the
+    # last frame drawn is on the screen once the browser has run a few more (a fixed
+    # wait was too short on a loaded machine: 25 of 36 nodes matched an older frame).
     tab.js("document.getElementById('pause').click()")
-    time.sleep(0.2)
+    seen = tab.js("mccsView.state.frames")
+    tab.until(f"mccsView.state.frames >= {seen + 4}", "four animation frames after the pause")
+    time.sleep(0.1)
     png = tab.screenshot()
     if png_path:
         with open(png_path, "wb") as f:

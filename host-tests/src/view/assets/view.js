@@ -371,6 +371,9 @@ function drawPlots() {
 }
 
 function frame() {
+  // Animation frames seen, paused or not (the browser test waits on them: a frame
+  // drawn before a pause is on the screen once a few more have passed).
+  state.frames = (state.frames || 0) + 1;
   if (!state.paused) {
     follow();
     drawScene();
