@@ -2,6 +2,7 @@
 //! ([`device_file`]).
 
 pub mod device_file;
+pub mod gravity_fit;
 pub mod joints;
 pub mod twin;
 

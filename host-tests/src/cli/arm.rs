@@ -2,6 +2,7 @@
 //! firmware runs (default) or the `f64` twin (docs/arm.md).
 
 use super::{arg_error, io_error, Backend, CliError};
+use crate::arm::gravity_fit::{self, HeldPose};
 use crate::arm::{device_file, ArmTwin};
 use mccs::{Arm, Force};
 use std::io::Write;
@@ -40,6 +41,22 @@ enum Command {
         /// Fixed point, as the firmware computes it, or the f64 twin.
         #[arg(long, value_enum, default_value_t = Backend::Fixed)]
         backend: Backend,
+    },
+    /// The arm's masses from static poses: prints `GRAVITY upper_arm_mass_kg=…
+    /// forearm_mass_kg=… g_b_nmm=… g_c_nmm=… offset_duty_b=… offset_duty_c=…
+    /// rms_duty_b=… rms_duty_c=… poses=N`, and with --out writes the device file with
+    /// those masses.
+    Calibrate {
+        /// The device file: its [gravity] section gives the centres of mass and g.
+        #[arg(long)]
+        device: PathBuf,
+        /// CSV `count_a,count_b,count_c,duty_b,duty_c`: at least 8 poses held still,
+        /// each with the duties (before the trims, −1 … 1) that hold it.
+        #[arg(long)]
+        poses: PathBuf,
+        /// Write the device file with the fitted masses here (it may be --device).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -94,6 +111,11 @@ fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
                     "{file}: row {row}: {name}: must be a whole number of counts"
                 )));
             }
+            if name.starts_with("duty_") && x.abs() > 1.0 {
+                return Err(CliError::new(format!(
+                    "{file}: row {row}: {name}: must be within ±1 (a fraction of full duty)"
+                )));
+            }
             if name.ends_with("_n") && x.abs() > 2000.0 {
                 return Err(CliError::new(format!(
                     "{file}: row {row}: {name}: must be within ±2000 N"
@@ -107,64 +129,150 @@ fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
-    let (device, backend) = match &a.command {
+    match a.command {
         Command::Fk {
-            device, backend, ..
-        }
-        | Command::Torque {
-            device, backend, ..
-        } => (device, *backend),
-    };
+            device,
+            counts,
+            backend,
+        } => fk(&device, &counts, backend, out),
+        Command::Torque {
+            device,
+            input,
+            backend,
+        } => torque(&device, &input, backend, out),
+        Command::Calibrate {
+            device,
+            poses,
+            out: written,
+        } => calibrate(&device, &poses, written.as_deref(), out),
+    }
+}
+
+/// The device file as the fixed-point arm and its `f64` twin.
+fn load(device: &Path) -> Result<(Arm, ArmTwin), CliError> {
     let spec = device_file::read(device).map_err(CliError::new)?;
     let arm = Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
-    let twin = ArmTwin { spec };
+    Ok((arm, ArmTwin { spec }))
+}
+
+/// `mccs arm fk`.
+fn fk(device: &Path, counts: &Path, backend: Backend, out: &mut dyn Write) -> Result<(), CliError> {
+    let (arm, twin) = load(device)?;
+    let rows = rows(counts, &["count_a", "count_b", "count_c"])?;
     let mut w = std::io::BufWriter::new(out);
-    match a.command {
-        Command::Fk { counts, .. } => {
-            let rows = rows(&counts, &["count_a", "count_b", "count_c"])?;
-            writeln!(w, "x_mm,y_mm,z_mm").map_err(io_error)?;
-            for r in rows {
-                let c = [r[0], r[1], r[2]];
-                let p = match backend {
-                    Backend::Fixed => arm.pose(c.map(|x| x as i32)).device_mm(),
-                    Backend::Reference => twin.fk(twin.angles(c)),
-                };
-                writeln!(w, "{},{},{}", p[0], p[1], p[2]).map_err(io_error)?;
-            }
-        }
-        Command::Torque { input, .. } => {
-            let rows = rows(
-                &input,
-                &["count_a", "count_b", "count_c", "fx_n", "fy_n", "fz_n"],
-            )?;
-            writeln!(w, "tau_a_nm,tau_b_nm,tau_c_nm,duty_a,duty_b,duty_c").map_err(io_error)?;
-            for r in rows {
-                let c = [r[0], r[1], r[2]];
-                let f = [r[3], r[4], r[5]];
-                let (tau, duty) = match backend {
-                    Backend::Fixed => {
-                        let d = arm.drive(
-                            &arm.pose(c.map(|x| x as i32)),
-                            f.map(Force::saturating_from_num),
-                        );
-                        (
-                            d.torque_q8.map(|t| t as f64 / 256.0 / 1000.0),
-                            d.duty_q16.map(|x| x as f64 / 65_536.0),
-                        )
-                    }
-                    Backend::Reference => {
-                        let t = twin.torque(twin.angles(c), f);
-                        (t.map(|x| x / 1000.0), twin.duties(t).0)
-                    }
-                };
-                writeln!(
-                    w,
-                    "{},{},{},{},{},{}",
-                    tau[0], tau[1], tau[2], duty[0], duty[1], duty[2]
-                )
-                .map_err(io_error)?;
-            }
-        }
+    writeln!(w, "x_mm,y_mm,z_mm").map_err(io_error)?;
+    for r in rows {
+        let c = [r[0], r[1], r[2]];
+        let p = match backend {
+            Backend::Fixed => arm.pose(c.map(|x| x as i32)).device_mm(),
+            Backend::Reference => twin.fk(twin.angles(c)),
+        };
+        writeln!(w, "{},{},{}", p[0], p[1], p[2]).map_err(io_error)?;
     }
     w.flush().map_err(io_error)
+}
+
+/// `mccs arm torque`.
+fn torque(
+    device: &Path,
+    input: &Path,
+    backend: Backend,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let (arm, twin) = load(device)?;
+    let rows = rows(
+        input,
+        &["count_a", "count_b", "count_c", "fx_n", "fy_n", "fz_n"],
+    )?;
+    let mut w = std::io::BufWriter::new(out);
+    writeln!(w, "tau_a_nm,tau_b_nm,tau_c_nm,duty_a,duty_b,duty_c").map_err(io_error)?;
+    for r in rows {
+        let c = [r[0], r[1], r[2]];
+        let f = [r[3], r[4], r[5]];
+        let (tau, duty) = match backend {
+            Backend::Fixed => {
+                let d = arm.drive(
+                    &arm.pose(c.map(|x| x as i32)),
+                    f.map(Force::saturating_from_num),
+                );
+                (
+                    d.torque_q8.map(|t| t as f64 / 256.0 / 1000.0),
+                    d.duty_q16.map(|x| x as f64 / 65_536.0),
+                )
+            }
+            Backend::Reference => {
+                let t = twin.torque(twin.angles(c), f);
+                (t.map(|x| x / 1000.0), twin.duties(t).0)
+            }
+        };
+        writeln!(
+            w,
+            "{},{},{},{},{},{}",
+            tau[0], tau[1], tau[2], duty[0], duty[1], duty[2]
+        )
+        .map_err(io_error)?;
+    }
+    w.flush().map_err(io_error)
+}
+
+/// `mccs arm calibrate`: the fit, its line, and the device file written with it.
+fn calibrate(
+    device: &Path,
+    poses: &Path,
+    written: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let spec = device_file::read(device).map_err(CliError::new)?;
+    if let Some(p) = written {
+        super::check_writable("--out", p)?;
+    }
+    let rows = rows(
+        poses,
+        &["count_a", "count_b", "count_c", "duty_b", "duty_c"],
+    )?;
+    let held: Vec<HeldPose> = rows
+        .iter()
+        .map(|r| HeldPose {
+            counts: [r[0], r[1], r[2]],
+            duty: [r[3], r[4]],
+        })
+        .collect();
+    let twin = ArmTwin { spec };
+    let fit = gravity_fit::fit(&twin, &held)
+        .map_err(|e| CliError::new(format!("{}: {e}", poses.display())))?;
+    writeln!(
+        out,
+        "GRAVITY upper_arm_mass_kg={:.4} forearm_mass_kg={:.4} g_b_nmm={:.2} g_c_nmm={:.2} offset_duty_b={:.4} offset_duty_c={:.4} rms_duty_b={:.4} rms_duty_c={:.4} poses={}",
+        fit.upper_arm_mass_kg,
+        fit.forearm_mass_kg,
+        fit.coefficients_nmm[0],
+        fit.coefficients_nmm[1],
+        fit.offset_duty[0],
+        fit.offset_duty[1],
+        fit.rms_duty[0],
+        fit.rms_duty[1],
+        held.len()
+    )
+    .map_err(io_error)?;
+    out.flush().map_err(io_error)?;
+    if fit.offset_duty.iter().any(|o| o.abs() > 0.01) {
+        eprintln!(
+            "mccs: warning: the holding duties carry an offset of {:.3} (B) and {:.3} (C) of full duty: measure the joints' trims (docs/arm.md, the locked-rotor sweep)",
+            fit.offset_duty[0], fit.offset_duty[1]
+        );
+    }
+    if let Some(path) = written {
+        let text = std::fs::read_to_string(device)
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
+        let new = gravity_fit::with_masses(&text, &fit).ok_or_else(|| {
+            CliError::new(format!(
+                "{}: gravity.upper_arm_mass_kg or gravity.forearm_mass_kg: not found to rewrite",
+                device.display()
+            ))
+        })?;
+        std::fs::write(path, new)
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
+        eprintln!("mccs: wrote {} with the fitted masses", path.display());
+    }
+    Ok(())
 }

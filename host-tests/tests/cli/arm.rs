@@ -325,3 +325,159 @@ fn a_joint_space_replay_is_the_cartesian_replay_at_the_fixed_kinematics() {
     }
     assert!(pressed > 100, "{pressed} ticks in contact");
 }
+
+/// `count_a,count_b,count_c,duty_b,duty_c` rows of `n` poses held still by the arm
+/// `truth`, spread over B's and C's ranges (5° inside them), each duty off by up to
+/// `noise` (a fixed pseudo-random draw).
+fn held_poses(truth: &mccs_host::arm::ArmTwin, n: usize, spread: f64, noise: f64) -> String {
+    let mut csv = String::from("count_a,count_b,count_c,duty_b,duty_c\n");
+    let mut seed = 0x9E37_79B9u32;
+    let j = &truth.spec.joints;
+    for i in 0..n {
+        let at = |k: usize, phase: f64| {
+            let (lo, hi) = (j[k].min_angle_deg + 5.0, j[k].max_angle_deg - 5.0);
+            let mid = 0.5 * (lo + hi);
+            let u = ((i as f64 + phase) / n as f64 * std::f64::consts::TAU).sin();
+            (mid + spread * u * 0.5 * (hi - lo)).to_radians()
+        };
+        let counts = truth
+            .counts([0.0, at(1, 0.0), at(2, 0.37 * n as f64)])
+            .map(f64::round);
+        let t = truth.angles(counts);
+        let (d, _) = truth.duties(truth.gravity(t));
+        let mut jitter = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            noise * ((seed >> 8) as f64 / (1u32 << 24) as f64 * 2.0 - 1.0)
+        };
+        let (b, c) = (d[1] + jitter(), d[2] + jitter());
+        csv += &format!("{},{},{},{b},{c}\n", counts[0], counts[1], counts[2]);
+    }
+    csv
+}
+
+/// A `GRAVITY …` line's value of `key`.
+fn gravity_value(line: &str, key: &str) -> f64 {
+    line.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{key} in {line}"))
+}
+
+#[test]
+fn calibrate_recovers_the_masses_from_held_poses_and_writes_them() {
+    let wooden = root().join("devices/woodenhaptics.toml");
+    let spec = mccs_host::arm::device_file::read(&wooden).unwrap();
+    // The arm as it is: heavier than the file says (the file's masses are wrong).
+    let mut truth = spec;
+    let g = truth.gravity.as_mut().unwrap();
+    (g.upper_arm_mass_kg, g.forearm_mass_kg) = (0.23, 0.15);
+    let truth = mccs_host::arm::ArmTwin { spec: truth };
+    // Holding duties measured to ±0.002 of full duty.
+    let poses = temp_file("held.csv", &held_poses(&truth, 12, 1.0, 0.002));
+    let written = root().join("target/tmp-calibrated.toml");
+    let out = mccs_ok(&[
+        "arm",
+        "calibrate",
+        "--device",
+        wooden.to_str().unwrap(),
+        "--poses",
+        poses.to_str().unwrap(),
+        "--out",
+        written.to_str().unwrap(),
+    ]);
+    let line = String::from_utf8(out.stdout).unwrap();
+    let upper = gravity_value(&line, "upper_arm_mass_kg");
+    let fore = gravity_value(&line, "forearm_mass_kg");
+    println!(
+        "CALIBRATE case=heavier upper_arm_mass_kg={upper} forearm_mass_kg={fore} true_upper_arm_mass_kg=0.23 true_forearm_mass_kg=0.15"
+    );
+    assert!((upper / 0.23 - 1.0).abs() < 0.05, "{line}");
+    assert!((fore / 0.15 - 1.0).abs() < 0.05, "{line}");
+    assert!(
+        gravity_value(&line, "offset_duty_b").abs() < 0.005,
+        "{line}"
+    );
+    // The written file reads back with those masses, everything else the same.
+    let back = mccs_host::arm::device_file::read(&written).unwrap();
+    let bg = back.gravity.unwrap();
+    assert!(
+        (bg.upper_arm_mass_kg - upper).abs() < 1e-4 && (bg.forearm_mass_kg - fore).abs() < 1e-4
+    );
+    assert_eq!(back.joints, spec.joints);
+    let text = std::fs::read_to_string(&written).unwrap();
+    assert!(
+        text.contains("# mass_body_b, mass_body_c"),
+        "the file's comments are kept"
+    );
+}
+
+#[test]
+fn calibrate_refuses_what_cannot_give_masses() {
+    let wooden = root().join("devices/woodenhaptics.toml");
+    let spec = mccs_host::arm::device_file::read(&wooden).unwrap();
+    let truth = mccs_host::arm::ArmTwin { spec };
+    let run = |name: &str, csv: &str| {
+        let poses = temp_file(name, csv);
+        mccs(&[
+            "arm",
+            "calibrate",
+            "--device",
+            wooden.to_str().unwrap(),
+            "--poses",
+            poses.to_str().unwrap(),
+        ])
+    };
+    assert_one_line_error(
+        &run("few.csv", &held_poses(&truth, 7, 1.0, 0.0)),
+        &["few.csv: 7 poses; the fit needs at least 8"],
+    );
+    assert_one_line_error(
+        &run("bunched.csv", &held_poses(&truth, 10, 0.02, 0.0)),
+        &[
+            "bunched.csv: joint B: the poses' sin θ spans",
+            "spread the poses",
+        ],
+    );
+    let flipped: String = held_poses(&truth, 10, 1.0, 0.0)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                format!("{l}\n")
+            } else {
+                let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                format!("{},{},{},{},{}\n", f[0], f[1], f[2], -f[3], -f[4])
+            }
+        })
+        .collect();
+    assert_one_line_error(
+        &run("flipped.csv", &flipped),
+        &[
+            "flipped.csv: the fit gives negative masses",
+            "check the joints' signs",
+        ],
+    );
+    assert_one_line_error(
+        &run(
+            "over.csv",
+            "count_a,count_b,count_c,duty_b,duty_c\n0,0,0,1.5,0\n",
+        ),
+        &["over.csv: row 2: duty_b: must be within ±1"],
+    );
+    let no_gravity = temp_file(
+        "no-gravity.toml",
+        &WOODEN[..WOODEN.find("# mass_body_b").unwrap()],
+    );
+    let poses = temp_file("ok.csv", &held_poses(&truth, 10, 1.0, 0.0));
+    assert_one_line_error(
+        &mccs(&[
+            "arm",
+            "calibrate",
+            "--device",
+            no_gravity.to_str().unwrap(),
+            "--poses",
+            poses.to_str().unwrap(),
+        ]),
+        &["ok.csv: the device file has no [gravity] section"],
+    );
+}
