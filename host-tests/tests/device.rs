@@ -146,11 +146,7 @@ fn the_lever_is_followed_over_whole_turns_and_beyond_its_travel_is_a_fault() {
         force_at_full_duty: 3.0,
     };
     let motor = PwmMotor::new(pwm, PinMock::new(&[]), config).unwrap();
-    let mut dev = OneDofDevice {
-        encoder: enc,
-        motor,
-        max_bad_frames: 3,
-    };
+    let mut dev = OneDofDevice::new(enc, motor, 3);
     let reads: Vec<bool> = (0..=steps.len())
         .map(|_| dev.read_position().is_ok())
         .collect();
@@ -445,7 +441,7 @@ fn a_failed_direction_write_leaves_zero_duty() {
 
 /// What a fake PWM channel and pin saw: the duty now, every duty written, every
 /// failure.
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 struct Log {
     duty: u16,
     duties: Vec<u16>,
@@ -538,11 +534,7 @@ fn rig(
         },
     )
     .unwrap();
-    let mut device = OneDofDevice {
-        encoder: As5047p::new(sensor, plain()),
-        motor,
-        max_bad_frames: 3,
-    };
+    let mut device = OneDofDevice::new(As5047p::new(sensor, plain()), motor, 3);
     device.motor.enable().unwrap();
     device
 }
@@ -873,4 +865,62 @@ fn a_parameter_set_for_another_topology_is_refused() {
     }
     assert_eq!(with.telemetry().rejected_swaps, 1);
     assert_eq!(with.telemetry().swaps, 0);
+}
+
+/// The lever moving `counts_per_tick` a tick under a force of `push_n` along its
+/// motion (negative: against it), its passivity observer at 2 mJ beyond a 10 mJ credit:
+/// the tick it trips at (`None`: not within 2,000), and the log then.
+fn pushed_lever(counts_per_tick: i64, push_n: f64) -> (Option<usize>, Log) {
+    let log = Rc::new(RefCell::new(Log::default()));
+    let sensor = Sensor::new(move |n| (100 + counts_per_tick * n as i64).rem_euclid(16384) as u16);
+    let mut device = rig(&log, sensor, Fail::Never, Fail::Never)
+        .with_passivity(mccs::PassivityLimits::new(2.0, 10.0));
+    // At rest, no force: it watches from here.
+    let z0 = device.read_position().unwrap()[2];
+    device.write_force([Force::ZERO; 3]).unwrap();
+    let z1 = device.read_position().unwrap()[2];
+    let along = if z1 >= z0 { push_n } else { -push_n };
+    let force = [Force::ZERO, Force::ZERO, Force::from_num(along)];
+    for k in 0..2000 {
+        match device.write_force(force) {
+            Ok(()) => {}
+            Err(mccs_firmware::one_dof::OneDofError::EnergyOut) => {
+                let log = log.borrow().clone();
+                return (Some(k), log);
+            }
+            Err(e) => panic!("tick {k}: {e:?}"),
+        }
+        device.read_position().unwrap();
+    }
+    let log = log.borrow().clone();
+    (None, log)
+}
+
+#[test]
+fn a_force_along_the_lever_s_motion_trips_the_passivity_observer_motor_safe_first() {
+    // 2 N pushing the lever along its own motion, 0.0288 mm a tick (29 mm/s): the credit
+    // fills only from the hand's input, none here, so the trip comes at 2 mJ of output:
+    // 1 mm, about 35 ticks.
+    let (tick, log) = pushed_lever(10, 2.0);
+    let tick = tick.expect("the observer trips");
+    assert!((30..=40).contains(&tick), "tripped at tick {tick}");
+    assert_eq!(log.duty, 0, "zero duty at the trip");
+    assert!(!log.enabled, "the driver disabled at the trip");
+    // Against the motion (the hand pressing into a resisting tissue): never.
+    assert_eq!(pushed_lever(10, -2.0).0, None);
+    // And no observer, no trip.
+    let log = Rc::new(RefCell::new(Log::default()));
+    let mut plain_device = rig(
+        &log,
+        Sensor::new(|n| (100 + 10 * n) as u16),
+        Fail::Never,
+        Fail::Never,
+    );
+    for _ in 0..200 {
+        plain_device.read_position().unwrap();
+        plain_device
+            .write_force([Force::ZERO, Force::ZERO, Force::from_num(2.0)])
+            .unwrap();
+    }
+    assert_eq!(plain_device.passivity_mj(), None);
 }

@@ -58,12 +58,7 @@ pub const RUNAWAY_TICKS: u8 = 5;
 pub const WALL_MARGIN_DEG: f64 = 3.0;
 /// How long the home input must stay high, with the arm still, before the arm homes, ms.
 pub const HOME_DEBOUNCE_MS: u32 = 50;
-/// The passivity observer: energy put into the hand beyond the credit by this much,
-/// mJ, is a fault (docs/safety.md).
-pub const PASSIVITY_TRIP_MJ: f64 = 2.0;
-/// The most the hand's earlier input may pay for later output, mJ: above what the
-/// tissue stores at the force clamp (3 N over 6 mm: 9 mJ).
-pub const PASSIVITY_CREDIT_MJ: f64 = 10.0;
+pub use crate::device::{PASSIVITY_CREDIT_MJ, PASSIVITY_TRIP_MJ};
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input

@@ -30,6 +30,13 @@ pub const NODES: usize = mccs::topology::standard_capacity(MAX_GRID).0;
 pub const EDGES: usize = mccs::topology::standard_capacity(MAX_GRID).1;
 pub use crate::config::SPACING_MM;
 
+/// The passivity observer (the lever's and the arm's): energy put into the hand beyond
+/// the credit by this much, mJ, is a fault (docs/safety.md).
+pub const PASSIVITY_TRIP_MJ: f64 = 2.0;
+/// The most the hand's earlier input may pay for later output, mJ: above what the
+/// tissue stores at the force clamp (3 N over 6 mm: 9 mJ).
+pub const PASSIVITY_CREDIT_MJ: f64 = 10.0;
+
 /// The board's device on these parts.
 pub type BoardDevice<SPI, PWM, DIR, EN> = OneDofDevice<SPI, PWM, DIR, EN>;
 /// Its error.
@@ -94,6 +101,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
                 OneDofError::Motor(MotorError::Pwm(_)) => DevicePart::Pwm,
                 OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
                 OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
+                OneDofError::EnergyOut => DevicePart::EnergyOut,
             }),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
@@ -147,7 +155,8 @@ pub enum DevicePart {
     JointSpeed(u8),
     /// The arm's probe moved faster than its limit (a runaway).
     ProbeSpeed,
-    /// The arm's force put out energy beyond the passivity observer's trip.
+    /// The force (the lever's or the arm's) put out energy beyond the passivity
+    /// observer's trip.
     EnergyOut,
 }
 
@@ -265,11 +274,15 @@ where
     config.check().map_err(StartError::Config)?;
     let motor = PwmMotor::with_enable(pwm, dir, enable, config.motor())
         .map_err(|e| StartError::Config(BoardConfigError::Motor(e)))?;
-    let mut device = OneDofDevice {
-        encoder: As5047p::new(spi, config.encoder()),
+    let mut device = OneDofDevice::new(
+        As5047p::new(spi, config.encoder()),
         motor,
-        max_bad_frames: config.max_bad_frames,
-    };
+        config.max_bad_frames,
+    )
+    .with_passivity(mccs::PassivityLimits::new(
+        PASSIVITY_TRIP_MJ,
+        PASSIVITY_CREDIT_MJ,
+    ));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }
@@ -279,6 +292,9 @@ where
 /// back with the error. Out of line: its stack frames are free again before the ticks.
 #[inline(never)]
 #[allow(clippy::type_complexity)]
+// The device comes back whole with the error (no heap to box it in), so that the caller
+// can hold it in its safe state.
+#[allow(clippy::result_large_err)]
 pub fn controller_into<SPI, PWM, DIR, EN, const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
