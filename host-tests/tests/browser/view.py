@@ -171,6 +171,8 @@ def step_draws(tab, png_path):
     # Paused (the page's Pause button), the picture holds still while it is read; the
     # last frame drawn is on the screen once the browser has run a few more (a fixed
     # wait was too short on a loaded machine: 25 of 36 nodes matched an older frame).
+    # First the camera on the window it follows (it eases there in time).
+    tab.until("mccsView.settled()", "the camera on the window")
     tab.js("document.getElementById('pause').click()")
     seen = tab.js("mccsView.state.frames")
     tab.until(f"mccsView.state.frames >= {seen + 4}", "four animation frames after the pause")

@@ -226,10 +226,18 @@ function resetCamera() {
   camera.dist = h ? 2.4 * (h.grid - 1) * h.spacing_mm : 60;
 }
 
-function follow() {
+// The camera eases onto the window in time, not in frames (a tenth of the way a frame
+// lagged seconds behind a window that jumped, where the browser drew few frames): 63 %
+// of the way in FOLLOW_S.
+const FOLLOW_S = 0.15;
+let followedAt = null;
+function follow(now) {
   if (!state.t) return;
+  const dt = followedAt === null ? 1 : Math.min(1, (now - followedAt) / 1000);
+  followedAt = now;
+  const k = 1 - Math.exp(-dt / FOLLOW_S);
   const [wx, wy] = state.t.window, c = camera.target;
-  c[0] += 0.1 * (wx - c[0]); c[1] += 0.1 * (wy - c[1]); c[2] = -1;
+  c[0] += k * (wx - c[0]); c[1] += k * (wy - c[1]); c[2] = -1;
 }
 
 function matrix() {
@@ -370,12 +378,12 @@ function drawPlots() {
   plots.fillStyle = '#888'; plots.fillText('\u2212' + HISTORY_S + ' s', L, H - 2); plots.fillText('now', W - R - 20, H - 2);
 }
 
-function frame() {
+function frame(now) {
   // Animation frames seen, paused or not (the browser test waits on them: a frame
   // drawn before a pause is on the screen once a few more have passed).
   state.frames = (state.frames || 0) + 1;
   if (!state.paused) {
-    follow();
+    follow(now);
     drawScene();
     drawPlots();
   }
@@ -396,6 +404,12 @@ function onScreen(p) {
 }
 window.mccsView = {
   state,
+  // The camera within 3 mm of the window it follows (the patch is 17.5 mm across).
+  settled() {
+    if (!state.t) return false;
+    const [wx, wy] = state.t.window, c = camera.target;
+    return Math.hypot(wx - c[0], wy - c[1]) < 3;
+  },
   nodesOnScreen() {
     return drawn.mesh ? drawn.mesh.nodes.map((n) => onScreen(n.slice(2))) : [];
   },
