@@ -15,7 +15,7 @@ use std::path::Path;
 pub type Check = fn(&[u8]);
 
 /// The targets, by name, with their checks.
-pub const TARGETS: [(&str, Check); 10] = [
+pub const TARGETS: [(&str, Check); 11] = [
     ("param_file", param_file),
     ("fit_data", fit_data),
     ("trajectory", trajectory),
@@ -26,6 +26,7 @@ pub const TARGETS: [(&str, Check); 10] = [
     ("arm_device_file", arm_device_file),
     ("joints", joints),
     ("view_request", view_request),
+    ("arm_inputs", arm_inputs),
 ];
 
 /// A parameter file: a one-line error naming the file, or parameters that validate,
@@ -416,6 +417,70 @@ pub fn joints(data: &[u8]) {
             assert!(!ticks.is_empty());
         }
         Err(e) => assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}"),
+    }
+}
+
+/// The arm's CSV inputs (`mccs arm fk --counts`, `calibrate --poses`): a one-line error,
+/// or rows of the kinds their columns say, on which the fixed-point pose and the gravity
+/// fit give finite figures or one line why not.
+pub fn arm_inputs(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let one_line = |e: &str| assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}");
+    let spec = mccs_firmware::arm::device::WOODENHAPTICS;
+    let counts = ["count_a", "count_b", "count_c"];
+    match crate::arm::columns::parse(text, "fuzz.csv", &counts) {
+        Ok(rows) => {
+            let arm = mccs::Arm::new(&spec).expect("valid");
+            for r in rows {
+                let c = [r[0], r[1], r[2]];
+                assert!(c
+                    .iter()
+                    .all(|x| x.fract() == 0.0 && x.abs() <= i32::MAX as f64));
+                let pose = arm.pose(c.map(|x| x as i32));
+                let d = arm.drive(&pose, [mccs::Force::from_num(1); 3]);
+                assert!(d.duty_q16.iter().all(|x| x.abs() <= 65_536));
+            }
+        }
+        Err(e) => one_line(&e),
+    }
+    let held = ["count_a", "count_b", "count_c", "duty_b", "duty_c"];
+    match crate::arm::columns::parse(text, "fuzz.csv", &held) {
+        Ok(rows) => {
+            let poses: Vec<_> = rows
+                .iter()
+                .map(|r| crate::arm::gravity_fit::HeldPose {
+                    counts: [r[0], r[1], r[2]],
+                    duty: [r[3], r[4]],
+                })
+                .collect();
+            let twin = crate::arm::ArmTwin {
+                spec: mccs::ArmSpec {
+                    gravity: Some(mccs::GravitySpec {
+                        upper_arm_mass_kg: 0.17,
+                        upper_arm_com_mm: 51.0,
+                        forearm_mass_kg: 0.11,
+                        forearm_com_mm: 91.0,
+                        g: 9.81,
+                    }),
+                    ..spec
+                },
+            };
+            match crate::arm::gravity_fit::fit(&twin, &poses) {
+                Ok(f) => {
+                    assert!(f.upper_arm_mass_kg.is_finite() && f.upper_arm_mass_kg >= 0.0);
+                    assert!(f.forearm_mass_kg.is_finite() && f.forearm_mass_kg >= 0.0);
+                    assert!(f
+                        .rms_duty
+                        .iter()
+                        .chain(&f.offset_duty)
+                        .all(|x| x.is_finite()));
+                }
+                Err(e) => assert!(!e.contains('\n'), "{e}"),
+            }
+        }
+        Err(e) => one_line(&e),
     }
 }
 

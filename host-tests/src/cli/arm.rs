@@ -3,7 +3,7 @@
 
 use super::{arg_error, io_error, Backend, CliError};
 use crate::arm::gravity_fit::{self, HeldPose};
-use crate::arm::{device_file, ArmTwin};
+use crate::arm::{columns, device_file, ArmTwin};
 use mccs::{Arm, Force};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -60,72 +60,12 @@ enum Command {
     },
 }
 
-/// The rows of a numeric CSV file with exactly `header`; one line naming the file and
-/// the row (the header is row 1) for anything else.
+/// The rows of a numeric CSV file with exactly `header` ([`columns::parse`]).
 fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
-    let file = path.display();
+    let file = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::new(format!("{file}: cannot read: {e}")))?;
-    let mut lines = text.lines();
-    let want = header.join(",");
-    match lines
-        .next()
-        .map(|h| h.trim().trim_start_matches('\u{feff}'))
-    {
-        Some(h) if h == want => {}
-        Some(h) => {
-            return Err(CliError::new(format!(
-                "{file}: row 1: the header must be `{want}`, not `{}`",
-                h.escape_debug()
-            )))
-        }
-        None => return Err(CliError::new(format!("{file}: empty file"))),
-    }
-    let mut out = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let row = i + 2;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        if fields.len() != header.len() {
-            return Err(CliError::new(format!(
-                "{file}: row {row}: {} fields, {} expected",
-                fields.len(),
-                header.len()
-            )));
-        }
-        let mut v = Vec::with_capacity(fields.len());
-        for (f, name) in fields.iter().zip(header) {
-            let x: f64 = f
-                .parse()
-                .ok()
-                .filter(|x: &f64| x.is_finite())
-                .ok_or_else(|| {
-                    CliError::new(format!(
-                        "{file}: row {row}: {name}: `{f}` is not a finite number"
-                    ))
-                })?;
-            if name.starts_with("count_") && (x.fract() != 0.0 || x.abs() > i32::MAX as f64) {
-                return Err(CliError::new(format!(
-                    "{file}: row {row}: {name}: must be a whole number of counts"
-                )));
-            }
-            if name.starts_with("duty_") && x.abs() > 1.0 {
-                return Err(CliError::new(format!(
-                    "{file}: row {row}: {name}: must be within ±1 (a fraction of full duty)"
-                )));
-            }
-            if name.ends_with("_n") && x.abs() > 2000.0 {
-                return Err(CliError::new(format!(
-                    "{file}: row {row}: {name}: must be within ±2000 N"
-                )));
-            }
-            v.push(x);
-        }
-        out.push(v);
-    }
-    Ok(out)
+    columns::parse(&text, &file, header).map_err(CliError::new)
 }
 
 pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
