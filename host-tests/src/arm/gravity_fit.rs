@@ -198,4 +198,31 @@ mod tests {
         assert!((a - 3.0).abs() < 1e-12 && (c + 0.5).abs() < 1e-12 && rms < 1e-12);
         assert!((line.spread() - 0.9).abs() < 1e-12);
     }
+
+    fn fitted() -> GravityFit {
+        GravityFit {
+            coefficients_nmm: [400.0, 90.0],
+            upper_arm_mass_kg: 0.25,
+            forearm_mass_kg: 0.125,
+            offset_duty: [0.0; 2],
+            rms_duty: [0.0; 2],
+        }
+    }
+
+    #[test]
+    fn the_masses_are_rewritten_where_and_as_they_are_written() {
+        // In the section, a comment kept; at the top level as `gravity.key`, the key kept.
+        let text = "[arm]\nx = 1\n[gravity]\nupper_arm_mass_kg = 0.17 # scale\nforearm_mass_kg=0.11\n";
+        let out = with_masses(text, &fitted()).unwrap();
+        assert_eq!(
+            out,
+            "[arm]\nx = 1\n[gravity]\nupper_arm_mass_kg = 0.2500  # scale\nforearm_mass_kg= 0.1250  # fitted by `mccs arm calibrate`\n"
+        );
+        let top = "gravity.upper_arm_mass_kg = 0.17\ngravity.forearm_mass_kg = 0.11";
+        let out = with_masses(top, &fitted()).unwrap();
+        assert!(out.starts_with("gravity.upper_arm_mass_kg = 0.2500"), "{out}");
+        assert!(!out.ends_with('\n'));
+        // A file without them: nothing to rewrite.
+        assert_eq!(with_masses("[gravity]\ng = 9.81\n", &fitted()), None);
+    }
 }
