@@ -212,7 +212,8 @@ mod tests {
     #[test]
     fn the_masses_are_rewritten_where_and_as_they_are_written() {
         // In the section, a comment kept; at the top level as `gravity.key`, the key kept.
-        let text = "[arm]\nx = 1\n[gravity]\nupper_arm_mass_kg = 0.17 # scale\nforearm_mass_kg=0.11\n";
+        let text =
+            "[arm]\nx = 1\n[gravity]\nupper_arm_mass_kg = 0.17 # scale\nforearm_mass_kg=0.11\n";
         let out = with_masses(text, &fitted()).unwrap();
         assert_eq!(
             out,
@@ -220,7 +221,10 @@ mod tests {
         );
         let top = "gravity.upper_arm_mass_kg = 0.17\ngravity.forearm_mass_kg = 0.11";
         let out = with_masses(top, &fitted()).unwrap();
-        assert!(out.starts_with("gravity.upper_arm_mass_kg = 0.2500"), "{out}");
+        assert!(
+            out.starts_with("gravity.upper_arm_mass_kg = 0.2500"),
+            "{out}"
+        );
         assert!(!out.ends_with('\n'));
         // A file without them: nothing to rewrite.
         assert_eq!(with_masses("[gravity]\ng = 9.81\n", &fitted()), None);
