@@ -30,6 +30,7 @@
 pub mod addr;
 pub mod device;
 pub mod error;
+mod facts;
 mod ffi;
 pub mod mesh;
 pub mod paramfile;
