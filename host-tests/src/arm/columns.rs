@@ -1,11 +1,21 @@
 //! The arm's numeric CSV inputs (`mccs arm fk --counts`, `torque --input`, `calibrate
-//! --poses`): a fixed header, then rows of finite numbers, each column held to its kind.
+//! --poses`, and the recorded motion of `replay --joints`): a fixed header, then rows of
+//! finite numbers, each column held to its kind.
 
 /// The rows of numeric CSV text with exactly `header`; one line naming `file` and the
 /// row (the header is row 1) for anything else. Counts (`count_*`) whole and within
 /// `i32`, forces (`*_n`) within ±2,000 N, duties (`duty_*`) within ±1. Blank lines are
 /// skipped.
 pub fn parse(text: &str, file: &str, header: &[&str]) -> Result<Vec<Vec<f64>>, String> {
+    Ok(numbered(text, file, header)?
+        .into_iter()
+        .map(|(_, v)| v)
+        .collect())
+}
+
+/// [`parse`], each row with its number in the file (the header is row 1), for checks
+/// across rows.
+pub fn numbered(text: &str, file: &str, header: &[&str]) -> Result<Vec<(usize, Vec<f64>)>, String> {
     let mut lines = text.lines();
     let want = header.join(",");
     match lines
@@ -39,7 +49,7 @@ pub fn parse(text: &str, file: &str, header: &[&str]) -> Result<Vec<Vec<f64>>, S
         for (f, name) in fields.iter().zip(header) {
             v.push(value(f, name).map_err(|what| format!("{file}: row {row}: {name}: {what}"))?);
         }
-        out.push(v);
+        out.push((row, v));
     }
     Ok(out)
 }

@@ -15,43 +15,9 @@ pub fn read(path: &std::path::Path) -> Result<Vec<(f64, [f64; 3])>, String> {
 
 /// [`read`] on text; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<Vec<(f64, [f64; 3])>, String> {
-    let header = "time_s,count_a,count_b,count_c";
-    let mut lines = text.lines();
-    match lines
-        .next()
-        .map(|h| h.trim().trim_start_matches('\u{feff}'))
-    {
-        Some(h) if h == header => {}
-        Some(h) => {
-            return Err(format!(
-                "{file}: row 1: the header must be `{header}`, not `{}`",
-                h.escape_debug()
-            ))
-        }
-        None => return Err(format!("{file}: empty file")),
-    }
+    let header = ["time_s", "count_a", "count_b", "count_c"];
     let mut rows: Vec<(f64, [f64; 3])> = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let row = i + 2;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let v: Vec<f64> = line
-            .split(',')
-            .map(|f| f.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
-            .collect::<Option<Vec<f64>>>()
-            .ok_or_else(|| format!("{file}: row {row}: not four finite numbers"))?;
-        if v.len() != 4 {
-            return Err(format!("{file}: row {row}: {} fields, 4 expected", v.len()));
-        }
-        if v[1..]
-            .iter()
-            .any(|c| c.fract() != 0.0 || c.abs() > i32::MAX as f64)
-        {
-            return Err(format!(
-                "{file}: row {row}: the counts must be whole numbers"
-            ));
-        }
+    for (row, v) in super::columns::numbered(text, file, &header)? {
         if rows.last().is_some_and(|&(t, _)| v[0] <= t) {
             return Err(format!("{file}: row {row}: times must increase strictly"));
         }
