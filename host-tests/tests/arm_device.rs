@@ -197,14 +197,15 @@ fn enable_and_home(r: &Rig, dev: &mut Device) {
     r.home.set(false);
 }
 
-/// Counts at a pose in the workspace, with the force pressing into it.
+/// Counts at a pose in the workspace, the probe just above the tissue's surface (a
+/// probe that appears below it is held out of contact: `ArmDevice::below_entry`).
 fn at_work(r: &Rig) {
-    // B 20°, C 38°: the probe near the tissue's origin, on the working branch
+    // B 20°, C 38.5°: the probe 0.8 mm above the tissue's origin, on the working branch
     // (docs/arm.md).
     let counts = [
         0i32,
         (20.0 / 360.0 * 24_000.0) as i32,
-        (38.0 / 360.0 * 24_000.0) as i32,
+        (38.5 / 360.0 * 24_000.0) as i32,
     ];
     for k in 0..3 {
         r.raw[k].set(counts[k] as u16);
@@ -375,10 +376,10 @@ fn a_force_along_the_probe_s_motion_trips_the_passivity_observer_zero_duty_first
             assert!(r.duty.iter().all(|d| d.get() == 0), "zero duty written");
         } else {
             assert_eq!(ended, None);
-            assert!(
-                (dev.passivity_mj().unwrap() - 10.0).abs() < 1e-3,
-                "the credit full"
-            );
+            // In contact all the hand put in is held (a release may give it back),
+            // past the 10 mJ credit that holds out of contact.
+            let e = dev.passivity_mj().unwrap();
+            assert!(e > 10.0, "the hand's input held: {e} mJ");
         }
     }
 }
@@ -658,4 +659,56 @@ fn a_failed_write_and_a_failing_safe_state_still_end_at_zero() {
     assert_eq!(dev.safe_state(), Err(ArmFault::Pwm(0)));
     assert_eq!((r.duty[1].get(), r.duty[2].get()), (0, 0));
     assert!(!r.enable.get());
+}
+
+/// A contact starts only by coming down onto the surface: a probe that comes into the
+/// tissue's frame from beside it below the surface's height (where the simulated arm's
+/// approach came in, 21 mm deep at x = −128 mm) reads as far above the tissue, no
+/// contact, until it rises to the surface inside the frame; then a press is a contact
+/// again. Without the rule the contact met it with the whole depth's force (a
+/// pop-through of 2.9 N along the approach, which the arm's closed loop measured as
+/// 0.15 J put into the hand).
+#[test]
+fn a_probe_that_comes_in_below_the_surface_is_out_of_contact_until_it_rises_to_it() {
+    let spec = wooden();
+    let (r, mut dev) = rig();
+    enable_and_home(&r, &mut dev);
+    let origin = spec.tissue_origin_mm;
+    let at = |r: &Rig, tissue: [f64; 3]| {
+        let p = std::array::from_fn(|k| tissue[k] + origin[k]);
+        let counts = mccs::arm::inverse::counts(&spec, p).unwrap();
+        for k in 0..3 {
+            r.raw[k].set(counts[k] as u16);
+        }
+    };
+    let far = [Length::ZERO, Length::ZERO, Length::MAX];
+    // Beside the frame, 21 mm below the surface's height; then in it, still below.
+    for (x, z, expect_far) in [
+        (-140.0, -21.0, true),
+        (-120.0, -21.0, true),
+        (-60.0, -10.0, true),
+        (-60.0, -0.2, true),
+        // At the surface inside the frame: the rule is done; a press is a contact.
+        (-60.0, 0.1, false),
+        (-60.0, -1.0, false),
+    ] {
+        at(&r, [x, 0.0, z]);
+        let p = dev.read_position().unwrap();
+        dev.write_force([Force::ZERO; 3]).unwrap();
+        assert_eq!(p == far, expect_far, "at x {x}, z {z}: {p:?}");
+        assert_eq!(dev.below_entry(), expect_far, "at x {x}, z {z}");
+        if !expect_far {
+            assert!((p[2].to_num::<f64>() - z).abs() < 0.1, "at z {z}: {p:?}");
+        }
+    }
+    // Out of the frame beneath it and back: held out of contact again.
+    at(&r, [-60.0, 0.0, -130.0]);
+    assert_eq!(dev.read_position().unwrap(), far);
+    at(&r, [-60.0, 0.0, -1.0]);
+    assert_eq!(dev.read_position().unwrap(), far, "came back in below");
+    // Homed (the home pose: beside the frame, 40 mm below the surface's height).
+    let (r, mut dev) = rig();
+    enable_and_home(&r, &mut dev);
+    assert!(dev.below_entry());
+    assert_eq!(dev.read_position().unwrap(), far);
 }

@@ -14,6 +14,8 @@ mod arm;
 mod arm_demo;
 #[path = "arm_device.rs"]
 mod arm_device;
+#[path = "arm_dynamics.rs"]
+mod arm_dynamics;
 #[path = "cap.rs"]
 mod cap;
 #[path = "cli/mod.rs"]

@@ -253,6 +253,9 @@ fn no_duty_before_homing_then_a_press_drives_the_joints() {
     rig.ctl.tick(None);
     assert!(rig.ctl.device().inner().homed());
     rig.home.value.set(0);
+    // Down onto the tissue from above it (a contact starts only so).
+    rig.set_counts(pressing_counts(-2.0));
+    rig.ctl.tick(None);
     rig.set_counts(counts);
     let mut force = [Force::ZERO; 3];
     for _ in 0..200 {
@@ -294,6 +297,7 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
     // Pressing at the origin, then joint A turned 30 counts: the proxy sticks (friction),
     // so the force has a lateral part and every joint is driven.
     let pressed = pressing_counts(1.0);
+    let above = pressing_counts(-2.0);
     let mut counts = pressed;
     counts[0] = 30;
     for (name, part, fault) in cases {
@@ -310,6 +314,8 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
                 rig.ctl.tick(None);
             }
             rig.home.value.set(0);
+            rig.set_counts(above);
+            rig.ctl.tick(None);
             rig.set_counts(pressed);
             for _ in 0..100 {
                 rig.ctl.tick(None);
@@ -321,6 +327,8 @@ fn a_failure_at_every_part_ends_at_zero_duty_and_the_driver_off() {
                 rig.ctl.tick(None);
             }
             rig.home.value.set(0);
+            rig.set_counts(above);
+            rig.ctl.tick(None);
             rig.set_counts(pressed);
             for _ in 0..100 {
                 rig.ctl.tick(None);

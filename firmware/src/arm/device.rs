@@ -153,6 +153,10 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     /// (see [`ArmDevice::with_passivity`]).
     passivity: Option<(PassivityObserver, PassivityLimits)>,
     watching: bool,
+    /// The probe came into the tissue's frame below its surface's rest height (from
+    /// beside or beneath it, or homed there): no contact until it rises to that height
+    /// inside the frame ([`ArmDevice::below_entry`]).
+    below_entry: bool,
     /// Homed at the last read: that tick's write is zero duty (its force was computed
     /// with the gain of before; the link's ramp starts from the next).
     fresh_home: bool,
@@ -188,16 +192,14 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             trims: Trims::default(),
             passivity: None,
             watching: false,
+            below_entry: true,
         }
     }
 
     /// The device with a passivity observer on the force it renders: energy put into
     /// the hand beyond `limits` is [`ArmFault::EnergyOut`] (zero duty first). It
     /// watches while the probe is within the tissue frame's range, from the first tick
-    /// there with no force; beyond the range it forgets. (A probe that enters the range
-    /// below the tissue's surface, as the simulated arm's approach does at its edge, is
-    /// met by the contact with a force it did not earn: that pop-through is the
-    /// contact's to mend, and is not taken for the device's own output.)
+    /// there with no force; beyond the range it forgets.
     pub fn with_passivity(mut self, limits: PassivityLimits) -> Self {
         self.passivity = Some((PassivityObserver::default(), limits));
         self
@@ -302,6 +304,17 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
         self.enable.set_high().map_err(|_| ArmFault::Enable)
     }
 
+    /// Whether the probe is held out of contact because it came into the tissue's frame
+    /// below the surface's rest height (`z < 0`: from beside or beneath the frame, or
+    /// homed there). A contact starts only by coming down onto the surface: a probe that
+    /// appeared beneath it would otherwise be met at once by the whole depth's force (a
+    /// pop-through, up to the force limit, along whatever way the probe moves). Cleared
+    /// once the probe is at or above `z = 0` inside the frame. The height is the tissue's
+    /// at rest in the arm's tissue frame, before the link's pose (docs/safety.md).
+    pub fn below_entry(&self) -> bool {
+        self.below_entry
+    }
+
     /// Whether the arm has been homed.
     pub fn homed(&self) -> bool {
         self.homed
@@ -394,8 +407,16 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             // (Before homing the counts mean nothing and every duty is zero.)
             self.check_speed(deltas, pose.probe)?;
         }
-        if pose.flags & OUTSIDE != 0 {
-            // Beyond the tissue's frame: far above it, no contact.
+        let below = pose.probe[2] < Length::ZERO;
+        if pose.flags & OUTSIDE != 0 || settled {
+            // Beyond the tissue's frame (or just homed): no contact, and none on coming
+            // into it below the surface.
+            self.below_entry |= below;
+        } else if !below {
+            self.below_entry = false;
+        }
+        if pose.flags & OUTSIDE != 0 || self.below_entry {
+            // Far above the tissue: no contact.
             return Ok([Length::ZERO, Length::ZERO, Length::MAX]);
         }
         Ok(pose.probe)

@@ -1,5 +1,5 @@
 //! The device file (TOML, docs/arm.md): `[arm]`, `[joint.a]`, `[joint.b]`, `[joint.c]`,
-//! optionally `[gravity]`; every key required but `gravity.g`. The same strictness as a
+//! optionally `[gravity]` and `[stability]`; every key required but `gravity.g`. The same strictness as a
 //! parameter file: an unknown key (with the nearest known one), a missing one, a
 //! non-number or a value out of its range is one line naming the file, the line and the
 //! key.
@@ -40,6 +40,9 @@ const GRAVITY: [&str; 5] = [
     "g",
 ];
 
+/// The keys of `[stability]`.
+const STABILITY: [&str; 2] = ["coupling_damping_n_s_m", "max_coupling_n_mm"];
+
 /// Every key as `section.key`.
 fn all_keys() -> Vec<String> {
     let mut v: Vec<String> = ARM.iter().map(|k| format!("arm.{k}")).collect();
@@ -47,8 +50,150 @@ fn all_keys() -> Vec<String> {
         v.extend(JOINT.iter().map(|k| format!("joint.{j}.{k}")));
     }
     v.extend(GRAVITY.iter().map(|k| format!("gravity.{k}")));
-    v.extend(["arm", "joint.a", "joint.b", "joint.c", "gravity"].map(String::from));
+    v.extend(STABILITY.iter().map(|k| format!("stability.{k}")));
+    v.extend(
+        [
+            "arm",
+            "joint.a",
+            "joint.b",
+            "joint.c",
+            "gravity",
+            "stability",
+        ]
+        .map(String::from),
+    );
     v
+}
+
+/// The arm's stable region as measured on its simulated body (`mccs arm stability`,
+/// docs/safety.md): at each coupling damping, the largest coupling stiffness with which
+/// a held press showed no cycle and put out no energy.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StableRegion {
+    /// `(damping N·s/m, stiffness N/mm)`, the dampings rising.
+    pub points: Vec<(f64, f64)>,
+}
+
+impl StableRegion {
+    /// The region's stiffness at `damping`: a measured one's, or between two the lower
+    /// of theirs (nothing is known between them; None: outside them).
+    pub fn max_coupling(&self, damping: f64) -> Option<f64> {
+        let p = &self.points;
+        if let Some(&(_, k)) = p.iter().find(|(b, _)| *b == damping) {
+            return Some(k);
+        }
+        p.windows(2).find_map(|w| {
+            let ((b0, k0), (b1, k1)) = (w[0], w[1]);
+            (b0 < damping && damping < b1).then_some(k0.min(k1))
+        })
+    }
+}
+
+/// Reads a device file's `[stability]` (None: the file has none).
+pub fn read_stability(path: &Path) -> Result<Option<StableRegion>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    parse_stability(&text, path)
+}
+
+/// Parses and checks a device file's `[stability]`: two lists of 1 to 16 numbers of
+/// the same length, the dampings (0 … 1000 N·s/m) rising, each stiffness > 0 and
+/// ≤ 1000 N/mm. The rest of the file is checked as [`parse`] does.
+pub fn parse_stability(text: &str, path: &Path) -> Result<Option<StableRegion>, String> {
+    with_doc(text, path, |doc| {
+        spec_of(doc)?;
+        stability_of(doc)
+    })
+}
+
+/// The stable region a checked document holds, if any.
+fn stability_of(doc: &Doc) -> Result<Option<StableRegion>, String> {
+    if doc.section("stability").is_none() {
+        return Ok(None);
+    }
+    let list = |key: &str, ok: &dyn Fn(f64) -> bool, rule: &str| -> Result<Vec<f64>, String> {
+        let v = doc
+            .section("stability")
+            .and_then(|t| t.get(key))
+            .ok_or_else(|| format!("{}: missing", doc.at("stability", key)))?;
+        let xs: Option<Vec<f64>> = v.as_array().map(|a| {
+            a.iter()
+                .map(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+                .collect::<Option<Vec<f64>>>()
+                .unwrap_or_default()
+        });
+        match xs {
+            Some(xs) if (1..=16).contains(&xs.len()) && xs.iter().all(|&x| ok(x)) => Ok(xs),
+            _ => Err(format!(
+                "{}: must be a list of 1 to 16 numbers, {rule}",
+                doc.at("stability", key)
+            )),
+        }
+    };
+    let dampings = list(
+        "coupling_damping_n_s_m",
+        &|b| (0.0..=1000.0).contains(&b),
+        "each 0 … 1000 N·s/m",
+    )?;
+    let stiffness = list(
+        "max_coupling_n_mm",
+        &|k| k > 0.0 && k <= 1000.0,
+        "each > 0 and ≤ 1000 N/mm",
+    )?;
+    if stiffness.len() != dampings.len() {
+        return Err(format!(
+            "{}: must have one value for each of coupling_damping_n_s_m's {}",
+            doc.at("stability", "max_coupling_n_mm"),
+            dampings.len()
+        ));
+    }
+    if dampings.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(format!(
+            "{}: the dampings must rise",
+            doc.at("stability", "coupling_damping_n_s_m")
+        ));
+    }
+    Ok(Some(StableRegion {
+        points: dampings.into_iter().zip(stiffness).collect(),
+    }))
+}
+
+/// `text` with its `[stability]` section set to `region` (the old one, its comments
+/// within it, dropped; the new one last), under `comment` (each line a `#` comment).
+pub fn with_stability(text: &str, region: &StableRegion, comment: &str) -> String {
+    let mut kept: Vec<&str> = Vec::new();
+    let mut skipping = false;
+    for line in text.lines() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            skipping = t == "[stability]";
+        }
+        if !skipping {
+            kept.push(line);
+        }
+    }
+    while kept.last().is_some_and(|l| l.trim().is_empty()) {
+        kept.pop();
+    }
+    let list = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        region
+            .points
+            .iter()
+            .map(|p| format!("{:?}", f(p)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut out = kept.join("\n");
+    out.push_str("\n\n[stability]\n");
+    for l in comment.lines() {
+        out.push_str(&format!("# {l}\n"));
+    }
+    out.push_str(&format!(
+        "coupling_damping_n_s_m = [{}]\nmax_coupling_n_mm = [{}]\n",
+        list(&|p| p.0),
+        list(&|p| p.1)
+    ));
+    out
 }
 
 /// Reads and checks a device file.
@@ -58,8 +203,12 @@ pub fn read(path: &Path) -> Result<ArmSpec, String> {
     parse(&text, path)
 }
 
-/// Parses and checks device-file text; `path` names it in errors.
-pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
+/// The text as a document with known keys only, handed to `read`.
+fn with_doc<T>(
+    text: &str,
+    path: &Path,
+    read: impl FnOnce(&Doc) -> Result<T, String>,
+) -> Result<T, String> {
     let file = path.display().to_string();
     let table = toml_table(text, &file)?;
     let doc = Doc {
@@ -68,6 +217,16 @@ pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
         table: &table,
     };
     doc.known_keys_only()?;
+    read(&doc)
+}
+
+/// Parses and checks device-file text; `path` names it in errors.
+pub fn parse(text: &str, path: &Path) -> Result<ArmSpec, String> {
+    with_doc(text, path, spec_of)
+}
+
+/// The arm a checked document describes.
+fn spec_of(doc: &Doc) -> Result<ArmSpec, String> {
     let spec = ArmSpec {
         base_height_mm: doc.number("arm", "base_height_mm")?,
         upper_arm_mm: doc.number("arm", "upper_arm_mm")?,
@@ -135,6 +294,7 @@ impl Doc<'_> {
             let keys: &[&str] = match name.as_str() {
                 "arm" => &ARM,
                 "gravity" => &GRAVITY,
+                "stability" => &STABILITY,
                 "joint" => {
                     self.known_joints(name, value)?;
                     continue;

@@ -58,6 +58,22 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// The arm's stable region on its simulated body (docs/safety.md): the board's loop
+    /// closed through the arm's dynamics, a held press with each hand of the range; at
+    /// each coupling damping, prints `STABLE damping_n_s_m=… max_coupling_n_mm=…
+    /// first_unstable=…` (about a minute each), and with --out writes the device file's
+    /// [stability] section, which `mccs check --device arm` holds couplings to half of.
+    Stability {
+        /// The device file.
+        #[arg(long)]
+        device: PathBuf,
+        /// The coupling dampings, N·s/m, rising (0 … 1000), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "0,0.5,1,2,5")]
+        damping: Vec<f64>,
+        /// Write the device file with the measured [stability] here (it may be --device).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// The rows of a numeric CSV file with exactly `header` ([`columns::parse`]).
@@ -85,7 +101,80 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             poses,
             out: written,
         } => calibrate(&device, &poses, written.as_deref(), out),
+        Command::Stability {
+            device,
+            damping,
+            out: written,
+        } => stability(&device, &damping, written.as_deref(), out),
     }
+}
+
+/// `mccs arm stability`: the region, its lines, and the device file written with it.
+fn stability(
+    device: &Path,
+    dampings: &[f64],
+    written: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    use crate::arm::closed_loop::{largest_stable, HANDS};
+    use crate::arm::dynamics::BodySpec;
+    let spec = device_file::read(device).map_err(CliError::new)?;
+    Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
+    if let Some(p) = written {
+        super::check_writable("--out", p)?;
+    }
+    let rising = dampings.windows(2).all(|w| w[1] > w[0]);
+    if dampings.is_empty()
+        || dampings.len() > 16
+        || !rising
+        || dampings.iter().any(|b| !(0.0..=1000.0).contains(b))
+    {
+        return Err(arg_error(
+            "--damping",
+            "must be 1 to 16 dampings, rising, each 0 … 1000 N·s/m",
+        ));
+    }
+    let config = haptic_f405::BOARD;
+    let mut points = Vec::new();
+    for &b in dampings {
+        eprintln!(
+            "mccs arm stability: damping {b} N·s/m: a held press with each of {} hands, coupling 0.25 N/mm up by √2 until one is not stable",
+            HANDS.len()
+        );
+        let (k, why) = largest_stable(&config, &spec, BodySpec::STAND_IN, &HANDS, b, |k| {
+            eprintln!("mccs arm stability:   coupling {k:.3} N/mm");
+        });
+        if k == 0.0 {
+            return Err(CliError::new(format!(
+                "{}: no coupling is stable at {b} N·s/m: {why}",
+                device.display()
+            )));
+        }
+        writeln!(
+            out,
+            "STABLE damping_n_s_m={b} max_coupling_n_mm={k:.3} first_unstable=\"{why}\""
+        )
+        .map_err(io_error)?;
+        out.flush().map_err(io_error)?;
+        points.push((b, (k * 1000.0).round() / 1000.0));
+    }
+    if let Some(path) = written {
+        let text = std::fs::read_to_string(device)
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
+        let region = device_file::StableRegion { points };
+        let new = device_file::with_stability(
+            &text,
+            &region,
+            "measured by `mccs arm stability` on the simulated arm (docs/safety.md):\nat each coupling damping, the largest coupling stiffness a held press\nwas stable with; `mccs check --device arm` allows half of it.",
+        );
+        std::fs::write(path, new)
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
+        eprintln!(
+            "mccs: wrote {} with the measured [stability]",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// The device file as the fixed-point arm and its `f64` twin.

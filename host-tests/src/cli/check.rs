@@ -74,9 +74,14 @@ pub(super) struct Args {
     /// The core it is to run on.
     #[arg(long, value_enum, default_value_t = CoreArg::M4f)]
     core: CoreArg,
-    /// The tick it is to fit: the bare patch, or the arm board's whole tick.
+    /// The tick it is to fit: the bare patch, or the arm board's whole tick (which also
+    /// holds the coupling to half the arm's stable region).
     #[arg(long, value_enum, default_value_t = DeviceArg::Patch)]
     device: DeviceArg,
+    /// With --device arm: the device file whose [stability] the coupling is held to
+    /// (default: the board's, devices/woodenhaptics.toml).
+    #[arg(long)]
+    arm_file: Option<PathBuf>,
     /// Surface nodes per side, N (default: the core's demo patch, m4f 8, m3 5, m0 4).
     #[arg(long)]
     grid: Option<usize>,
@@ -120,6 +125,9 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "must be a whole number of Hz, 1 … 100000",
         ));
     }
+    if a.device == DeviceArg::Arm {
+        coupling_within_region(a.arm_file.as_deref(), &a.tuning)?;
+    }
     let substep = substep_figure(core, n, a.integrator)?;
     let cfg = SolverConfig {
         integrator: a.integrator.into(),
@@ -162,6 +170,50 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             "the tick would take {tick} instructions, over its budget of {budget}: a smaller --grid, a lower --rate or a heavier --node-mass"
         )))
     }
+}
+
+/// The board's device file, as committed: its [stability] is the default region.
+const BOARD_ARM: &str = include_str!("../../../devices/woodenhaptics.toml");
+
+/// With `--device arm`: the coupling at most half the arm's stable region at its
+/// damping (`arm_file`'s [stability], or the board's), or the failed check naming both.
+fn coupling_within_region(
+    arm_file: Option<&std::path::Path>,
+    tuning: &TuningArgs,
+) -> Result<(), CliError> {
+    use crate::arm::device_file;
+    let (path, region) = match arm_file {
+        Some(p) => (p.to_path_buf(), device_file::read_stability(p)),
+        None => {
+            let p = PathBuf::from("devices/woodenhaptics.toml");
+            let r = device_file::parse_stability(BOARD_ARM, &p);
+            (p, r)
+        }
+    };
+    let file = path.display();
+    let Some(region) = region.map_err(CliError::new)? else {
+        eprintln!(
+            "mccs check: warning: {file} has no [stability] (`mccs arm stability` measures it): the coupling is not held to the arm's stable region"
+        );
+        return Ok(());
+    };
+    let (k, b) = (tuning.coupling_stiffness, tuning.coupling_damping);
+    let Some(edge) = region.max_coupling(b) else {
+        let (lo, hi) = (region.points[0].0, region.points[region.points.len() - 1].0);
+        return Err(CliError::check_failed(format!(
+            "--coupling-damping {b} N·s/m is outside the arm's measured stable region ({lo} … {hi} N·s/m, {file} [stability])"
+        )));
+    };
+    if k > edge / 2.0 {
+        return Err(CliError::check_failed(format!(
+            "--coupling-stiffness {k} N/mm is over half the arm's stable region at {b} N·s/m ({edge:.3} N/mm measured, {file} [stability]): at most {:.3}",
+            edge / 2.0
+        )));
+    }
+    eprintln!(
+        "mccs check: the coupling, {k} N/mm at {b} N·s/m, is within half the arm's stable region there ({edge:.3} N/mm, {file} [stability])"
+    );
+    Ok(())
 }
 
 /// The bench's measured substep cost for the `n × n` patch on `core` with `integrator`,

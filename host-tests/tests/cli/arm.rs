@@ -481,3 +481,74 @@ fn calibrate_refuses_what_cannot_give_masses() {
         &["ok.csv: the device file has no [gravity] section"],
     );
 }
+
+/// A device file's [stability] out of its rules is exit 2 and one line naming the file,
+/// the line and the key (read by `mccs check --device arm --arm-file`).
+#[test]
+fn a_bad_stable_region_names_the_file_line_and_key() {
+    let good_b = "coupling_damping_n_s_m = [0.0, 0.5, 1.0, 2.0, 5.0]";
+    let good_k = "max_coupling_n_mm = [16.0, 64.0, 64.0, 64.0, 64.0]";
+    assert!(WOODEN.contains(good_b) && WOODEN.contains(good_k));
+    let cases: [(&str, String, &str); 5] = [
+        (
+            "region_short.toml",
+            WOODEN.replace(good_k, "max_coupling_n_mm = [16.0, 64.0]"),
+            "stability.max_coupling_n_mm: must have one value for each of coupling_damping_n_s_m's 5",
+        ),
+        (
+            "region_falling.toml",
+            WOODEN.replace(good_b, "coupling_damping_n_s_m = [0.0, 0.5, 1.0, 5.0, 2.0]"),
+            "stability.coupling_damping_n_s_m: the dampings must rise",
+        ),
+        (
+            "region_zero.toml",
+            WOODEN.replace(good_k, "max_coupling_n_mm = [0.0, 64.0, 64.0, 64.0, 64.0]"),
+            "stability.max_coupling_n_mm: must be a list of 1 to 16 numbers, each > 0 and ≤ 1000 N/mm",
+        ),
+        (
+            "region_missing.toml",
+            WOODEN.replace(good_k, ""),
+            "stability.max_coupling_n_mm: missing",
+        ),
+        (
+            "region_typo.toml",
+            WOODEN.replace("max_coupling_n_mm", "max_coupling_n_m"),
+            "stability.max_coupling_n_m: unknown key; did you mean stability.max_coupling_n_mm?",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let path = temp_file(name, &text);
+        let out = mccs(&[
+            "check",
+            "--params",
+            "params/table2.toml",
+            "--device",
+            "arm",
+            "--arm-file",
+            path.to_str().unwrap(),
+        ]);
+        // (A missing key has no line of its own.)
+        let line = if name == "region_missing.toml" {
+            name
+        } else {
+            "line "
+        };
+        assert_one_line_error(&out, &[name, line, needle]);
+    }
+}
+
+/// `--damping` out of its rules is exit 2 naming it, before any simulation runs.
+#[test]
+fn stability_refuses_bad_dampings() {
+    for bad in ["1,0.5", "-1", "2000"] {
+        let out = mccs(&[
+            "arm",
+            "stability",
+            "--device",
+            "devices/woodenhaptics.toml",
+            "--damping",
+            bad,
+        ]);
+        assert_one_line_error(&out, &["--damping", "rising, each 0 … 1000 N·s/m"]);
+    }
+}

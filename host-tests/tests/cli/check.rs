@@ -181,3 +181,56 @@ fn each_cores_largest_trainer_tick() {
         }
     }
 }
+
+/// `--device arm` holds the coupling to half the arm's stable region at its damping (the
+/// device file's [stability], `mccs arm stability`): at half, it goes on to the tick;
+/// over it, or at a damping outside the region, exit 1 with the reason; a device file
+/// without the region is a warning.
+#[test]
+fn the_arm_s_coupling_is_held_to_half_its_stable_region() {
+    let file = root().join("devices/woodenhaptics.toml");
+    let region = mccs_host::arm::device_file::read_stability(&file)
+        .unwrap()
+        .unwrap();
+    let edge = region.max_coupling(0.5).unwrap();
+    let run = |k: f64, b: f64, extra: &[&str]| {
+        let (k, b) = (k.to_string(), b.to_string());
+        let mut args = vec![
+            "check",
+            "--params",
+            "params/table2.toml",
+            "--device",
+            "arm",
+            "--coupling-stiffness",
+            &k,
+            "--coupling-damping",
+            &b,
+        ];
+        args.extend_from_slice(extra);
+        let out = mccs(&args);
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (_, err) = run(edge / 2.0, 0.5, &[]);
+    assert!(err.contains("within half the arm's stable region"), "{err}");
+    let (code, err) = run(edge / 2.0 * 1.01, 0.5, &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("over half the arm's stable region at 0.5 N·s/m"),
+        "{err}"
+    );
+    let (code, err) = run(1.0, 999.0, &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("outside the arm's measured stable region"),
+        "{err}"
+    );
+    // A device file without [stability]: a warning, and the check goes on.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let bare = text.split("\n[stability]").next().unwrap().to_string();
+    let bare = temp_file("arm_without_region.toml", &bare);
+    let (_, err) = run(500.0, 0.5, &["--arm-file", bare.to_str().unwrap()]);
+    assert!(err.contains("has no [stability]"), "{err}");
+}

@@ -1,0 +1,517 @@
+//! The board's arm loop closed through the arm's body: the board's own arm device and
+//! roaming controller (`haptic_f405::arm`, as the board builds them) read the counts of
+//! an [`ArmBody`] and drive its amplifiers, and a [`Hand`] leads the probe home, down to
+//! the tissue and along the demo's palpation. Each tick: the counts are read, the tick
+//! runs, and its duties reach the motors after the read-to-write delay (the tick's
+//! budget, half a tick: the latest they may), through ten steps of the body a tick.
+
+use super::dynamics::{ArmBody, BodySpec, Hand};
+use super::twin::ArmTwin;
+use embedded_hal::digital::{ErrorType, InputPin, OutputPin};
+use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm};
+use haptic_f405::config::BoardConfig;
+use haptic_f405::device::{BoardController, BoardRoaming};
+use haptic_f405::tissue::TISSUE;
+use mccs::ArmSpec;
+use mccs_firmware::arm::device::{Joint, PartFailed};
+use mccs_firmware::arm::plant::{
+    APPROACH_HEIGHT_MM, APPROACH_TICKS, DESCENT_TICKS, HOME_TICKS, PALPATION_TICKS,
+};
+use mccs_firmware::probe_path::ProbePath;
+use nalgebra::Vector3;
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// Body steps per tick.
+pub const STEPS_PER_TICK: u32 = 10;
+/// Steps of a tick before its duties reach the motors: half a tick, the tick's budget.
+pub const DELAY_STEPS: u32 = STEPS_PER_TICK / 2;
+/// A PWM channel's full scale (the board's TIM1 at 20 kHz from 168 MHz).
+const MAX_DUTY: u16 = 8400;
+/// The ticks before the palpation: the home pose, the rise and the descent.
+pub const LEAD_TICKS: u32 = HOME_TICKS + APPROACH_TICKS;
+
+/// What the board's parts read and were last given.
+#[derive(Clone, Copy, Debug, Default)]
+struct Wires {
+    counts: [i32; 3],
+    pwm: [u16; 3],
+    forward: [bool; 3],
+    enabled: bool,
+    home: bool,
+}
+
+type Shared = Rc<RefCell<Wires>>;
+
+/// Joint `k`'s counter, PWM channel and direction pin.
+pub struct BodyJoint(usize, Shared);
+impl Joint for BodyJoint {
+    fn read(&mut self) -> Result<u16, PartFailed> {
+        Ok(self.1.borrow().counts[self.0] as u16)
+    }
+    fn duty(&mut self, duty: u16) -> Result<(), PartFailed> {
+        self.1.borrow_mut().pwm[self.0] = duty.min(MAX_DUTY);
+        Ok(())
+    }
+    fn direction(&mut self, forward: bool) -> Result<(), PartFailed> {
+        self.1.borrow_mut().forward[self.0] = forward;
+        Ok(())
+    }
+    fn max_duty(&self) -> u16 {
+        MAX_DUTY
+    }
+}
+
+/// The driver's enable.
+pub struct BodyEnable(Shared);
+impl ErrorType for BodyEnable {
+    type Error = core::convert::Infallible;
+}
+impl OutputPin for BodyEnable {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.0.borrow_mut().enabled = false;
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.0.borrow_mut().enabled = true;
+        Ok(())
+    }
+}
+
+/// The home input.
+pub struct BodyHome(Shared);
+impl ErrorType for BodyHome {
+    type Error = core::convert::Infallible;
+}
+impl InputPin for BodyHome {
+    fn is_high(&mut self) -> Result<bool, Self::Error> {
+        Ok(self.0.borrow().home)
+    }
+    fn is_low(&mut self) -> Result<bool, Self::Error> {
+        Ok(!self.0.borrow().home)
+    }
+}
+
+/// The board's controller on the body's parts.
+pub type BodyController =
+    BoardController<LinkedArm<BodyJoint, BodyJoint, BodyJoint, BodyEnable, BodyHome>, BoardRoaming>;
+
+/// Where the hand leads the probe (device frame, mm) at each tick: home, a rise in joint
+/// space to above the palpation's start, straight down to it, then the palpation over
+/// and over; or held at one point from a tick on.
+pub struct Lead {
+    home: [f64; 3],
+    above: [f64; 3],
+    start: [f64; 3],
+    palpation: ProbePath<9>,
+    origin: [f64; 3],
+    twin: ArmTwin,
+    /// From a tick on, the hand goes to a point and holds it there.
+    pub hold: Option<HoldAt>,
+}
+
+/// A hold: from tick `from`, the hand waits `wait` ticks where it is led then, moves to
+/// `to` (device frame, mm) over `ramp` ticks (smoothly), and holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoldAt {
+    /// See [`HoldAt`].
+    pub from: u32,
+    /// See [`HoldAt`].
+    pub wait: u32,
+    /// See [`HoldAt`].
+    pub ramp: u32,
+    /// See [`HoldAt`].
+    pub to: [f64; 3],
+}
+
+fn smooth(t: f64) -> f64 {
+    let t = t.clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+impl Lead {
+    /// The demo's palpation at the board's tick rate, on the arm of `spec`.
+    pub fn palpation(config: &BoardConfig, spec: &ArmSpec) -> Lead {
+        let twin = ArmTwin { spec: *spec };
+        let palpation = mccs_firmware::palpation_path(config.tick_hz)
+            .unwrap_or_else(|e| panic!("the demo's palpation: {e:?}"));
+        let origin = spec.tissue_origin_mm;
+        let start: [f64; 3] =
+            std::array::from_fn(|k| palpation.at(0)[k].to_num::<f64>() + origin[k]);
+        let above = [start[0], start[1], start[2] + APPROACH_HEIGHT_MM];
+        let home_angles = spec.joints.map(|j| j.home_angle_deg.to_radians());
+        Lead {
+            home: twin.fk(home_angles),
+            above,
+            start,
+            palpation,
+            origin,
+            twin,
+            hold: None,
+        }
+    }
+
+    /// A point of the tissue's frame (mm) in the device frame.
+    pub fn device(&self, tissue: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|k| tissue[k] + self.origin[k])
+    }
+
+    /// Where the probe is led at `tick`, device frame, mm.
+    pub fn at(&self, tick: u32) -> [f64; 3] {
+        match self.hold {
+            Some(h) if tick >= h.from => {
+                let p = self.path(h.from);
+                let t =
+                    smooth((tick - h.from).saturating_sub(h.wait) as f64 / h.ramp.max(1) as f64);
+                std::array::from_fn(|k| p[k] + (h.to[k] - p[k]) * t)
+            }
+            _ => self.path(tick),
+        }
+    }
+
+    /// Where the path leads at `tick` (no hold), device frame, mm.
+    fn path(&self, tick: u32) -> [f64; 3] {
+        let rise_end = LEAD_TICKS - DESCENT_TICKS;
+        if tick < HOME_TICKS {
+            self.home
+        } else if tick < rise_end {
+            let t = smooth((tick - HOME_TICKS) as f64 / (rise_end - HOME_TICKS) as f64);
+            let from = self.twin.spec.joints.map(|j| j.home_angle_deg.to_radians());
+            let to = self.twin.ik(self.above).unwrap_or(from);
+            self.twin
+                .fk(std::array::from_fn(|k| from[k] + (to[k] - from[k]) * t))
+        } else if tick < LEAD_TICKS {
+            let t = smooth((tick - rise_end) as f64 / DESCENT_TICKS as f64);
+            let mut p = self.above;
+            p[2] = self.start[2] + APPROACH_HEIGHT_MM * (1.0 - t);
+            p
+        } else {
+            let t = (tick - LEAD_TICKS) % PALPATION_TICKS;
+            self.device(self.palpation.at(t).map(|c| c.to_num::<f64>()))
+        }
+    }
+}
+
+/// The loop: the body, the hand, the board's controller, the lead.
+pub struct ClosedLoop {
+    /// The arm's body.
+    pub body: ArmBody,
+    /// The hand on the handle (change it to let go).
+    pub hand: Hand,
+    /// Where the hand leads.
+    pub lead: Lead,
+    ctl: BodyController,
+    wires: Shared,
+    tick: u32,
+    tick_hz: f64,
+}
+
+/// Why the loop could not be built: the board refused its configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refused(pub String);
+
+impl ClosedLoop {
+    /// The board of `config` on the arm of `spec` with the body `body`, held by `hand`,
+    /// at home.
+    pub fn new(
+        config: &BoardConfig,
+        spec: &ArmSpec,
+        body: BodySpec,
+        hand: Hand,
+    ) -> Result<Self, Refused> {
+        let wires: Shared = Rc::default();
+        let joint = |k| BodyJoint(k, wires.clone());
+        let device = arm_device(
+            config,
+            spec,
+            (joint(0), joint(1), joint(2)),
+            BodyEnable(wires.clone()),
+            BodyHome(wires.clone()),
+        )
+        .map_err(|e| Refused(e.fault().to_string()))?;
+        let mut slot = None;
+        arm_controller_into(config, TISSUE, device, &mut slot)
+            .map_err(|(e, _)| Refused(e.fault().to_string()))?;
+        let mut ctl: BodyController = slot.ok_or_else(|| Refused("no controller".into()))?;
+        // Full force at once (the link's guard ramps it on the board).
+        ctl.device_mut().set_gain(u16::MAX);
+        Ok(Self {
+            body: ArmBody::new(*spec, body),
+            hand,
+            lead: Lead::palpation(config, spec),
+            ctl,
+            wires,
+            tick: 0,
+            tick_hz: config.tick_hz as f64,
+        })
+    }
+
+    /// Ticks run.
+    pub fn ticks(&self) -> u32 {
+        self.tick
+    }
+
+    /// The board's fault, if it has one.
+    pub fn fault(&self) -> Option<String> {
+        self.ctl.telemetry().fault.map(|f| f.to_string())
+    }
+
+    /// The energy the board's passivity observer holds, mJ (negative: put out).
+    pub fn observer_mj(&self) -> f64 {
+        self.ctl.device().inner().passivity_mj().unwrap_or(0.0)
+    }
+
+    /// The driver is off and every duty is zero: the safe state.
+    pub fn safe(&self) -> bool {
+        let w = self.wires.borrow();
+        !w.enabled && w.pwm == [0; 3]
+    }
+
+    /// The motors' commanded currents, A, from the parts' state.
+    fn command(&self) -> [f64; 3] {
+        let w = *self.wires.borrow();
+        std::array::from_fn(|k| {
+            if !w.enabled {
+                return 0.0;
+            }
+            let sign = if w.forward[k] { 1.0 } else { -1.0 };
+            sign * w.pwm[k] as f64 / MAX_DUTY as f64 * self.lead.twin.spec.joints[k].max_current_a
+        })
+    }
+
+    /// One tick: counts read, the board's tick, the body driven through it. The force
+    /// the tick rendered, N (tissue frame).
+    pub fn step(&mut self) -> [f64; 3] {
+        {
+            let mut w = self.wires.borrow_mut();
+            w.counts = self.body.counts();
+            w.home = self.tick < HOME_TICKS;
+        }
+        let before = self.command();
+        let force = self.ctl.tick(None).map(|f| f.to_num::<f64>());
+        let after = self.command();
+        let led = |t: u32| Vector3::from(self.lead.at(t)) / 1000.0;
+        let (from, to) = (led(self.tick), led(self.tick + 1));
+        let velocity = (to - from) * self.tick_hz;
+        let dt = 1.0 / (self.tick_hz * STEPS_PER_TICK as f64);
+        for i in 0..STEPS_PER_TICK {
+            let command = if i < DELAY_STEPS { before } else { after };
+            let at = from + (to - from) * (i as f64 / STEPS_PER_TICK as f64);
+            self.body.step(dt, command, &self.hand, at, velocity);
+        }
+        self.tick += 1;
+        force
+    }
+
+    /// The probe in the tissue's frame, mm.
+    pub fn probe_mm(&self) -> [f64; 3] {
+        let p = self.body.probe().0;
+        std::array::from_fn(|k| p[k] * 1000.0 - self.lead.origin[k])
+    }
+}
+
+/// A held press waits this long above the tissue (the hand catching up with its lead),
+/// then goes down over as long, ticks.
+pub const PRESS_TICKS: u32 = 500;
+
+/// A press held: what [`hold`] measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Held {
+    /// Each joint's cycle over the window, counts: the range (largest less smallest) of
+    /// its counts about their moving mean ([`CYCLE_MEAN_TICKS`]; a press that still
+    /// creeps as the tissue relaxes is not a cycle).
+    pub cycle_counts: [f64; 3],
+    /// The energy the device rendered over the window, mJ (positive: put into the hand).
+    pub window_mj: f64,
+    /// Over the whole run.
+    pub run_mj: f64,
+    /// The largest force over the window, N.
+    pub most_n: f64,
+    /// The board's fault, and its tick.
+    pub fault: Option<(u32, String)>,
+}
+
+/// The hand leads the probe down to just above the tissue at the palpation's start,
+/// waits there, goes `depth_mm` into it (each [`PRESS_TICKS`]) and holds; `settle`
+/// ticks later, a window of `window` ticks.
+pub fn hold(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hand: Hand,
+    depth_mm: f64,
+    settle: u32,
+    window: u32,
+) -> Result<Held, Refused> {
+    let mut lp = ClosedLoop::new(config, spec, body, hand)?;
+    let start = lp.lead.at(LEAD_TICKS);
+    lp.lead.hold = Some(HoldAt {
+        from: LEAD_TICKS,
+        wait: PRESS_TICKS,
+        ramp: PRESS_TICKS,
+        to: [start[0], start[1], lp.lead.device([0.0; 3])[2] - depth_mm],
+    });
+    let settle = settle + 2 * PRESS_TICKS;
+    let end = LEAD_TICKS + settle + window;
+    let mut seen: Vec<[i32; 3]> = Vec::with_capacity(window as usize);
+    let mut before = 0.0;
+    let mut most = 0.0f64;
+    while lp.ticks() < end {
+        let t = lp.ticks();
+        if t == LEAD_TICKS + settle {
+            before = lp.body.rendered_j;
+        }
+        let f = lp.step();
+        if let Some(fault) = lp.fault() {
+            return Ok(Held {
+                cycle_counts: [f64::INFINITY; 3],
+                window_mj: f64::NAN,
+                run_mj: lp.body.rendered_j * 1e3,
+                most_n: most,
+                fault: Some((t, fault)),
+            });
+        }
+        if t >= LEAD_TICKS + settle {
+            seen.push(lp.body.counts());
+            most = most.max(f.iter().map(|x| x * x).sum::<f64>().sqrt());
+        }
+    }
+    Ok(Held {
+        cycle_counts: std::array::from_fn(|k| cycle_range(seen.iter().map(|c| c[k] as f64))),
+        window_mj: (lp.body.rendered_j - before) * 1e3,
+        run_mj: lp.body.rendered_j * 1e3,
+        most_n: most,
+        fault: None,
+    })
+}
+
+/// The hands the stable region is measured with: the corners of the range a hand on a
+/// surgical trainer's handle spans (0.1–0.5 kg, 2–10 N·s/m, 100–1000 N/m).
+pub const HANDS: [Hand; 8] = {
+    let mut hands = [Hand::OFF; 8];
+    let mut i = 0;
+    while i < 8 {
+        hands[i] = Hand {
+            mass_kg: if i & 1 == 0 { 0.1 } else { 0.5 },
+            damping_n_s_m: if i & 2 == 0 { 2.0 } else { 10.0 },
+            stiffness_n_m: if i & 4 == 0 { 100.0 } else { 1000.0 },
+        };
+        i += 1;
+    }
+    hands
+};
+
+/// How deep the hand leads a held press, mm.
+pub const HOLD_DEPTH_MM: f64 = 3.0;
+/// Ticks a held press settles, then the ticks it is watched.
+pub const HOLD_SETTLE: u32 = 2000;
+/// See [`HOLD_SETTLE`].
+pub const HOLD_WINDOW: u32 = 1000;
+/// The largest cycle a joint may show over a held press's window, counts (no limit
+/// cycle above it).
+pub const STILL_COUNTS: f64 = 2.0;
+
+/// Ticks of the moving mean a joint's cycle is measured about (0.1 s at 1 kHz).
+pub const CYCLE_MEAN_TICKS: usize = 101;
+
+/// The range of `xs` less their centred moving mean over [`CYCLE_MEAN_TICKS`] (where the
+/// mean has its whole span): a cycle, not a creep.
+fn cycle_range(xs: impl Iterator<Item = f64>) -> f64 {
+    let xs: Vec<f64> = xs.collect();
+    let w = CYCLE_MEAN_TICKS;
+    if xs.len() < w {
+        return 0.0;
+    }
+    let mut sum: f64 = xs[..w].iter().sum();
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for i in 0..=xs.len() - w {
+        if i > 0 {
+            sum += xs[i + w - 1] - xs[i - 1];
+        }
+        let r = xs[i + w / 2] - sum / w as f64;
+        lo = lo.min(r);
+        hi = hi.max(r);
+    }
+    hi - lo
+}
+
+/// Whether a held press is stable: no fault, no joint's counts spread over
+/// [`STILL_COUNTS`], no net energy out of the device over the run; or why not.
+pub fn verdict(h: &Held) -> Result<(), String> {
+    if let Some((t, f)) = &h.fault {
+        return Err(format!("the board faulted at tick {t}: {f}"));
+    }
+    if let Some(k) = (0..3).find(|&k| h.cycle_counts[k] > STILL_COUNTS) {
+        return Err(format!(
+            "joint {} cycles over {:.1} counts",
+            ["A", "B", "C"][k],
+            h.cycle_counts[k]
+        ));
+    }
+    if h.run_mj > 0.0 {
+        return Err(format!("the device put out {:.3} mJ net", h.run_mj));
+    }
+    Ok(())
+}
+
+/// [`hold`] as the stable region measures it: [`HOLD_DEPTH_MM`] deep, after
+/// [`HOLD_SETTLE`], over [`HOLD_WINDOW`].
+pub fn held_press(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hand: Hand,
+) -> Result<Held, Refused> {
+    hold(
+        config,
+        spec,
+        body,
+        hand,
+        HOLD_DEPTH_MM,
+        HOLD_SETTLE,
+        HOLD_WINDOW,
+    )
+}
+
+/// The coupling stiffnesses tried, N/mm: 0.25 to 1024 by factors of √2.
+pub fn stiffness_grid() -> impl Iterator<Item = f64> {
+    (0..=24).map(|i| 0.25 * 2f64.powf(i as f64 / 2.0))
+}
+
+/// The stable region's edge at one damping: the largest coupling stiffness on
+/// [`stiffness_grid`] below the first that is not stable with every hand of `hands`,
+/// and why that one is not (`None`: the board refused it, or the grid ran out).
+/// `progress` is called with each stiffness tried.
+pub fn largest_stable(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hands: &[Hand],
+    damping: f64,
+    mut progress: impl FnMut(f64),
+) -> (f64, String) {
+    let mut best = 0.0;
+    for k in stiffness_grid() {
+        progress(k);
+        let cfg = BoardConfig {
+            coupling_stiffness: k,
+            coupling_damping: damping,
+            ..*config
+        };
+        for hand in hands {
+            let why = match held_press(&cfg, spec, body, *hand) {
+                Err(Refused(e)) => format!("the board refuses it: {e}"),
+                Ok(h) => match verdict(&h) {
+                    Ok(()) => continue,
+                    Err(e) => format!(
+                        "{e} (hand {} kg, {} N·s/m, {} N/m)",
+                        hand.mass_kg, hand.damping_n_s_m, hand.stiffness_n_m
+                    ),
+                },
+            };
+            return (best, format!("{k:.3} N/mm: {why}"));
+        }
+        best = k;
+    }
+    (best, "the grid's end".into())
+}

@@ -1,0 +1,185 @@
+//! The board's arm loop closed through the arm's own dynamics
+//! (`mccs_host::arm::{dynamics, closed_loop}`): the board's arm device and roaming
+//! controller, as the board builds them, drive a body with inertia, friction, a current
+//! stage, whole-count encoders and half a tick's delay, held by a hand. docs/safety.md,
+//! "The arm's own dynamics", quotes the `ARMLOOP` lines.
+
+use haptic_f405::arm::ARM;
+use haptic_f405::{BoardConfig, BOARD};
+use mccs_firmware::arm::plant::PALPATION_TICKS;
+use mccs_host::arm::closed_loop::{
+    held_press, stiffness_grid, verdict, ClosedLoop, HoldAt, HANDS, HOLD_DEPTH_MM, LEAD_TICKS,
+};
+use mccs_host::arm::device_file;
+use mccs_host::arm::dynamics::{ArmBody, BodySpec, Hand};
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// The board's arm's stable region, as its device file holds it.
+fn region() -> device_file::StableRegion {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../devices/woodenhaptics.toml");
+    device_file::read_stability(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .unwrap_or_else(|| panic!("devices/woodenhaptics.toml has no [stability]"))
+}
+
+/// The board with the stiffest coupling `mccs check --device arm` accepts at its
+/// damping: half the region there.
+fn stiffest_board() -> BoardConfig {
+    let edge = region().max_coupling(BOARD.coupling_damping).unwrap();
+    BoardConfig {
+        coupling_stiffness: edge / 2.0,
+        ..BOARD
+    }
+}
+
+/// The body's own check: with no friction, no motor and no hand, a swinging arm keeps
+/// its energy to 0.2 % (the velocity-product terms are right; semi-implicit Euler's own
+/// bounded wobble is the rest), over 2 s of 0.1 ms steps.
+#[test]
+fn a_free_arm_swinging_keeps_its_energy() {
+    let body = BodySpec {
+        viscous_nm_s: [0.0; 3],
+        coulomb_nm: [0.0; 3],
+        ..BodySpec::STAND_IN
+    };
+    let mut arm = ArmBody::new(ARM, body);
+    arm.angle = [0.3, 0.5, 0.9];
+    arm.rate = [2.0, -1.0, 3.0];
+    let e0 = arm.energy(&Hand::OFF);
+    let mut most = 0.0f64;
+    for _ in 0..20_000 {
+        arm.step(
+            1e-4,
+            [0.0; 3],
+            &Hand::OFF,
+            Vector3::zeros(),
+            Vector3::zeros(),
+        );
+        most = most.max((arm.energy(&Hand::OFF) - e0).abs() / e0);
+    }
+    println!("ARMLOOP case=free_swing energy_drift={most:.2e}");
+    assert!(most < 2e-3, "the energy drifted by {most:e} of {e0} J");
+}
+
+/// Each hand of the range (0.1–0.5 kg, 2–10 N·s/m, 100–1000 N/m) leads the probe home,
+/// down and twice along the demo's palpation (10 s in all), with the stiffest coupling
+/// `mccs check --device arm` accepts: no fault, and no net energy out of the device.
+#[test]
+fn every_hand_palpates_10_s_at_the_stiffest_coupling_allowed_with_no_energy_out() {
+    let config = stiffest_board();
+    let ticks = 10_000;
+    assert!(LEAD_TICKS + 2 * PALPATION_TICKS <= ticks);
+    let mut most = f64::MIN;
+    for hand in HANDS {
+        let mut lp = ClosedLoop::new(&config, &ARM, BodySpec::STAND_IN, hand).unwrap();
+        let mut pressed = 0.0f64;
+        for t in 0..ticks {
+            let f = lp.step();
+            pressed = pressed.max(f[2]);
+            assert_eq!(lp.fault(), None, "tick {t}, hand {hand:?}");
+        }
+        let mj = lp.body.rendered_j * 1e3;
+        assert!(pressed > 0.2, "{hand:?}: pressed only {pressed} N");
+        assert!(mj <= 0.0, "{hand:?}: the device put out {mj} mJ");
+        most = most.max(mj);
+    }
+    println!(
+        "ARMLOOP case=palpation coupling_n_mm={:.3} hands={} most_energy_out_mj={most:.3}",
+        config.coupling_stiffness,
+        HANDS.len()
+    );
+}
+
+/// A held press at that coupling with each hand: no cycle over 2 counts, no energy
+/// out; then the hand lets go: the arm comes to rest, the board unfaulted.
+#[test]
+fn a_held_press_is_still_and_the_released_arm_comes_to_rest() {
+    let config = stiffest_board();
+    let mut worst = 0.0f64;
+    for hand in HANDS {
+        let h = held_press(&config, &ARM, BodySpec::STAND_IN, hand).unwrap();
+        assert_eq!(verdict(&h), Ok(()), "{hand:?}: {h:?}");
+        worst = worst.max(h.cycle_counts.iter().cloned().fold(0.0, f64::max));
+    }
+    println!("ARMLOOP case=held_press most_cycle_counts={worst:.2}");
+    // Released in the tissue (a light hand, held firmly: 1000 N/m): the tissue pushes
+    // the arm out; a second later it is still (each joint within one count over the
+    // last 0.5 s).
+    let hand = HANDS[4];
+    assert_eq!(hand.stiffness_n_m, 1000.0);
+    let mut lp = ClosedLoop::new(&config, &ARM, BodySpec::STAND_IN, hand).unwrap();
+    let start = lp.lead.at(LEAD_TICKS);
+    lp.lead.hold = Some(HoldAt {
+        from: LEAD_TICKS,
+        wait: 500,
+        ramp: 500,
+        to: [
+            start[0],
+            start[1],
+            lp.lead.device([0.0; 3])[2] - HOLD_DEPTH_MM,
+        ],
+    });
+    while lp.ticks() < LEAD_TICKS + 2500 {
+        lp.step();
+    }
+    assert!(
+        lp.probe_mm()[2] < -0.2,
+        "pressing before the release: {:?}",
+        lp.probe_mm()
+    );
+    lp.hand = Hand::OFF;
+    let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
+    for t in 0..1500 {
+        lp.step();
+        assert_eq!(lp.fault(), None, "{t} ticks after the release");
+        if t >= 1000 {
+            let c = lp.body.counts();
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+    }
+    let spread: Vec<i32> = (0..3).map(|k| hi[k] - lo[k]).collect();
+    println!(
+        "ARMLOOP case=released rest_mm={:.2} spread_counts={}",
+        lp.probe_mm()[2],
+        spread.iter().max().unwrap()
+    );
+    assert!(spread.iter().all(|&s| s <= 1), "not at rest: {spread:?}");
+}
+
+/// The region in devices/woodenhaptics.toml is what the simulated arm measures at the
+/// board's damping: its stiffness is stable with every hand, the grid's next is not.
+#[test]
+fn the_device_file_s_stable_region_is_what_the_simulated_arm_measures() {
+    let b = BOARD.coupling_damping;
+    let edge = region().max_coupling(b).unwrap();
+    let on_grid = stiffness_grid().any(|k| (k - edge).abs() < 1e-3);
+    assert!(
+        on_grid,
+        "{edge} N/mm is not on the grid: remeasure (`mccs arm stability`)"
+    );
+    let at = |k: f64| BoardConfig {
+        coupling_stiffness: k,
+        coupling_damping: b,
+        ..BOARD
+    };
+    for hand in HANDS {
+        let h = held_press(&at(edge), &ARM, BodySpec::STAND_IN, hand).unwrap();
+        assert_eq!(verdict(&h), Ok(()), "{edge} N/mm, {hand:?}");
+    }
+    let next = edge * 2f64.sqrt();
+    let unstable =
+        HANDS.iter().any(
+            |hand| match held_press(&at(next), &ARM, BodySpec::STAND_IN, *hand) {
+                Err(_) => true,
+                Ok(h) => verdict(&h).is_err(),
+            },
+        );
+    assert!(
+        unstable,
+        "{next} N/mm is stable with every hand: the region is larger"
+    );
+}
