@@ -44,9 +44,10 @@ use crate::units::{Force, Length};
 pub struct PassivityLimits {
     /// The energy below which it trips: minus the trip, Q24 mJ (< 0).
     floor_q24: i64,
-    /// The most the hand's past input may pay for later output, Q24 mJ (≥ 0): at least
-    /// what the tissue can store (a release gives it back), no more than needed (a
-    /// fault with the credit full puts out `credit + trip` before it trips).
+    /// Out of contact, the most the hand's past input may pay for later output, Q24 mJ
+    /// (≥ 0): what a tissue still settling may give back on the next touch, no more
+    /// than needed (a fault at a touch with the credit full puts out `credit + trip`
+    /// before it trips). In contact the hand's input is not held to it.
     credit_q24: i64,
 }
 
@@ -86,7 +87,8 @@ pub const WINDOW_SHIFT: u32 = 12;
 /// The observer's state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PassivityObserver {
-    /// The energy the hand has put in, held to the credit, Q24 mJ (negative: put out).
+    /// The energy the hand has put in, held to the credit out of contact, Q24 mJ
+    /// (negative: put out).
     energy_q24: i64,
     /// The probe at the last tick (zero before the first: its work is 0).
     last_probe: [Length; 3],
@@ -143,8 +145,8 @@ impl PassivityObserver {
         self.tripped
     }
 
-    /// The energy the hand has put in, held to the credit, mJ (negative: the device put
-    /// it out).
+    /// The energy the hand has put in, held to the credit out of contact, mJ (negative:
+    /// the device put it out).
     pub fn energy_mj(&self) -> f64 {
         self.energy_q24 as f64 / (1u64 << 24) as f64
     }

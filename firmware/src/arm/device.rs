@@ -23,7 +23,7 @@
 //!   `thermal` status while any joint is folded.
 //! - **Passivity** ([`ArmDevice::with_passivity`], [`mccs::PassivityObserver`]): the
 //!   work the rendered force does on the probe, tick by tick; energy put out beyond the
-//!   hand's recent input (held to a credit) by more than the trip is
+//!   hand's input (held to a credit out of contact) by more than the trip is
 //!   [`ArmFault::EnergyOut`], zero duty first.
 //! - **Trims** ([`Trims`], [`ArmDevice::with_trims`]): each duty, last, through its
 //!   amplifier's offset and dead band, so that the current is what the force needs

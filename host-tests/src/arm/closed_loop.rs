@@ -256,11 +256,6 @@ impl ClosedLoop {
         self.ctl.telemetry().fault.map(|f| f.to_string())
     }
 
-    /// The energy the board's passivity observer holds, mJ (negative: put out).
-    pub fn observer_mj(&self) -> f64 {
-        self.ctl.device().inner().passivity_mj().unwrap_or(0.0)
-    }
-
     /// The driver is off and every duty is zero: the safe state.
     pub fn safe(&self) -> bool {
         let w = self.wires.borrow();

@@ -177,9 +177,11 @@ impl ArmBody {
 
     /// The arm's masses' potential, J (zero at the base).
     fn potential(&self) -> f64 {
-        let g = gravity(&self.spec);
-        g.g * (g.upper_arm_mass_kg * upper_com(&self.spec, &self.angle).z
-            + g.forearm_mass_kg * fore_com(&self.spec, &self.angle).z)
+        let g = gravity(&self.spec).g;
+        self.masses(&Hand::OFF)
+            .iter()
+            .map(|(point, mass)| g * mass * point(&self.spec, &self.angle).z)
+            .sum()
     }
 
     /// The points with mass: each one's position function and mass, kg.
@@ -256,14 +258,12 @@ impl ArmBody {
 
     /// `∂U/∂q`, N·m: the torque that holds the arm still against gravity.
     pub fn gravity_torque(&self) -> Vector3<f64> {
-        let g = gravity(&self.spec);
+        // (A hand carries its own weight: the arm's masses only.)
+        let g = gravity(&self.spec).g;
         let mut t = Vector3::zeros();
-        for (point, mass) in [
-            (upper_com as PointFn, g.upper_arm_mass_kg),
-            (fore_com as PointFn, g.forearm_mass_kg),
-        ] {
+        for (point, mass) in self.masses(&Hand::OFF) {
             let j = jacobian(&self.spec, point, &self.angle);
-            t += j.transpose() * Vector3::new(0.0, 0.0, mass * g.g);
+            t += j.transpose() * Vector3::new(0.0, 0.0, mass * g);
         }
         t
     }
