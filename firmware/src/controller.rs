@@ -209,7 +209,7 @@ impl Default for Telemetry {
 /// A solver driving a device.
 #[derive(Debug)]
 pub struct Controller<
-    D,
+    D: HapticDevice,
     const NODES: usize,
     const EDGES: usize,
     const S: usize,
@@ -223,6 +223,8 @@ pub struct Controller<
     telemetry: Telemetry,
     /// Overruns in a row that end in the safe state (0: never).
     overrun_limit: u32,
+    /// The device's error that put it in the safe state, if one did.
+    device_error: Option<D::Error>,
 }
 
 impl<D: HapticDevice, const NODES: usize, const EDGES: usize, const S: usize, A: Arith>
@@ -259,6 +261,7 @@ impl<
             steady_tick,
             telemetry: Telemetry::new(),
             overrun_limit: 0,
+            device_error: None,
         }
     }
 
@@ -302,13 +305,18 @@ impl<
                 Ok(probe) => {
                     let force = self.contact.step(&mut self.solver, probe);
                     self.telemetry.window_shifts = self.contact.window_shifts();
-                    if self.device.write_force(force).is_ok() {
-                        force
-                    } else {
-                        self.enter_safe_state(Fault::Write)
+                    match self.device.write_force(force) {
+                        Ok(()) => force,
+                        Err(e) => {
+                            self.device_error = Some(e);
+                            self.enter_safe_state(Fault::Write)
+                        }
                     }
                 }
-                Err(_) => self.enter_safe_state(Fault::Read),
+                Err(e) => {
+                    self.device_error = Some(e);
+                    self.enter_safe_state(Fault::Read)
+                }
             }
         };
         let clamped = is_clamped(force, self.solver.max_force());
@@ -363,6 +371,12 @@ impl<
     /// A tick that ended within its budget: the run of overruns is over.
     pub fn note_on_time(&mut self) {
         self.telemetry.overruns_in_row = 0;
+    }
+
+    /// The device's error that put it in the safe state (the first fault's, if it was
+    /// a failed read or write; `None` otherwise).
+    pub fn device_error(&self) -> Option<&D::Error> {
+        self.device_error.as_ref()
     }
 
     /// The statistics so far.

@@ -6,7 +6,7 @@
 
 use haptic_f405::arm::ARM;
 use haptic_f405::{BoardConfig, BOARD};
-use mccs_firmware::arm::plant::PALPATION_TICKS;
+use mccs_firmware::arm::plant::{HOME_TICKS, PALPATION_TICKS};
 use mccs_host::arm::closed_loop::{
     held_press, stiffness_grid, verdict, ClosedLoop, HoldAt, HANDS, HOLD_DEPTH_MM, LEAD_TICKS,
 };
@@ -79,7 +79,7 @@ fn every_hand_palpates_10_s_at_the_stiffest_coupling_allowed_with_no_energy_out(
             pressed = pressed.max(f[2]);
             assert_eq!(lp.fault(), None, "tick {t}, hand {hand:?}");
         }
-        let mj = lp.body.rendered_j * 1e3;
+        let mj = lp.rendered_mj();
         assert!(pressed > 0.2, "{hand:?}: pressed only {pressed} N");
         assert!(mj <= 0.0, "{hand:?}: the device put out {mj} mJ");
         most = most.max(mj);
@@ -182,4 +182,104 @@ fn the_device_file_s_stable_region_is_what_the_simulated_arm_measures() {
         unstable,
         "{next} N/mm is stable with every hand: the region is larger"
     );
+}
+
+/// What a direction check on the closed loop did.
+struct Checked {
+    /// The board's fault, if any.
+    fault: Option<String>,
+    /// Ticks the check took (the lead waiting at home).
+    ticks: u32,
+    /// From the first tick joint `joint` was nudged to the verdict: ticks, and how far the
+    /// probe moved, mm.
+    after_nudge: (u32, f64),
+    /// The nudges' work, mJ.
+    nudged_mj: f64,
+}
+
+/// Runs the loop until the board's direction check has a verdict (or `limit` ticks),
+/// watching `joint`'s nudge.
+fn direction_check(body: BodySpec, hand: Hand, joint: u8, limit: u32) -> Checked {
+    let mut lp = ClosedLoop::new(&BOARD, &ARM, body, hand).unwrap();
+    let mut nudged: Option<(u32, [f64; 3])> = None;
+    let mut after = (0, 0.0f64);
+    for t in 0..limit {
+        lp.step();
+        if nudged.is_none() && lp.nudging() == Some(joint) {
+            nudged = Some((t, lp.probe_mm()));
+        }
+        if let Some((t0, at)) = nudged {
+            let p = lp.probe_mm();
+            let moved = (0..3).map(|k| (p[k] - at[k]).powi(2)).sum::<f64>().sqrt();
+            after = (t - t0, after.1.max(moved));
+        }
+        if lp.fault().is_some() || lp.ticks() > HOME_TICKS {
+            break;
+        }
+    }
+    assert!(
+        lp.fault().is_none() || lp.safe(),
+        "a fault not in the safe state"
+    );
+    Checked {
+        fault: lp.fault(),
+        ticks: lp.checking_ticks(),
+        after_nudge: after,
+        nudged_mj: lp.nudged_mj(),
+    }
+}
+
+/// A motor wired the wrong way round (issue "safe with a hand on it": "reaches the safe
+/// state within 50 ms and 20 mm"): the board's start-up nudges find it before any
+/// tissue force, whichever joint, whichever hand rests on the handle, within 50 ms and
+/// 1 mm of the nudge that finds it; the right wiring passes with every hand and with
+/// none.
+#[test]
+fn a_reversed_motor_is_found_by_its_start_up_nudge_before_any_force() {
+    let (mut ms, mut mm) = (0u32, 0.0f64);
+    for k in 0..3u8 {
+        for hand in HANDS.iter().chain([&Hand::OFF]) {
+            let mut body = BodySpec::STAND_IN;
+            body.polarity[k as usize] = -1.0;
+            let c = direction_check(body, *hand, k, 3000);
+            let joint = ["A", "B", "C"][k as usize];
+            let said = format!("joint {joint} turning against its drive");
+            assert!(
+                c.fault.as_deref().is_some_and(|f| f.contains(&said)),
+                "joint {joint} reversed, {hand:?}: {:?}",
+                c.fault
+            );
+            (ms, mm) = (ms.max(c.after_nudge.0), mm.max(c.after_nudge.1));
+        }
+    }
+    println!("DIRECTION case=reversed found_ms={ms} moved_mm={mm:.3}");
+    assert!(
+        ms <= 50 && mm <= 1.0,
+        "found {ms} ms and {mm:.3} mm after its nudge"
+    );
+    let (mut ticks, mut nudged_mj) = (0u32, 0.0f64);
+    for hand in HANDS.iter().chain([&Hand::OFF]) {
+        let c = direction_check(BodySpec::STAND_IN, *hand, 0, 3000);
+        assert_eq!(c.fault, None, "{hand:?}");
+        (ticks, nudged_mj) = (ticks.max(c.ticks), nudged_mj.max(c.nudged_mj));
+    }
+    println!("DIRECTION case=wired_right check_ms={ticks} nudges_mj={nudged_mj:.3}");
+}
+
+/// A jammed joint (or one whose motor or amplifier is not connected: the friction here
+/// 25 times the stand-in's) fails the check as "not moving", never passes it: no
+/// tissue force until a reset.
+#[test]
+fn a_jammed_joint_fails_the_check_as_not_moving() {
+    for k in 0..3 {
+        let mut body = BodySpec::STAND_IN;
+        body.coulomb_nm[k] *= 25.0;
+        let c = direction_check(body, HANDS[0], k as u8, 3000);
+        let said = format!("joint {} not moving when nudged", ["A", "B", "C"][k]);
+        assert!(
+            c.fault.as_deref().is_some_and(|f| f.contains(&said)),
+            "{:?}",
+            c.fault
+        );
+    }
 }

@@ -11,7 +11,9 @@ use crate::device::{
 };
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable, PassivityLimits};
-use mccs_firmware::arm::device::{ArmDevice, ArmFault, Joint, SpeedLimits, Thermal, Trims, Walls};
+use mccs_firmware::arm::device::{
+    ArmDevice, ArmFault, DirectionCheck, Joint, SpeedLimits, Thermal, Trims, Walls,
+};
 use mccs_firmware::link::LinkedDevice;
 use mccs_firmware::HapticDevice;
 
@@ -31,19 +33,28 @@ impl StartError<ArmFault> {
         match self {
             Self::Config(e) => StartFault::Config(*e),
             Self::Arm(e) => StartFault::Arm(*e),
-            Self::SafeState(e) => StartFault::SafeState(match *e {
-                ArmFault::Encoder(k) => DevicePart::JointEncoder(k),
-                ArmFault::Pwm(k) => DevicePart::JointPwm(k),
-                ArmFault::Direction(k) => DevicePart::JointDirection(k),
-                ArmFault::Enable => DevicePart::Enable,
-                ArmFault::Home => DevicePart::Home,
-                ArmFault::Overspeed(k) => DevicePart::JointSpeed(k),
-                ArmFault::ProbeSpeed => DevicePart::ProbeSpeed,
-                ArmFault::EnergyOut => DevicePart::EnergyOut,
-            }),
+            Self::SafeState(e) => StartFault::SafeState(e.into()),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
+        }
+    }
+}
+
+impl From<&ArmFault> for DevicePart {
+    /// The part of the arm that failed, or what it did.
+    fn from(e: &ArmFault) -> Self {
+        match *e {
+            ArmFault::Encoder(k) => DevicePart::JointEncoder(k),
+            ArmFault::Pwm(k) => DevicePart::JointPwm(k),
+            ArmFault::Direction(k) => DevicePart::JointDirection(k),
+            ArmFault::Enable => DevicePart::Enable,
+            ArmFault::Home => DevicePart::Home,
+            ArmFault::Overspeed(k) => DevicePart::JointSpeed(k),
+            ArmFault::ProbeSpeed => DevicePart::ProbeSpeed,
+            ArmFault::EnergyOut => DevicePart::EnergyOut,
+            ArmFault::Reversed(k) => DevicePart::JointReversed(k),
+            ArmFault::Unmoved(k) => DevicePart::JointUnmoved(k),
         }
     }
 }
@@ -59,6 +70,14 @@ pub const WALL_MARGIN_DEG: f64 = 3.0;
 /// How long the home input must stay high, with the arm still, before the arm homes, ms.
 pub const HOME_DEBOUNCE_MS: u32 = 50;
 pub use crate::device::{PASSIVITY_CREDIT_MJ, PASSIVITY_TRIP_MJ};
+/// The direction check's nudge at each joint, N·m (docs/safety.md).
+pub const NUDGE_TORQUE_NM: f64 = 0.2;
+/// Motor counts a nudge must move its joint.
+pub const NUDGE_COUNTS: u32 = 8;
+/// How long a nudge may take to move them, ms.
+pub const NUDGE_TIMEOUT_MS: u32 = 200;
+/// Zero duty before each nudge, ms.
+pub const NUDGE_SETTLE_MS: u32 = 30;
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input
@@ -87,7 +106,15 @@ pub fn arm_device<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin>(
         .with_walls(Walls::of(spec, WALL_MARGIN_DEG))
         .with_thermal(Thermal::of(spec, config.tick_hz))
         .with_trims(Trims::of(spec))
-        .with_passivity(PassivityLimits::new(PASSIVITY_TRIP_MJ, PASSIVITY_CREDIT_MJ));
+        .with_passivity(PassivityLimits::new(PASSIVITY_TRIP_MJ, PASSIVITY_CREDIT_MJ))
+        .with_direction_check(DirectionCheck::of(
+            spec,
+            config.tick_hz,
+            NUDGE_TORQUE_NM,
+            NUDGE_COUNTS,
+            NUDGE_TIMEOUT_MS,
+            NUDGE_SETTLE_MS,
+        ));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

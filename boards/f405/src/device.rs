@@ -94,18 +94,25 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
         match self {
             Self::Config(e) => StartFault::Config(*e),
             Self::Arm(e) => StartFault::Arm(*e),
-            Self::SafeState(e) => StartFault::SafeState(match e {
-                OneDofError::Spi(_) => DevicePart::Spi,
-                OneDofError::Encoder => DevicePart::Encoder,
-                OneDofError::Travel => DevicePart::Travel,
-                OneDofError::Motor(MotorError::Pwm(_)) => DevicePart::Pwm,
-                OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
-                OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
-                OneDofError::EnergyOut => DevicePart::EnergyOut,
-            }),
+            Self::SafeState(e) => StartFault::SafeState(e.into()),
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
+        }
+    }
+}
+
+impl<S, P, D, E> From<&OneDofError<S, P, D, E>> for DevicePart {
+    /// The part of the lever that failed (its HAL error type is the board's).
+    fn from(e: &OneDofError<S, P, D, E>) -> Self {
+        match e {
+            OneDofError::Spi(_) => DevicePart::Spi,
+            OneDofError::Encoder => DevicePart::Encoder,
+            OneDofError::Travel => DevicePart::Travel,
+            OneDofError::Motor(MotorError::Pwm(_)) => DevicePart::Pwm,
+            OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
+            OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
+            OneDofError::EnergyOut => DevicePart::EnergyOut,
         }
     }
 }
@@ -155,6 +162,10 @@ pub enum DevicePart {
     JointSpeed(u8),
     /// The arm's probe moved faster than its limit (a runaway).
     ProbeSpeed,
+    /// The arm's joint `0..3` turned against its start-up nudge.
+    JointReversed(u8),
+    /// The arm's joint `0..3` did not move when nudged at start-up.
+    JointUnmoved(u8),
     /// The force (the lever's or the arm's) put out energy beyond the passivity
     /// observer's trip.
     EnergyOut,
@@ -204,6 +215,22 @@ impl DevicePart {
                 ],
             ),
             Self::ProbeSpeed => "the probe running away",
+            Self::JointReversed(k) => pick(
+                *k,
+                [
+                    "joint A turning against its drive (motor or encoder reversed)",
+                    "joint B turning against its drive (motor or encoder reversed)",
+                    "joint C turning against its drive (motor or encoder reversed)",
+                ],
+            ),
+            Self::JointUnmoved(k) => pick(
+                *k,
+                [
+                    "joint A not moving when nudged (let go of the handle; reset)",
+                    "joint B not moving when nudged (let go of the handle; reset)",
+                    "joint C not moving when nudged (let go of the handle; reset)",
+                ],
+            ),
             Self::EnergyOut => "the force putting energy into the hand (passivity)",
         }
     }

@@ -4,6 +4,7 @@
 //! run, whose encoder reads zeros.
 
 use crate::config::BoardConfig;
+use crate::device::DevicePart;
 use mccs_firmware::drivers::as5047p::EncoderErrors;
 use mccs_firmware::{DeviceStatus, Fault, Telemetry};
 
@@ -24,6 +25,9 @@ pub struct BoardTelemetry {
     pub fault_tick: Option<u32>,
     /// What the device knows of itself: homed, at a limit, its duties.
     pub device: DeviceStatus,
+    /// The device's part that failed (or what it did) when a failed read or write put
+    /// it in the safe state.
+    pub part: Option<DevicePart>,
 }
 
 impl BoardTelemetry {
@@ -47,20 +51,22 @@ impl BoardTelemetry {
                 thermal: false,
                 duties: [0; 3],
             },
+            part: None,
         }
     }
 
     /// Records one tick: the controller's telemetry after it, its length, the encoder's
-    /// counters and the device's status.
+    /// counters, the device's status and the part whose failure put it in the safe
+    /// state.
     pub fn record(
         &mut self,
         run: Telemetry,
         us: u32,
         cycles: u32,
-        encoder: EncoderErrors,
-        device: DeviceStatus,
+        (encoder, device, part): (EncoderErrors, DeviceStatus, Option<DevicePart>),
     ) {
         self.device = device;
+        self.part = part;
         if self.fault_tick.is_none() && run.fault.is_some() {
             self.fault_tick = Some(run.ticks.saturating_sub(1));
         }

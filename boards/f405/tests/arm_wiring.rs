@@ -13,7 +13,7 @@ use embedded_hal::pwm::{ErrorKind as PwmErrorKind, ErrorType as PwmErrorType, Se
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinTx};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
 use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm, ARM};
-use haptic_f405::device::{BoardController, BoardRoaming, StartError};
+use haptic_f405::device::{BoardController, BoardRoaming, DevicePart, StartError};
 use haptic_f405::tissue::TISSUE;
 use haptic_f405::BOARD;
 use mccs::{Arm, ArmError, Force};
@@ -166,6 +166,42 @@ impl Rig {
     fn duties(&self) -> [u16; 3] {
         [0, 1, 2].map(|k| self.pwm[k].value.get())
     }
+
+    /// Homed at `counts` (the home input held high its 50 ms with the arm still), then
+    /// released.
+    fn home_at(&mut self, counts: [i32; 3]) {
+        self.set_counts(counts);
+        self.home.value.set(1);
+        for _ in 0..50 {
+            self.ctl.tick(None);
+        }
+        assert!(self.ctl.device().inner().homed());
+        self.home.value.set(0);
+    }
+
+    /// Ticks the direction check through, each joint turning a count a tick the way its
+    /// duty and pin drive it times `wiring` (+1 right, −1 reversed); the ticks it took,
+    /// or the fault it ended in.
+    fn nudge_through(&mut self, wiring: [i32; 3]) -> Result<u32, Fault> {
+        let mut counts = [0i32; 3];
+        for tick in 0..2000 {
+            self.ctl.tick(None);
+            if let Some(fault) = self.ctl.telemetry().fault {
+                return Err(fault);
+            }
+            if self.ctl.device().inner().direction_checked() {
+                return Ok(tick);
+            }
+            let pins = [0, 1, 2].map(|k| self.direction[k].value.get());
+            for k in 0..3 {
+                if self.duties()[k] > 0 {
+                    counts[k] += if pins[k] == 1 { wiring[k] } else { -wiring[k] };
+                }
+            }
+            self.set_counts(counts);
+        }
+        panic!("no verdict in 2 s");
+    }
 }
 
 /// Counts that put the probe `depth_mm` into the tissue at its origin (yaw 0, the probe
@@ -253,6 +289,9 @@ fn no_duty_before_homing_then_a_press_drives_the_joints() {
     rig.ctl.tick(None);
     assert!(rig.ctl.device().inner().homed());
     rig.home.value.set(0);
+    // Each joint nudged both ways, and turning the way it is driven.
+    assert!(rig.nudge_through([1; 3]).is_ok());
+    rig.set_counts([0; 3]);
     // Down onto the tissue from above it (a contact starts only so).
     rig.set_counts(pressing_counts(-2.0));
     rig.ctl.tick(None);
@@ -494,4 +533,43 @@ fn the_simulated_arm_s_palpation_never_trips_the_passivity_observer() {
     }
     assert!(most > 0.5, "the palpation pressed: {most} N");
     println!("PASSIVITY case=simulated_arm lowest_mj={lowest:.3}");
+}
+
+/// A joint wired the wrong way round: the direction check after homing finds it, the
+/// arm goes to its safe state (every duty zero, the driver off) and the board's log
+/// names the joint; before the check no force reaches the tissue, however deep the
+/// counts read.
+#[test]
+fn a_reversed_joint_fails_the_direction_check_into_the_safe_state() {
+    for k in 0..3 {
+        let mut rig = Rig::new();
+        rig.home_at([0; 3]);
+        let mut wiring = [1; 3];
+        wiring[k] = -1;
+        assert_eq!(rig.nudge_through(wiring), Err(Fault::Read));
+        assert_eq!(rig.duties(), [0; 3]);
+        assert_eq!(rig.enable.value.get(), 0, "the driver off");
+        let part = rig.ctl.device_error().map(DevicePart::from);
+        assert_eq!(part, Some(DevicePart::JointReversed(k as u8)));
+        assert!(part.is_some_and(|p| p.name().contains("turning against its drive")));
+        // The fault holds: a press reads nothing and drives nothing.
+        rig.set_counts(pressing_counts(2.0));
+        for _ in 0..10 {
+            assert_eq!(rig.ctl.tick(None), [Force::ZERO; 3]);
+        }
+        assert_eq!(rig.duties(), [0; 3]);
+    }
+    // Wired right: no tissue force while the check runs, even pressed.
+    let mut rig = Rig::new();
+    rig.home_at([0; 3]);
+    rig.ctl.tick(None);
+    assert!(!rig.ctl.device().inner().direction_checked());
+    rig.set_counts(pressing_counts(2.0));
+    for _ in 0..20 {
+        assert_eq!(
+            rig.ctl.tick(None),
+            [Force::ZERO; 3],
+            "force before the check"
+        );
+    }
 }

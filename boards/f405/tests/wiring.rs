@@ -375,15 +375,16 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     for _ in 0..ticks {
         ctl.tick(None);
         let status = ctl.device().status();
+        let part = ctl.device_error().map(device::DevicePart::from);
         t.record(
             ctl.telemetry(),
             0,
             0,
-            ctl.device().inner().encoder.errors(),
-            status,
+            (ctl.device().inner().encoder.errors(), status, part),
         );
     }
     assert_eq!(t.run.fault, Some(Fault::Read));
+    assert_eq!(t.part, Some(device::DevicePart::Encoder));
     assert_eq!(t.fault_tick, Some(fault_tick));
     assert_eq!(t.encoder.diagnostic, fault_tick);
     assert_eq!(qemu_verdict(&BOARD, &t, zeros_fault_tick(&BOARD)), Ok(()));

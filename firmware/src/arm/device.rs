@@ -32,6 +32,11 @@
 //!   each mechanical stop): a homed joint past its wall gets a duty back toward its range,
 //!   proportional to how far past, full duty at the stop, added to the tissue's (the sum
 //!   held to ±100 %).
+//! - **A motor wired the wrong way round** ([`DirectionCheck`],
+//!   [`ArmDevice::with_direction_check`]): once homed and its home input released, before
+//!   any tissue force, each joint is nudged both ways and must turn the way it is driven
+//!   ([`ArmFault::Reversed`], [`ArmFault::Unmoved`]; the safe state, zero duty first). A
+//!   failed check holds until a reset.
 //! - **No runaway.** With [`SpeedLimits`] ([`ArmDevice::with_speed_limits`]), a joint
 //!   faster than its limit (2 rev/s by default) or a probe faster than its limit (1 m/s)
 //!   for [`SpeedLimits::ticks`] ticks in a row is a fault ([`ArmFault::Overspeed`],
@@ -39,11 +44,13 @@
 //!   once the arm is homed (before, its counts mean nothing and its duty is zero), from
 //!   the tick after (its counts jump to the home pose).
 
+pub use crate::arm::direction::DirectionCheck;
 pub use crate::arm::runaway::SpeedLimits;
 pub use crate::arm::thermal::Thermal;
 pub use crate::arm::trims::Trims;
 pub use crate::arm::walls::Walls;
 
+use crate::arm::direction::{Nudge, Nudges};
 use crate::arm::encoder::{Extended, JointEncoder};
 use crate::arm::thermal::Heat;
 use crate::device::HapticDevice;
@@ -83,6 +90,12 @@ pub enum ArmFault {
     /// The rendered force put energy into the hand beyond what the passivity observer
     /// allows ([`ArmDevice::with_passivity`]): an unstable tissue, a reversed sign.
     EnergyOut,
+    /// Joint `0..3` turned against its nudge ([`DirectionCheck`]): its motor or encoder
+    /// wired the wrong way round.
+    Reversed(u8),
+    /// Joint `0..3` did not move when nudged ([`DirectionCheck`]): held, jammed, or its
+    /// motor or amplifier not connected.
+    Unmoved(u8),
 }
 
 /// A joint's part that failed.
@@ -162,6 +175,13 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     fresh_home: bool,
     /// Since the home input rose: the reads it has been high, and the counts then.
     home_since: Option<(u32, [i32; 3])>,
+    /// The direction check (none by default) and where it is: `None` until the home
+    /// input is released after homing. The check is over once `direction_checked`.
+    direction: Option<DirectionCheck>,
+    nudges: Option<Nudges>,
+    direction_checked: bool,
+    /// The check's duties for the next write (None: the tissue's force).
+    nudge_duty: Option<[i32; 3]>,
 }
 
 /// The most a joint may move, counts, while the home input is being debounced.
@@ -193,7 +213,65 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             passivity: None,
             watching: false,
             below_entry: true,
+            direction: None,
+            nudges: None,
+            direction_checked: true,
+            nudge_duty: None,
         }
+    }
+
+    /// The device checking, once homed and its home input released, that each joint
+    /// turns the way it is driven, before any tissue force ([`DirectionCheck`]): until
+    /// it has, the probe reads out of contact and the duties are the check's (with the
+    /// arm's gravity compensation).
+    pub fn with_direction_check(mut self, check: DirectionCheck) -> Self {
+        self.direction = Some(check);
+        self.direction_checked = false;
+        self
+    }
+
+    /// Whether every joint has turned the way it was driven (true without a check).
+    pub fn direction_checked(&self) -> bool {
+        self.direction_checked
+    }
+
+    /// The joint the direction check drives now, if any.
+    pub fn direction_nudging(&self) -> Option<u8> {
+        match (self.direction, self.nudges, self.direction_checked) {
+            (Some(check), Some(nudges), false) => nudges.driving(&check),
+            _ => None,
+        }
+    }
+
+    /// The direction check's part of a read, once homed: the duties it asks for next,
+    /// its fault, or the tissue's turn once it has passed.
+    fn check_direction(&mut self, counts: [i32; 3]) -> Result<(), ArmFault> {
+        let Some(check) = self.direction.filter(|_| !self.direction_checked) else {
+            self.nudge_duty = None;
+            return Ok(());
+        };
+        if self.nudges.is_none() {
+            // The check starts once the home input is released (the arm let go of).
+            if self.home.is_high().map_err(|_| ArmFault::Home)? {
+                self.nudge_duty = Some([0; 3]);
+                return Ok(());
+            }
+            self.nudges = Some(Nudges::default());
+        }
+        let nudges = self.nudges.get_or_insert_with(Nudges::default);
+        match nudges.step(&check, counts) {
+            Nudge::Drive(duty) => self.nudge_duty = Some(duty),
+            Nudge::Passed => {
+                self.direction_checked = true;
+                self.nudge_duty = None;
+            }
+            Nudge::Failed(fault) => {
+                self.nudge_duty = Some([0; 3]);
+                let _ = self.zero();
+                return Err(fault);
+            }
+        }
+        Ok(())
     }
 
     /// The device with a passivity observer on the force it renders: energy put into
@@ -406,6 +484,9 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         if self.homed {
             // (Before homing the counts mean nothing and every duty is zero.)
             self.check_speed(deltas, pose.probe)?;
+            if !settled {
+                self.check_direction(counts)?;
+            }
         }
         let below = pose.probe[2] < Length::ZERO;
         if pose.flags & OUTSIDE != 0 || settled {
@@ -415,8 +496,8 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
         } else if !below {
             self.below_entry = false;
         }
-        if pose.flags & OUTSIDE != 0 || self.below_entry {
-            // Far above the tissue: no contact.
+        if pose.flags & OUTSIDE != 0 || self.below_entry || !self.direction_checked {
+            // Far above the tissue: no contact (nor before the direction check passes).
             return Ok([Length::ZERO, Length::ZERO, Length::MAX]);
         }
         Ok(pose.probe)
@@ -438,8 +519,13 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
                 return Err(ArmFault::EnergyOut);
             }
         }
-        let mut duty = match (self.homed && !fresh, self.pose) {
-            (true, Some(pose)) => self.arm.drive(&pose, force).duty_q16,
+        let mut duty = match (self.homed && !fresh, self.pose, self.nudge_duty) {
+            // The direction check: its nudge on the arm's own duties, no tissue force.
+            (true, Some(pose), Some(nudge)) => {
+                let own = self.arm.drive(&pose, [Force::ZERO; 3]).duty_q16;
+                core::array::from_fn(|k| own[k].saturating_add(nudge[k]))
+            }
+            (true, Some(pose), None) => self.arm.drive(&pose, force).duty_q16,
             _ => [0; 3],
         };
         if let (Some(walls), true) = (self.walls, self.homed && !fresh) {

@@ -6,6 +6,8 @@
 //!   homing and safe state, and the WoodenHaptics constant;
 //! - [`runaway`], [`walls`], [`thermal`]: what keeps the device safe beyond its parts'
 //!   faults — the speed limits, the virtual walls, the I²t model;
+//! - [`direction`]: the start-up check that each motor turns its joint the way it is
+//!   driven;
 //! - [`trims`]: each amplifier's duty offset and dead band;
 //! - [`encoder`]: a joint's quadrature counter, carried past its 16 bits;
 //! - [`sim`]: the arm's chain on a recorded motion (the demo on the arm);
@@ -13,6 +15,7 @@
 //! - [`float`]: the same chain in `f32`, the bench's peer.
 
 pub mod device;
+pub mod direction;
 pub mod encoder;
 pub mod float;
 pub mod plant;

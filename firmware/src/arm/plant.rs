@@ -2,8 +2,11 @@
 //! input (`haptic-f405 --features sim`), so that the board's main, tick, link and arm
 //! device run unchanged in QEMU, where no encoder turns.
 //!
-//! The plant starts at its home pose with the home input high (the arm homes on the
-//! first tick), rises in joint space to [`APPROACH_HEIGHT_MM`] above the palpation's
+//! The plant starts at its home pose with the home input high (the arm homes once the
+//! input has been high the debounce's ticks). When the input falls it waits at home
+//! [`NUDGE_TICKS`], turning each joint a count a tick the way it is driven (the board's
+//! direction check nudges each joint both ways: the counts come back home), then rises
+//! in joint space to [`APPROACH_HEIGHT_MM`] above the palpation's
 //! first point (a path that stays above the tissue: from the folded home pose, a joint
 //! path to a lower point would pass under its surface), comes straight down to that
 //! point ([`APPROACH_TICKS`] in all), then its hand follows the demo's palpation on its
@@ -29,6 +32,13 @@ use mccs::ArmSpec;
 pub const APPROACH_TICKS: u32 = 1000;
 /// Ticks the plant holds its home pose first.
 pub const HOME_TICKS: u32 = 64;
+/// Ticks the plant then waits at home, its home input low, each joint nudged a count a
+/// tick the way a duty over [`NUDGE_MIN_PWM`] drives it (the board's direction check
+/// takes 6 × 40 at 1 kHz).
+pub const NUDGE_TICKS: u32 = 400;
+/// The PWM counts (1 % of [`PLANT_MAX_DUTY`]) over which a duty turns a joint waiting at
+/// home.
+pub const NUDGE_MIN_PWM: u16 = PLANT_MAX_DUTY / 100;
 /// Height above the palpation's first point the rise ends at, mm.
 pub const APPROACH_HEIGHT_MM: f64 = 80.0;
 /// Ticks of the approach's straight descent (the rest of it is the rise).
@@ -52,6 +62,8 @@ pub struct PlantState {
     pub pwm: [u16; 3],
     /// See `pwm`.
     pub forward: [bool; 3],
+    /// Each joint's counts from home, as the nudges turned it.
+    pub nudged: [i32; 3],
 }
 
 impl PlantState {
@@ -136,9 +148,15 @@ impl Plant {
         })
     }
 
-    /// The joint counts at `tick`: home, the approach, then the palpation over and over;
-    /// linear between two samples, to the nearest count.
-    pub fn counts(&self, tick: u32) -> [i32; 3] {
+    /// The joint counts at `tick`: home (nudged by `nudged` while it waits there), the
+    /// approach, then the palpation over and over; linear between two samples, to the
+    /// nearest count.
+    pub fn counts(&self, tick: u32, nudged: [i32; 3]) -> [i32; 3] {
+        if tick < HOME_TICKS + NUDGE_TICKS {
+            let home = self.samples[0];
+            return core::array::from_fn(|k| home[k].wrapping_add(nudged[k]));
+        }
+        let tick = tick - NUDGE_TICKS;
         let lead = HOME_TICKS + APPROACH_TICKS;
         let (base, t) = if tick < lead {
             (0, tick)
@@ -183,14 +201,20 @@ pub struct PlantJoint<const J: usize>(&'static Plant);
 
 impl<const J: usize> Joint for PlantJoint<J> {
     fn read(&mut self) -> Result<u16, PartFailed> {
-        let tick = self.0.state.update(|s| {
+        let (tick, nudged) = self.0.state.update(|s| {
             let t = s.tick;
             if J == 0 {
                 s.tick = s.tick.saturating_add(1);
             }
-            t
+            let waiting = (HOME_TICKS..HOME_TICKS + NUDGE_TICKS).contains(&t);
+            if waiting && s.enabled && s.pwm[J] > NUDGE_MIN_PWM {
+                // Waiting at home: a count the way the duty drives (not the gravity
+                // compensation's few counts once a nudge has turned a joint).
+                s.nudged[J] += if s.forward[J] { 1 } else { -1 };
+            }
+            (t, s.nudged)
         });
-        let counts = self.0.counts(tick);
+        let counts = self.0.counts(tick, nudged);
         // A 16-bit counter, as a timer in encoder mode reads.
         Ok(counts.get(J).copied().unwrap_or(0) as u16)
     }

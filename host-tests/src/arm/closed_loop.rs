@@ -10,7 +10,7 @@ use super::twin::ArmTwin;
 use embedded_hal::digital::{ErrorType, InputPin, OutputPin};
 use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm};
 use haptic_f405::config::BoardConfig;
-use haptic_f405::device::{BoardController, BoardRoaming};
+use haptic_f405::device::{BoardController, BoardRoaming, DevicePart};
 use haptic_f405::tissue::TISSUE;
 use mccs::ArmSpec;
 use mccs_firmware::arm::device::{Joint, PartFailed};
@@ -202,7 +202,12 @@ pub struct ClosedLoop {
     pub lead: Lead,
     ctl: BodyController,
     wires: Shared,
+    /// The lead's clock: it waits at home while the board checks its motors' directions.
     tick: u32,
+    /// Ticks the lead waited so.
+    checking: u32,
+    /// The work the device did on the body over those ticks (the nudges'), J.
+    nudged_j: f64,
     tick_hz: f64,
 }
 
@@ -242,18 +247,55 @@ impl ClosedLoop {
             ctl,
             wires,
             tick: 0,
+            checking: 0,
+            nudged_j: 0.0,
             tick_hz: config.tick_hz as f64,
         })
     }
 
-    /// Ticks run.
+    /// The lead's ticks: those run, less the ticks it waited at home for the board's
+    /// direction check ([`ClosedLoop::checking_ticks`]).
     pub fn ticks(&self) -> u32 {
         self.tick
     }
 
+    /// Ticks the lead waited at home, its home input released, while the board nudged
+    /// each joint ([`mccs_firmware::arm::device::DirectionCheck`]).
+    pub fn checking_ticks(&self) -> u32 {
+        self.checking
+    }
+
+    /// The energy the device rendered into the body and hand over the run, less its
+    /// direction check's nudges (work it means to do), mJ (positive: put out).
+    pub fn rendered_mj(&self) -> f64 {
+        (self.body.rendered_j - self.nudged_j) * 1e3
+    }
+
+    /// The nudges' work, mJ.
+    pub fn nudged_mj(&self) -> f64 {
+        self.nudged_j * 1e3
+    }
+
+    /// The joint the board's direction check drives now, if any.
+    pub fn nudging(&self) -> Option<u8> {
+        self.ctl.device().inner().direction_nudging()
+    }
+
+    /// Whether the board is checking its motors' directions (homed, its home input
+    /// released, no verdict yet): the hand waits at home, still.
+    fn checking(&self) -> bool {
+        let arm = self.ctl.device().inner();
+        self.tick >= HOME_TICKS && !arm.direction_checked() && self.fault().is_none()
+    }
+
     /// The board's fault, if it has one.
+    /// (With the part that failed, as the board's log names it.)
     pub fn fault(&self) -> Option<String> {
-        self.ctl.telemetry().fault.map(|f| f.to_string())
+        let fault = self.ctl.telemetry().fault?;
+        Some(match self.ctl.device_error() {
+            Some(e) => format!("{fault}: {}", DevicePart::from(e).name()),
+            None => fault.to_string(),
+        })
     }
 
     /// The driver is off and every duty is zero: the safe state.
@@ -286,15 +328,23 @@ impl ClosedLoop {
         let force = self.ctl.tick(None).map(|f| f.to_num::<f64>());
         let after = self.command();
         let led = |t: u32| Vector3::from(self.lead.at(t)) / 1000.0;
-        let (from, to) = (led(self.tick), led(self.tick + 1));
+        let waiting = self.checking();
+        let next = if waiting { self.tick } else { self.tick + 1 };
+        let (from, to) = (led(self.tick), led(next));
         let velocity = (to - from) * self.tick_hz;
         let dt = 1.0 / (self.tick_hz * STEPS_PER_TICK as f64);
+        let rendered = self.body.rendered_j;
         for i in 0..STEPS_PER_TICK {
             let command = if i < DELAY_STEPS { before } else { after };
             let at = from + (to - from) * (i as f64 / STEPS_PER_TICK as f64);
             self.body.step(dt, command, &self.hand, at, velocity);
         }
-        self.tick += 1;
+        if waiting {
+            self.checking += 1;
+            self.nudged_j += self.body.rendered_j - rendered;
+        } else {
+            self.tick += 1;
+        }
         force
     }
 
@@ -361,7 +411,7 @@ pub fn hold(
             return Ok(Held {
                 cycle_counts: [f64::INFINITY; 3],
                 window_mj: f64::NAN,
-                run_mj: lp.body.rendered_j * 1e3,
+                run_mj: lp.rendered_mj(),
                 most_n: most,
                 fault: Some((t, fault)),
             });
@@ -374,7 +424,7 @@ pub fn hold(
     Ok(Held {
         cycle_counts: std::array::from_fn(|k| cycle_range(seen.iter().map(|c| c[k] as f64))),
         window_mj: (lp.body.rendered_j - before) * 1e3,
-        run_mj: lp.body.rendered_j * 1e3,
+        run_mj: lp.rendered_mj(),
         most_n: most,
         fault: None,
     })

@@ -277,7 +277,15 @@ mod firmware {
         );
         Variant::log_second(t);
         if let (Some(fault), Some(at)) = (t.run.fault, t.fault_tick) {
-            defmt::error!("safe state since tick {=u32}: {}", at, fault);
+            match t.part {
+                Some(p) => defmt::error!(
+                    "safe state since tick {=u32}: {}: {=str}",
+                    at,
+                    fault,
+                    p.name()
+                ),
+                None => defmt::error!("safe state since tick {=u32}: {}", at, fault),
+            }
         }
     }
 
@@ -317,8 +325,9 @@ mod firmware {
         }
         let encoder = Variant::encoder_errors(ctl);
         let device = ctl.device().status();
+        let part = Variant::device_part(ctl);
         let run = ctl.telemetry();
-        TELEMETRY.update(|t| t.record(run, us, cycles, encoder, device));
+        TELEMETRY.update(|t| t.record(run, us, cycles, (encoder, device, part)));
     }
 
     /// The tick's first run: builds the controller on the hardware `main` handed over,

@@ -10,7 +10,7 @@
 //! | `sim` | the same 1-DOF device on a simulated lever and encoder | `sim_one_dof.rs` |
 
 use haptic_f405::config::BoardConfig;
-use haptic_f405::device::{BoardController, StartFault};
+use haptic_f405::device::{BoardController, DevicePart, StartFault};
 use haptic_f405::telemetry::BoardTelemetry;
 use haptic_f405::tissue::TissueTable;
 use mccs_firmware::drivers::as5047p::EncoderErrors;
@@ -124,6 +124,16 @@ pub trait BoardVariant {
         Self: Sized,
     {
         BoardTelemetry::new().encoder
+    }
+
+    /// The part whose failure put the device in its safe state, if a failed read or
+    /// write did.
+    fn device_part(ctl: &CtlOf<Self>) -> Option<DevicePart>
+    where
+        Self: Sized,
+        for<'e> DevicePart: From<&'e <Self::Device as HapticDevice>::Error>,
+    {
+        ctl.device_error().map(DevicePart::from)
     }
 
     /// Its own line in the log every second (none by default).
