@@ -17,6 +17,7 @@
 //!
 //! `Device` is `Send + Sync`: requests from several threads take turns.
 
+use crate::black_box::BlackBox;
 use crate::error::Error;
 pub use crate::facts::{Info, Status};
 use crate::mesh::Mesh;
@@ -272,6 +273,35 @@ impl Device {
         Error::Unexpected {
             addr: self.session.addr.clone(),
             what: format!("an answer this client did not ask for: {m:?}"),
+        }
+    }
+
+    /// The black box the device kept of its run before its last reset, read a part at a
+    /// time (`progress` is told the ticks read and their total after each part).
+    pub fn black_box(&self, mut progress: impl FnMut(usize, usize)) -> Result<BlackBox, Error> {
+        let mut b = BlackBox::default();
+        loop {
+            let first = u16::try_from(b.ticks.len()).unwrap_or(u16::MAX);
+            let part = match self.request(
+                &[ToDevice::BlackBox { first }],
+                "blackbox",
+                self.options.answer_timeout,
+                |m| matches!(m, ToHost::BlackBox(_)),
+            )? {
+                ToHost::BlackBox(p) => p,
+                other => return Err(self.unexpected(other)),
+            };
+            if !part.kept {
+                return Ok(BlackBox::default());
+            }
+            let left = b.take(&part).map_err(|what| Error::Unexpected {
+                addr: self.session.addr.clone(),
+                what,
+            })?;
+            progress(b.ticks.len(), part.ticks as usize);
+            if left == 0 {
+                return Ok(b);
+            }
         }
     }
 

@@ -17,7 +17,8 @@
 //! # Ok::<(), mccs_client::Error>(())
 //! ```
 //!
-//! - [`Device`]: the session; [`Info`], [`Status`], [`TelemetrySample`], [`Mesh`];
+//! - [`Device`]: the session; [`Info`], [`Status`], [`TelemetrySample`], [`Mesh`],
+//!   [`BlackBox`] (the device's record of its last run);
 //! - [`Tissue`]: a tissue's table bytes, from a parameter file (the one table builder,
 //!   `mccs::ForceTable::new`), from parameters in memory, or from a `.bin` file;
 //! - [`Error`]: every error, typed; a device's refusal is [`Error::Refused`];
@@ -28,6 +29,7 @@
 //! - `ffi`: the C ABI (`include/mccs.h`), which the Python module uses.
 
 pub mod addr;
+pub mod black_box;
 pub mod device;
 pub mod error;
 mod facts;
@@ -44,6 +46,7 @@ pub mod trajectory;
 mod transport;
 
 pub use addr::Addr;
+pub use black_box::BlackBox;
 pub use device::{Armed, Device, Info, Options, Proposal, Status, TelemetrySample};
 pub use error::{Error, Refusal};
 pub use mccs_link::{FaultReason, Flags, Pose};

@@ -13,7 +13,8 @@
 //!   `Arm`, its encoder, its simulations (the demo's, the board's plant) and its `f32`
 //!   peer;
 //! - [`controller`]: one tick end to end with its safe state; [`mailbox`]: the double
-//!   buffer between the main loop and the tick interrupt;
+//!   buffer between the main loop and the tick interrupt; [`black_box`]: the last ticks
+//!   and the stop of a run, kept across a reset;
 //! - [`link`]: the device's side of the host link (`mccs-link`);
 //! - [`demo`]: the demo run shared by the QEMU firmware and the host (`mccs demo`);
 //! - [`entry`], [`float_patch`]: what the instruction-count bench calls.
@@ -25,6 +26,7 @@
 #![deny(missing_docs)]
 
 pub mod arm;
+pub mod black_box;
 #[cfg(target_os = "none")]
 pub mod command_line;
 pub mod controller;

@@ -7,6 +7,7 @@
 //!   [`TissueBegin`]);
 //! - [`info`]: what the device tells of itself: hello, status, telemetry, mesh;
 //! - [`nak`]: why it refuses; [`flags`]: a live tick's flags;
+//! - [`black_box`]: the record a device keeps of its last run, as a message carries it;
 //! - [`frame`]: a message on the wire — postcard bytes, a CRC-32 over them, COBS with a
 //!   `0x00` delimiter, at most [`MAX_FRAME`] bytes — and the byte-stream [`Decoder`];
 //! - [`crc`]: the CRC-32 (IEEE 802.3); [`fnv`]: the FNV-1a hash of tissues;
@@ -19,6 +20,7 @@
 //!   fixed-point core, the same code on the host and on the device.
 #![no_std]
 
+pub mod black_box;
 pub mod crc;
 pub mod flags;
 /// FNV-1a, the core's ([`mccs::fnv`]): the one hash.
@@ -35,6 +37,7 @@ pub mod table_bytes;
 pub mod tissue;
 pub mod tissue_file;
 
+pub use black_box::{BlackBoxPart, BoxStop, BoxTick, StopCause, BOX_PART};
 pub use flags::Flags;
 pub use frame::{encode, parse, Decoder, FrameError, MAX_FRAME, MAX_PAYLOAD};
 pub use info::{

@@ -3,6 +3,7 @@
 //! message goes at the end, and any change here changes [`crate::SCHEMA`]
 //! (docs/protocol.md lists them all, with an example frame each).
 
+use crate::black_box::BlackBoxPart;
 use crate::info::{HelloInfo, MeshPart, StatusInfo, Telemetry};
 use crate::nak::NakReason;
 use crate::replay::{ReplayRow, ReplaySpec};
@@ -67,6 +68,12 @@ pub enum ToDevice<'a> {
     /// (12) Nothing but a valid frame, which feeds the guard: what a host with nothing
     /// else to say sends at least every [`crate::rates::KEEPALIVE_MS`]. Not answered.
     Keepalive,
+    /// (13) The black box the device kept from its last run, ticks `first ..`: answered
+    /// with one [`ToHost::BlackBox`] part.
+    BlackBox {
+        /// The first tick wanted (0: the oldest kept).
+        first: u16,
+    },
 }
 
 /// From the device to the host.
@@ -99,4 +106,6 @@ pub enum ToHost {
     },
     /// (8) A part of a live mesh: up to [`crate::info::MESH_PART`] nodes.
     Mesh(MeshPart),
+    /// (9) A part of the black box: up to [`crate::black_box::BOX_PART`] ticks.
+    BlackBox(BlackBoxPart),
 }

@@ -172,6 +172,74 @@ pub enum DevicePart {
 }
 
 impl DevicePart {
+    /// Every part, by its code less one ([`DevicePart::code`]).
+    pub const ALL: [DevicePart; 27] = {
+        use DevicePart::*;
+        [
+            Spi,
+            Encoder,
+            Travel,
+            Pwm,
+            Direction,
+            Enable,
+            JointEncoder(0),
+            JointEncoder(1),
+            JointEncoder(2),
+            JointPwm(0),
+            JointPwm(1),
+            JointPwm(2),
+            JointDirection(0),
+            JointDirection(1),
+            JointDirection(2),
+            Home,
+            JointSpeed(0),
+            JointSpeed(1),
+            JointSpeed(2),
+            ProbeSpeed,
+            EnergyOut,
+            JointReversed(0),
+            JointReversed(1),
+            JointReversed(2),
+            JointUnmoved(0),
+            JointUnmoved(1),
+            JointUnmoved(2),
+        ]
+    };
+
+    /// Its code in the black box (1 … 27, its place in [`DevicePart::ALL`]; 0 is no
+    /// part). A joint past C is C, as its name is.
+    pub const fn code(self) -> u8 {
+        const fn j(k: u8) -> u8 {
+            if k > 2 {
+                2
+            } else {
+                k
+            }
+        }
+        match self {
+            Self::Spi => 1,
+            Self::Encoder => 2,
+            Self::Travel => 3,
+            Self::Pwm => 4,
+            Self::Direction => 5,
+            Self::Enable => 6,
+            Self::JointEncoder(k) => 7 + j(k),
+            Self::JointPwm(k) => 10 + j(k),
+            Self::JointDirection(k) => 13 + j(k),
+            Self::Home => 16,
+            Self::JointSpeed(k) => 17 + j(k),
+            Self::ProbeSpeed => 20,
+            Self::EnergyOut => 21,
+            Self::JointReversed(k) => 22 + j(k),
+            Self::JointUnmoved(k) => 25 + j(k),
+        }
+    }
+
+    /// The part of black-box code `code` (0 or unknown: none).
+    pub fn from_code(code: u8) -> Option<DevicePart> {
+        Self::ALL.get((code as usize).checked_sub(1)?).copied()
+    }
+
     /// Its name in the log.
     pub const fn name(&self) -> &'static str {
         match self {

@@ -10,6 +10,7 @@
 //! - [`arm`]: the arm variant's device (`--features arm`: the WoodenHaptics arm);
 //! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
 //! - [`safe_stop`]: the motor cut every way out of the firmware takes first;
+//! - [`black_box`]: the last ticks and the stop of a run, kept across a reset;
 //! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
 //! - [`tissue`]: the force table the firmware runs (`boards/f405/tissue.rs`);
 //! - `pins`, `arm_pins` (firmware builds only): the pin maps, 1-DOF and arm.
@@ -21,6 +22,7 @@
 pub mod arm;
 #[cfg(target_os = "none")]
 pub mod arm_pins;
+pub mod black_box;
 pub mod config;
 pub mod device;
 #[cfg(target_os = "none")]

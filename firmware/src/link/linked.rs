@@ -45,6 +45,11 @@ impl<D> LinkedDevice<D> {
         self.gain = gain.min(GAIN_FULL);
     }
 
+    /// The force gain now, Q15.
+    pub fn gain(&self) -> u16 {
+        self.gain
+    }
+
     /// The last probe read, in the tissue's frame.
     pub fn probe(&self) -> [Length; 3] {
         self.probe

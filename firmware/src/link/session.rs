@@ -14,6 +14,7 @@ use super::mesh::{grid_place, Mesh};
 use super::replayer::max_grid;
 use super::state::Snapshot;
 use super::work::Work;
+use crate::black_box::{BlackBox, BLACK_BOX_TICKS};
 use mccs::{Arith, ForceTable, SolverConfig, TableBound};
 use mccs_link::table_bytes::{self, Assembler};
 use mccs_link::{
@@ -92,7 +93,13 @@ pub struct Session<const S: usize> {
     last_mesh: Option<u32>,
     mesh_seq: u32,
     dropped_mesh: u32,
+    /// The record kept from the device's last run, if it keeps one.
+    black_box: Option<&'static LastRun>,
 }
+
+/// The black box a session answers `BlackBox` from: the last run's, which only a boot
+/// writes (before the session exists).
+pub type LastRun = BlackBox<BLACK_BOX_TICKS>;
 
 impl<const S: usize> Session<S> {
     /// The device `live` with its start-up tissue `table` and friction (`None`: a contact
@@ -118,7 +125,15 @@ impl<const S: usize> Session<S> {
             last_mesh: None,
             mesh_seq: 0,
             dropped_mesh: 0,
+            black_box: None,
         }
+    }
+
+    /// The session answering `BlackBox` from `last`, the record of the device's last run
+    /// (without one, the answer says none is kept).
+    pub fn with_black_box(mut self, last: &'static LastRun) -> Self {
+        self.black_box = Some(last);
+        self
     }
 
     /// The live tissue's table and hash.
@@ -191,6 +206,10 @@ impl<const S: usize> Session<S> {
                 return Effect::Disarm;
             }
             ToDevice::Keepalive => {}
+            ToDevice::BlackBox { first } => {
+                let part = self.black_box.map(|b| b.part(first)).unwrap_or_default();
+                out(&ToHost::BlackBox(part));
+            }
             ToDevice::Pose(p) => match self.check_pose(&p) {
                 Ok(()) => {
                     self.pose = p;

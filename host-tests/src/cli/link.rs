@@ -86,6 +86,12 @@ enum Command {
     Arm,
     /// Force to zero until the next `arm`.
     Disarm,
+    /// What the device kept of its run before its last reset (docs/safety.md, "The
+    /// black box"): one line — stopped_by, part, stop_tick, ended_by, end_tick, pc,
+    /// reset, reset_flags, ticks — then its last ticks as CSV (tick, count_a … count_c,
+    /// fx_n … fz_n, duty_a … duty_c, gain, flags). After a power-on: `blackbox
+    /// kept=false`.
+    Blackbox,
     /// Run a scene from FILE on one connection (docs/link.md, "Scripts"): hello, status,
     /// load, pose, arm, disarm, telemetry, mesh and wait steps; each step's result on a
     /// line that starts with `# `, the telemetry as one CSV.
@@ -149,6 +155,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Status => writeln!(out, "{}", device.status().map_err(fail)?).map_err(io_error),
         Command::Arm => writeln!(out, "{}", device.arm_held().map_err(fail)?).map_err(io_error),
         Command::Disarm => writeln!(out, "{}", device.disarm().map_err(fail)?).map_err(io_error),
+        Command::Blackbox => black_box(&device, out),
         Command::Pose { .. } => {
             let p = pose.unwrap_or(Pose::IDENTITY);
             device.set_pose(p).map_err(fail)?;
@@ -164,6 +171,31 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Mesh { seconds, every } => mesh(&device, seconds, every, out),
         Command::Script { .. } => Ok(()),
     }
+}
+
+/// `link blackbox`: the record's line (the part by its name, as the board's log names
+/// it), then its ticks as CSV; progress on stderr every second while it reads.
+fn black_box(device: &Device, out: &mut dyn Write) -> Result<(), CliError> {
+    let mut said = Instant::now();
+    let b = device
+        .black_box(|read, total| {
+            if said.elapsed() >= Duration::from_secs(1) {
+                eprintln!("mccs link blackbox: {read} of {total} ticks read");
+                said = Instant::now();
+            }
+        })
+        .map_err(device_error)?;
+    // The part by the name the board's log gives it (its code in the box).
+    let part = haptic_f405::device::DevicePart::from_code(b.head.part)
+        .map_or("none".to_string(), |p| format!("\"{}\"", p.name()));
+    writeln!(out, "{}", b.line(&part)).map_err(io_error)?;
+    if b.kept() {
+        writeln!(out, "{}", mccs_client::BlackBox::CSV_HEADER).map_err(io_error)?;
+        for t in &b.ticks {
+            writeln!(out, "{}", mccs_client::BlackBox::csv_row(t)).map_err(io_error)?;
+        }
+    }
+    Ok(())
 }
 
 /// Opens the device; every failure one line (exit 2).

@@ -9,10 +9,12 @@
 use haptic_f405::device::{linked, roaming, BoardRoaming, EDGES, NODES, SPACING_MM};
 use haptic_f405::BOARD;
 use mccs::{Force, ForceTable64, Length, Solver, Topology, Wide};
+use mccs_firmware::link::session::LastRun;
 use mccs_firmware::link::{
     Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Live, Session, Work,
 };
 use mccs_firmware::{Controller, HapticDevice, ProbePath};
+use mccs_link::StopCause;
 use mccs_link::{ContactKind, Core, DeviceKind};
 use std::collections::VecDeque;
 use std::io::{Read, Write};
@@ -165,6 +167,48 @@ fn live() -> Live {
     }
 }
 
+/// What the soft device says of its "last run" (it has none: a fixture, so that `mccs
+/// link blackbox` has a record to read): its palpation's first [`LAST_RUN_TICKS`] ticks,
+/// recorded as the board records a tick, stopped there as if its encoder's frames had
+/// failed (a read fault), then ended by a HardFault at PC `0x0800_1234`, and kept
+/// through a watchdog's reset (IWDG).
+pub fn last_run(table: ForceTable64) -> &'static LastRun {
+    use haptic_f405::black_box::{record, tick_record};
+    use haptic_f405::device::DevicePart;
+    let mut live = Box::new(LastRun::EMPTY);
+    live.start();
+    if let Some(mut ctl) = controller(table) {
+        ctl.device_mut().set_gain(mccs_link::scale::GAIN_FULL);
+        for _ in 0..LAST_RUN_TICKS {
+            ctl.tick(None);
+            let (run, status) = (ctl.telemetry(), ctl.device().status());
+            let counts = ctl
+                .device()
+                .probe()
+                .map(|x| (x.to_num::<f64>() * 1000.0) as i32);
+            let tick = tick_record(&run, &status, counts, ctl.device().gain());
+            record(&mut live, tick, run.fault, None);
+        }
+    }
+    live.stop(
+        StopCause::Read,
+        DevicePart::Encoder.code(),
+        LAST_RUN_TICKS - 1,
+        0,
+    );
+    live.record(mccs_link::BoxTick {
+        tick: LAST_RUN_TICKS + 99,
+        ..Default::default()
+    });
+    live.end(StopCause::HardFault, 0x0800_1234);
+    let mut last = Box::new(LastRun::EMPTY);
+    last.keep(&mut live, 1 << 29);
+    Box::leak(last)
+}
+
+/// The ticks of the soft device's "last run" ([`last_run`]).
+pub const LAST_RUN_TICKS: u32 = 600;
+
 fn controller(table: ForceTable64) -> Option<Box<SoftController>> {
     let topo = Topology::standard_patch(BOARD.grid, SPACING_MM).ok()?;
     let mut solver = Solver::new(topo, table, &BOARD.solver()).ok()?;
@@ -188,7 +232,7 @@ fn run(listener: Listener, table: ForceTable64, stop: &AtomicBool) {
     )));
     let mut work: Box<Work<NODES, EDGES, 64, Wide, PATH>> = Box::default();
     let friction = mccs::Friction::new(BOARD.mu_s, BOARD.mu_k).ok();
-    let session = Session::new(live(), table, friction);
+    let session = Session::new(live(), table, friction).with_black_box(last_run(table));
     let mut server = LinkServer::new(&state, &mut work, session, BOARD.check_steps_per_poll);
     let start = Instant::now();
     let mut ticks: u64 = 0;

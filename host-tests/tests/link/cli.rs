@@ -391,3 +391,46 @@ fn a_script_holds_the_device_armed_as_long_as_it_says() {
     );
     assert!(line(&mccs_ok(&["link", "--connect", dev.addr(), "status"])).contains("armed=0"));
 }
+
+/// `mccs link blackbox`: the record the device kept of its last run (the soft device's
+/// fixture, `soft::last_run`: 600 ticks of its palpation, stopped by a read fault of the
+/// encoder's frames, ended by a HardFault, kept through a watchdog's reset), read part
+/// by part: its line with the part named as the board's log names it, then the ring's
+/// last 500 ticks as CSV, each row the tick the board's recording made of it.
+#[test]
+fn blackbox_reads_the_last_run_back_part_by_part() {
+    use mccs_firmware::black_box::BLACK_BOX_TICKS;
+    use mccs_host::link::soft::{last_run, LAST_RUN_TICKS};
+    let dev = device("blackbox");
+    let out = mccs_ok(&["link", "--connect", dev.addr(), "blackbox"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap_or("");
+    let last = LAST_RUN_TICKS - 1;
+    assert_eq!(
+        head,
+        format!(
+            "blackbox kept=true stopped_by=read part=\"the encoder's frames\" stop_tick={last} ended_by=hard-fault end_tick={} pc=0x08001234 reset=IWDG reset_flags=0x20000000 ticks={BLACK_BOX_TICKS}",
+            LAST_RUN_TICKS + 99
+        )
+    );
+    assert_eq!(lines.next(), Some(mccs_client::BlackBox::CSV_HEADER));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), BLACK_BOX_TICKS);
+    // The rows are the box's ticks, oldest first: the last 500 of the 600.
+    let kept = last_run(ForceTable64::new(&Params::TABLE2).unwrap());
+    for (i, row) in rows.iter().enumerate() {
+        let t = kept.tick(i).unwrap();
+        assert_eq!(*row, mccs_client::BlackBox::csv_row(&t), "row {i}");
+        assert_eq!(
+            t.tick as usize,
+            LAST_RUN_TICKS as usize - BLACK_BOX_TICKS + i
+        );
+    }
+    // The palpation pressed: some rows carry a force, all the full gain.
+    assert!(
+        rows.iter().any(|r| r.split(',').nth(6) != Some("0")),
+        "no force"
+    );
+    assert!(rows.iter().all(|r| r.split(',').nth(10) == Some("1.00000")));
+}

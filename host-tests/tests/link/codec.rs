@@ -33,7 +33,7 @@ fn decode_all(bytes: &[u8]) -> Vec<Result<Vec<u8>, FrameError>> {
 fn every_message_is_in_the_examples_and_round_trips_through_one_frame() {
     let dev = to_device();
     let host = to_host();
-    let mut seen = [false; 13];
+    let mut seen = [false; 14];
     for (_, m) in &dev {
         seen[covers_to_device(m)] = true;
         let f = frame_of(m);
@@ -49,7 +49,7 @@ fn every_message_is_in_the_examples_and_round_trips_through_one_frame() {
         seen.iter().all(|&s| s),
         "a message to the device without an example"
     );
-    let mut seen = [false; 9];
+    let mut seen = [false; 10];
     for (_, m) in &host {
         seen[covers_to_host(m)] = true;
         let out = decode_all(&frame_of(m));

@@ -20,6 +20,7 @@ pub fn covers_to_device(m: &ToDevice) -> usize {
         ToDevice::ReplayPath { .. } => 10,
         ToDevice::WatchMesh { .. } => 11,
         ToDevice::Keepalive => 12,
+        ToDevice::BlackBox { .. } => 13,
     }
 }
 
@@ -35,6 +36,7 @@ pub fn covers_to_host(m: &ToHost) -> usize {
         ToHost::ReplayCredit { .. } => 6,
         ToHost::ReplayEnd { .. } => 7,
         ToHost::Mesh(_) => 8,
+        ToHost::BlackBox(_) => 9,
     }
 }
 
@@ -172,6 +174,7 @@ pub fn to_device() -> Vec<(&'static str, ToDevice<'static>)> {
         ),
         ("ToDevice::WatchMesh", ToDevice::WatchMesh { every: 17 }),
         ("ToDevice::Keepalive", ToDevice::Keepalive),
+        ("ToDevice::BlackBox", ToDevice::BlackBox { first: 496 }),
     ]
 }
 
@@ -286,6 +289,29 @@ pub fn to_host() -> Vec<(&'static str, ToHost)> {
                 grid: core::array::from_fn(|k| [(3 + k / 6) as u8, (1 + k % 6) as u8]),
                 positions: core::array::from_fn(|k| {
                     [(k as i32 - 6) << 23, 7 << 22, -(k as i32) << 18]
+                }),
+            }),
+        ),
+        (
+            "ToHost::BlackBox",
+            ToHost::BlackBox(BlackBoxPart {
+                kept: true,
+                reset_flags: 1 << 29,
+                cause: StopCause::Read,
+                part: 22,
+                tick: 2_599,
+                end: StopCause::HardFault,
+                end_tick: 2_700,
+                pc: 0x0800_1234,
+                ticks: 500,
+                first: 496,
+                part_ticks: core::array::from_fn(|k| BoxTick {
+                    tick: 2_596 + k as u32,
+                    counts: [k as i32, -1_000, 2_000],
+                    force_mn: [0, -5, 1_200],
+                    duty_q15: [0, -1_738, 1_983],
+                    gain: 1 << 15,
+                    flags: black_box::box_flags::HOMED,
                 }),
             }),
         ),

@@ -46,6 +46,7 @@ mod firmware {
     use crate::variant::{BoardParts, BoardVariant, CtlOf, Variant};
     use cortex_m::peripheral::NVIC;
     use cortex_m_rt::entry;
+    use haptic_f405::black_box::{self, BoardBox};
     use haptic_f405::config::{self, tick_timer, BOARD};
     use haptic_f405::device::{StartFault, SPACING_MM};
     use haptic_f405::telemetry::BoardTelemetry;
@@ -75,7 +76,11 @@ mod firmware {
         watchdog: IndependentWatchdog,
         /// Cycles in a tick's period.
         period: u32,
+        /// The live black box.
+        black_box: &'static mut BoardBox,
     }
+    /// What the tick keeps of it once its controller runs.
+    type TickHardware = (TickTimer, IndependentWatchdog, u32, &'static mut BoardBox);
     static HARDWARE: Mailbox<Hardware> = Mailbox::new();
 
     /// How the tick's first run went.
@@ -98,6 +103,11 @@ mod firmware {
         else {
             fail("peripherals taken twice")
         };
+        // The last run's black box kept before anything else (the reset's cause with it).
+        let Some((live_box, last_box)) = black_box::take_at_boot(black_box::reset_flags()) else {
+            fail("the black box taken twice")
+        };
+        log_last_run(last_box);
         // Every fault to its own handler, each of which cuts the motor first.
         platform::enable_fault_handlers(&mut cp.SCB);
         if let Err(e) = BOARD.check() {
@@ -120,9 +130,9 @@ mod firmware {
         };
         // TIM1's PWM is set up, every duty zero: the stop chain's break input armed.
         haptic_f405::safe_stop::arm_break_input(BOARD.break_input);
-        post_hardware(device, dp.TIM2, dp.IWDG, &dp.DBGMCU, &clocks);
+        post_hardware(device, dp.TIM2, dp.IWDG, &dp.DBGMCU, &clocks, live_box);
         let work: &'static mut BoardWork = WORK.insert(BoardWork::new());
-        let session = Session::new(live(), TISSUE, friction());
+        let session = Session::new(live(), TISSUE, friction()).with_black_box(last_box);
         let mut link =
             match HostLink::start(dp.USART2, link_pins, &clocks, RX, &LINK, work, session) {
                 Ok(l) => l,
@@ -173,6 +183,7 @@ mod firmware {
         iwdg: pac::IWDG,
         dbgmcu: &pac::DBGMCU,
         clocks: &stm32f4xx_hal::rcc::Clocks,
+        black_box: &'static mut BoardBox,
     ) {
         let Some((psc, arr)) = tick_timer(platform::timer_clock(clocks), BOARD.tick_hz) else {
             fail_with(StartFault::Config(config::BoardConfigError::Tick))
@@ -186,6 +197,7 @@ mod firmware {
                 tick,
                 watchdog,
                 period: platform::tick_period_cycles(clocks),
+                black_box,
             })
             .is_some()
         {
@@ -292,13 +304,14 @@ mod firmware {
     #[interrupt]
     fn TIM2() {
         static mut CTL: Slot<Ctl> = Slot::new();
-        static mut HW: Option<(TickTimer, IndependentWatchdog, u32)> = None;
+        static mut HW: Option<TickHardware> = None;
         let slot = CTL.option();
         if slot.is_none() || HW.is_none() {
             init(slot, HW);
             return;
         }
-        let (Some(ctl), Some((tick, watchdog, period))) = (slot.as_mut(), HW.as_mut()) else {
+        let (Some(ctl), Some((tick, watchdog, period, live_box))) = (slot.as_mut(), HW.as_mut())
+        else {
             return;
         };
         let start = platform::cycles();
@@ -327,6 +340,9 @@ mod firmware {
         let device = ctl.device().status();
         let part = Variant::device_part(ctl);
         let run = ctl.telemetry();
+        let gain = ctl.device().gain();
+        let kept = black_box::tick_record(&run, &device, Variant::box_counts(ctl), gain);
+        black_box::record(live_box, kept, run.fault, part);
         TELEMETRY.update(|t| t.record(run, us, cycles, (encoder, device, part)));
     }
 
@@ -334,12 +350,13 @@ mod firmware {
     /// enables the driver, starts the watchdog and the timer. Out of line, so that its
     /// stack frames are free before the ticks.
     #[inline(never)]
-    fn init(ctl: &mut Option<Ctl>, hw: &mut Option<(TickTimer, IndependentWatchdog, u32)>) {
+    fn init(ctl: &mut Option<Ctl>, hw: &mut Option<TickHardware>) {
         let Some(Hardware {
             device,
             mut tick,
             mut watchdog,
             period,
+            black_box,
         }) = HARDWARE.take()
         else {
             return;
@@ -354,7 +371,7 @@ mod firmware {
                 }
                 watchdog.start(BOARD.watchdog_ms.millis());
                 tick.start();
-                *hw = Some((tick, watchdog, period));
+                *hw = Some((tick, watchdog, period, black_box));
             }
             // The device is in its safe state; the timer never starts.
             Err((fault, _)) => START.set(Start::Failed(fault)),
@@ -382,6 +399,34 @@ mod firmware {
             }
         );
         platform::exit(verdict.is_ok())
+    }
+
+    /// What the black box kept of the run before the last reset, in one line (none after
+    /// a power-on). With `fault-test`, a run that finds one stopped by its injected
+    /// fault ends here (with failure, as the fault's run would have).
+    fn log_last_run(last: &BoardBox) {
+        if !last.kept() {
+            defmt::info!("black box: no record of a last run");
+            return;
+        }
+        let (stop, (end, ended)) = (last.stop_record(), last.ended());
+        let part = haptic_f405::device::DevicePart::from_code(stop.part).map_or("", |p| p.name());
+        defmt::info!(
+            "black box: the last run stopped by {=str} ({=str}) at tick {=u32}, ended by {=str} at tick {=u32} pc={=u32:#x}; reset flags {=u32:#x}; {=usize} ticks kept",
+            last.cause().name(),
+            part,
+            stop.tick,
+            end.name(),
+            ended.tick,
+            ended.pc,
+            last.reset_flags(),
+            last.len()
+        );
+        // (The injected fault's run, read back after its reset: the test's end.)
+        #[cfg(board_fault_test)]
+        if end != mccs_link::StopCause::None {
+            platform::exit(false);
+        }
     }
 
     /// A start-up failure, logged with its type and values (`StartFault`): as [`fail`].

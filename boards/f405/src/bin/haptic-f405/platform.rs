@@ -13,9 +13,11 @@
 //!
 //! Every way out — a panic, HardFault, MemManage, BusFault, UsageFault — cuts the motor
 //! first, on every build (`haptic_f405::safe_stop::cut_motor`: raw register writes),
-//! then logs what stopped it, then exits.
+//! then stops the black box with its cause (`haptic_f405::black_box`), then logs what
+//! stopped it, then exits.
 
 use haptic_f405::config::{self, BOARD};
+use mccs_link::StopCause;
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::{Clocks, Rcc};
 
@@ -123,14 +125,27 @@ pub fn exit(success: bool) -> ! {
     }
 }
 
+/// The end of every way out, the motor cut and the black box stopped: on the board a
+/// breakpoint (with no debugger, a HardFault that spins until the watchdog resets the
+/// chip, the black box kept); in QEMU an exit with failure; with `fault-test`, the reset
+/// the watchdog would make (QEMU models no watchdog), so that the next boot reads the
+/// black box back.
+fn stopped() -> ! {
+    #[cfg(board_fault_test)]
+    cortex_m::peripheral::SCB::sys_reset();
+    #[allow(unreachable_code)]
+    exit(false)
+}
+
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     haptic_f405::safe_stop::cut_motor();
+    haptic_f405::black_box::stop_in_handler(StopCause::Panic, 0);
     defmt::error!(
         "stop: panic, the motor cut: {}",
         defmt::Display2Format(info)
     );
-    exit(false)
+    stopped()
 }
 
 /// Enables the configurable faults (MemManage, BusFault, UsageFault), so that each comes
@@ -147,29 +162,33 @@ pub fn enable_fault_handlers(scb: &mut cortex_m::peripheral::SCB) {
 #[cortex_m_rt::exception]
 unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     haptic_f405::safe_stop::cut_motor();
+    haptic_f405::black_box::stop_in_handler(StopCause::HardFault, frame.pc());
     defmt::error!("stop: HardFault at pc={=u32:#x}, the motor cut", frame.pc());
-    exit(false)
+    stopped()
 }
 
 #[cortex_m_rt::exception]
 fn MemoryManagement() -> ! {
     haptic_f405::safe_stop::cut_motor();
+    haptic_f405::black_box::stop_in_handler(StopCause::MemManage, 0);
     defmt::error!("stop: MemManage, the motor cut");
-    exit(false)
+    stopped()
 }
 
 #[cortex_m_rt::exception]
 fn BusFault() -> ! {
     haptic_f405::safe_stop::cut_motor();
+    haptic_f405::black_box::stop_in_handler(StopCause::BusFault, 0);
     defmt::error!("stop: BusFault, the motor cut");
-    exit(false)
+    stopped()
 }
 
 #[cortex_m_rt::exception]
 fn UsageFault() -> ! {
     haptic_f405::safe_stop::cut_motor();
+    haptic_f405::black_box::stop_in_handler(StopCause::UsageFault, 0);
     defmt::error!("stop: UsageFault, the motor cut");
-    exit(false)
+    stopped()
 }
 
 /// A fault injected after start-up (`--features fault-test`, for the test command's

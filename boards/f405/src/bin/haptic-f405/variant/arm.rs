@@ -92,4 +92,8 @@ impl BoardVariant for Arm {
     fn log_second(t: &BoardTelemetry) {
         log_joints(t);
     }
+
+    fn box_counts(ctl: &CtlOf<Self>) -> [i32; 3] {
+        ctl.device().inner().counts()
+    }
 }

@@ -136,6 +136,17 @@ pub trait BoardVariant {
         ctl.device_error().map(DevicePart::from)
     }
 
+    /// What the black box keeps as a tick's counts: by default the probe in the tissue's
+    /// frame, µm (the lever's travel along `z`); the arm's its joints' counts.
+    fn box_counts(ctl: &CtlOf<Self>) -> [i32; 3]
+    where
+        Self: Sized,
+    {
+        ctl.device()
+            .probe()
+            .map(|x| ((x.to_bits() as i64 * 1000) >> mccs::Length::FRAC_NBITS) as i32)
+    }
+
     /// Its own line in the log every second (none by default).
     fn log_second(_t: &BoardTelemetry) {}
 }

@@ -62,4 +62,8 @@ impl BoardVariant for SimArm {
     fn log_second(t: &BoardTelemetry) {
         log_joints(t);
     }
+
+    fn box_counts(ctl: &CtlOf<Self>) -> [i32; 3] {
+        ctl.device().inner().counts()
+    }
 }

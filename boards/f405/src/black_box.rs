@@ -1,0 +1,207 @@
+//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 32 KiB
+//! of SRAM ([`BLACK_BOX_ADDR`]), which `memory/stm32f405.x` leaves out of the linker's
+//! RAM, so that no section covers them: neither the start-up code (which zeroes `.bss`
+//! and copies `.data`) nor a loader writes them, and a reset leaves them as the run
+//! before left them.
+//!
+//! - At boot ([`take_at_boot`]): the reset's cause (RCC_CSR, then cleared), the live
+//!   box kept as the last run's, the live box started again.
+//! - Each tick: [`tick_record`] into the live box; the first fault stops it with the
+//!   cause and the part ([`stop_of`]).
+//! - A fault handler or a panic: [`stop_in_handler`], after the motor is cut.
+//! - The link answers `BlackBox` from the last box (`mccs link blackbox`).
+
+use crate::device::DevicePart;
+use mccs::Force;
+use mccs_firmware::black_box::{BlackBox, BLACK_BOX_TICKS};
+use mccs_firmware::{DeviceStatus, Fault, Telemetry};
+use mccs_link::black_box::{box_flags, BoxTick, StopCause};
+
+/// The board's box.
+pub type BoardBox = BlackBox<BLACK_BOX_TICKS>;
+
+/// Where the two boxes lie: the last 32 KiB of the STM32F405's 128 KiB SRAM (the live
+/// box, then the last run's).
+pub const BLACK_BOX_ADDR: usize = 0x2001_8000;
+/// Their room.
+pub const BLACK_BOX_BYTES: usize = 0x8000;
+const _: () = assert!(2 * core::mem::size_of::<BoardBox>() <= BLACK_BOX_BYTES);
+
+/// The cause a controller's fault is kept as.
+pub const fn stop_of(fault: Fault) -> StopCause {
+    match fault {
+        Fault::Read => StopCause::Read,
+        Fault::Write => StopCause::Write,
+        Fault::Overruns => StopCause::Overruns,
+        Fault::Amplifier => StopCause::Amplifier,
+    }
+}
+
+/// A force in mN, saturated to ±32,767 (integers only: the tick's).
+fn millinewtons(f: Force) -> i16 {
+    let mn = (f.to_bits() as i64 * 1000) >> Force::FRAC_NBITS;
+    mn.clamp(-32_767, 32_767) as i16
+}
+
+/// One tick as the box keeps it: the controller's telemetry after it (its tick and
+/// force), the device's status (its duties and flags), its `counts` and the link's
+/// `gain` (Q15).
+pub fn tick_record(run: &Telemetry, status: &DeviceStatus, counts: [i32; 3], gain: u16) -> BoxTick {
+    let flags = [
+        (status.homed, box_flags::HOMED),
+        (status.at_limit, box_flags::AT_LIMIT),
+        (status.thermal, box_flags::THERMAL),
+        (run.clamped, box_flags::CLAMPED),
+        (run.fault.is_some(), box_flags::FAULT),
+    ]
+    .iter()
+    .fold(0, |f, &(on, bit)| if on { f | bit } else { f });
+    BoxTick {
+        tick: run.ticks.saturating_sub(1),
+        counts,
+        force_mn: run.force.map(millinewtons),
+        duty_q15: status
+            .duties
+            .map(|d| (d >> 1).clamp(-32_767, 32_767) as i16),
+        gain,
+        flags,
+    }
+}
+
+/// Records a tick in `live` and, on the first tick of a fault, stops it with the
+/// cause and `part`.
+pub fn record(live: &mut BoardBox, tick: BoxTick, fault: Option<Fault>, part: Option<DevicePart>) {
+    live.record(tick);
+    if let Some(f) = fault {
+        live.stop(stop_of(f), part.map_or(0, DevicePart::code), tick.tick, 0);
+    }
+}
+
+/// The boxes, once, at boot: the live one kept as the last run's (with the reset's
+/// cause, `reset_flags`), then started again. `None` the second time.
+#[cfg(target_os = "none")]
+pub fn take_at_boot(reset_flags: u32) -> Option<(&'static mut BoardBox, &'static BoardBox)> {
+    use core::sync::atomic::{AtomicBool, Ordering};
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    if TAKEN.swap(true, Ordering::AcqRel) {
+        return None;
+    }
+    // SAFETY: the two boxes lie in SRAM no section covers (memory/stm32f405.x), aligned
+    // (0x2001_8000) and apart (the assertion above); taken once (`TAKEN`), so these are
+    // the only references but the fault handlers' last write (`stop_in_handler`). Every
+    // field is an integer: whatever bits a power-on leaves are a box, which `kept`
+    // rejects unless marked.
+    let (live, last) = unsafe {
+        let live = &mut *(BLACK_BOX_ADDR as *mut BoardBox);
+        let last = &mut *((BLACK_BOX_ADDR + core::mem::size_of::<BoardBox>()) as *mut BoardBox);
+        (live, last)
+    };
+    last.keep(live, reset_flags);
+    Some((live, &*last))
+}
+
+/// From a fault handler or the panic handler, after the motor is cut: the run ended
+/// with `cause` (and a HardFault's `pc`), on the tick after the box's last
+/// ([`BlackBox::end`]; its stop too, unless a fault stopped it first).
+#[cfg(target_os = "none")]
+pub fn stop_in_handler(cause: StopCause, pc: u32) {
+    // SAFETY: the handler does not return, so the tick's reference to the live box is
+    // never used again; at worst this interrupts a record half written, which the box
+    // still reads (integers), one tick's fields mixed.
+    let live = unsafe { &mut *(BLACK_BOX_ADDR as *mut BoardBox) };
+    live.end(cause, pc);
+}
+
+/// The reset's cause (RCC_CSR's flags, bits 24–31), read and then cleared (RMVF) so
+/// that the next reads only its own. QEMU models no RCC: 0.
+#[cfg(target_os = "none")]
+pub fn reset_flags() -> u32 {
+    const RCC_CSR: *mut u32 = 0x4002_3874 as *mut u32;
+    const RMVF: u32 = 1 << 24;
+    // SAFETY: RCC_CSR is a register of the STM32F405 (RM0090 §7.3.21); reading it and
+    // setting RMVF clears only the reset flags.
+    unsafe {
+        let flags = core::ptr::read_volatile(RCC_CSR) & 0xFF00_0000;
+        core::ptr::write_volatile(RCC_CSR, core::ptr::read_volatile(RCC_CSR) | RMVF);
+        flags
+    }
+}
+
+/// The reset flags' names, for the log and the CLI.
+pub const RESET_FLAGS: [(u32, &str); 7] = [
+    (1 << 25, "BOR"),
+    (1 << 26, "PIN"),
+    (1 << 27, "POR"),
+    (1 << 28, "SFT"),
+    (1 << 29, "IWDG"),
+    (1 << 30, "WWDG"),
+    (1 << 31, "LPWR"),
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_device_part_has_its_own_code_and_back() {
+        for (i, p) in DevicePart::ALL.iter().enumerate() {
+            assert_eq!(p.code() as usize, i + 1, "{p:?}");
+            assert_eq!(DevicePart::from_code(p.code()), Some(*p));
+        }
+        assert_eq!(DevicePart::from_code(0), None);
+        assert_eq!(DevicePart::from_code(28), None);
+        assert_eq!(
+            DevicePart::JointReversed(7).code(),
+            DevicePart::JointReversed(2).code()
+        );
+    }
+
+    #[test]
+    fn a_tick_is_kept_in_mn_and_q15_with_its_flags_and_the_first_fault_stops_the_box() {
+        let run = Telemetry {
+            ticks: 42,
+            force: [
+                Force::from_num(1.5),
+                Force::from_num(-40.0),
+                Force::from_num(0.0004),
+            ],
+            clamped: true,
+            ..Telemetry::new()
+        };
+        let status = DeviceStatus {
+            homed: true,
+            at_limit: false,
+            thermal: true,
+            duties: [65_536, -65_536, 1001],
+        };
+        let t = tick_record(&run, &status, [1, -2, 3], 16_384);
+        assert_eq!(t.tick, 41);
+        assert_eq!(t.force_mn, [1500, -32_767, 0]);
+        assert_eq!(t.duty_q15, [32_767, -32_767, 500]);
+        assert_eq!(
+            t.flags,
+            box_flags::HOMED | box_flags::THERMAL | box_flags::CLAMPED
+        );
+        let mut live = BoardBox::EMPTY;
+        live.start();
+        record(&mut live, t, None, None);
+        let mut t2 = t;
+        t2.tick = 42;
+        record(
+            &mut live,
+            t2,
+            Some(Fault::Read),
+            Some(DevicePart::JointReversed(1)),
+        );
+        record(&mut live, t2, Some(Fault::Write), None);
+        let p = live.part(0);
+        assert_eq!(
+            (p.cause, p.part, p.tick, p.ticks),
+            (StopCause::Read, 23, 42, 2)
+        );
+        assert_eq!(
+            DevicePart::from_code(p.part),
+            Some(DevicePart::JointReversed(1))
+        );
+    }
+}
