@@ -1,11 +1,12 @@
-//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 32 KiB
+//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 8 KiB
 //! of SRAM ([`BLACK_BOX_ADDR`]), which `memory/stm32f405.x` leaves out of the linker's
 //! RAM, so that no section covers them: neither the start-up code (which zeroes `.bss`
 //! and copies `.data`) nor a loader writes them, and a reset leaves them as the run
 //! before left them.
 //!
-//! - At boot ([`take_at_boot`]): the reset's cause (RCC_CSR, then cleared), the live
-//!   box kept as the last run's, the live box started again.
+//! - At boot ([`take_at_boot`]): the live box kept as the last run's with the reset's
+//!   cause (RCC_CSR, which the board's `main` reads and clears), the live box started
+//!   again.
 //! - Each tick: [`tick_record`] into the live box; the first fault stops it with the
 //!   cause and the part ([`stop_of`]).
 //! - A fault handler or a panic: [`stop_in_handler`], after the motor is cut.
@@ -20,11 +21,12 @@ use mccs_link::black_box::{box_flags, BoxTick, StopCause};
 /// The board's box.
 pub type BoardBox = BlackBox<BLACK_BOX_TICKS>;
 
-/// Where the two boxes lie: the last 32 KiB of the STM32F405's 128 KiB SRAM (the live
-/// box, then the last run's).
-pub const BLACK_BOX_ADDR: usize = 0x2001_8000;
+/// Where the two boxes lie: the last 8 KiB of the STM32F405's 128 KiB SRAM (the live
+/// box, then the last run's). No more: the main loop's stack reaches 77 KB deep (a
+/// replay's start), which with the 34 KB of statics leaves 16 KB (docs/safety.md).
+pub const BLACK_BOX_ADDR: usize = 0x2001_E000;
 /// Their room.
-pub const BLACK_BOX_BYTES: usize = 0x8000;
+pub const BLACK_BOX_BYTES: usize = 0x2000;
 const _: () = assert!(2 * core::mem::size_of::<BoardBox>() <= BLACK_BOX_BYTES);
 
 /// The cause a controller's fault is kept as.
@@ -77,8 +79,27 @@ pub fn record(live: &mut BoardBox, tick: BoxTick, fault: Option<Fault>, part: Op
     }
 }
 
+/// The two boxes where they lie: the live one and the last run's.
+#[cfg(target_os = "none")]
+fn boxes() -> (&'static mut BoardBox, &'static mut BoardBox) {
+    // Two callers: `take_at_boot`, once (`TAKEN`), whose references the tick and the
+    // session then hold; and a fault handler, which writes the live box's end and never
+    // returns, so that the tick's is not used again (at worst it interrupts a record half
+    // written: one tick's fields mixed). Every field is an integer: whatever bits a
+    // power-on leaves are a box, which `kept` rejects unless marked.
+    // SAFETY: the boxes lie in SRAM no section covers (memory/stm32f405.x), aligned and
+    // apart (the assertion above); their callers are the two above.
+    unsafe {
+        (
+            &mut *(BLACK_BOX_ADDR as *mut BoardBox),
+            &mut *((BLACK_BOX_ADDR + core::mem::size_of::<BoardBox>()) as *mut BoardBox),
+        )
+    }
+}
+
 /// The boxes, once, at boot: the live one kept as the last run's (with the reset's
-/// cause, `reset_flags`), then started again. `None` the second time.
+/// cause, `reset_flags`: RCC_CSR's, read by the board's `main`), then started again.
+/// `None` the second time.
 #[cfg(target_os = "none")]
 pub fn take_at_boot(reset_flags: u32) -> Option<(&'static mut BoardBox, &'static BoardBox)> {
     use core::sync::atomic::{AtomicBool, Ordering};
@@ -86,57 +107,18 @@ pub fn take_at_boot(reset_flags: u32) -> Option<(&'static mut BoardBox, &'static
     if TAKEN.swap(true, Ordering::AcqRel) {
         return None;
     }
-    // SAFETY: the two boxes lie in SRAM no section covers (memory/stm32f405.x), aligned
-    // (0x2001_8000) and apart (the assertion above); taken once (`TAKEN`), so these are
-    // the only references but the fault handlers' last write (`stop_in_handler`). Every
-    // field is an integer: whatever bits a power-on leaves are a box, which `kept`
-    // rejects unless marked.
-    let (live, last) = unsafe {
-        let live = &mut *(BLACK_BOX_ADDR as *mut BoardBox);
-        let last = &mut *((BLACK_BOX_ADDR + core::mem::size_of::<BoardBox>()) as *mut BoardBox);
-        (live, last)
-    };
+    let (live, last) = boxes();
     last.keep(live, reset_flags);
     Some((live, &*last))
 }
 
 /// From a fault handler or the panic handler, after the motor is cut: the run ended
-/// with `cause` (and a HardFault's `pc`), on the tick after the box's last
+/// with `cause` (and a HardFault's `pc`), after the last tick that ran
 /// ([`BlackBox::end`]; its stop too, unless a fault stopped it first).
 #[cfg(target_os = "none")]
 pub fn stop_in_handler(cause: StopCause, pc: u32) {
-    // SAFETY: the handler does not return, so the tick's reference to the live box is
-    // never used again; at worst this interrupts a record half written, which the box
-    // still reads (integers), one tick's fields mixed.
-    let live = unsafe { &mut *(BLACK_BOX_ADDR as *mut BoardBox) };
-    live.end(cause, pc);
+    boxes().0.end(cause, pc);
 }
-
-/// The reset's cause (RCC_CSR's flags, bits 24–31), read and then cleared (RMVF) so
-/// that the next reads only its own. QEMU models no RCC: 0.
-#[cfg(target_os = "none")]
-pub fn reset_flags() -> u32 {
-    const RCC_CSR: *mut u32 = 0x4002_3874 as *mut u32;
-    const RMVF: u32 = 1 << 24;
-    // SAFETY: RCC_CSR is a register of the STM32F405 (RM0090 §7.3.21); reading it and
-    // setting RMVF clears only the reset flags.
-    unsafe {
-        let flags = core::ptr::read_volatile(RCC_CSR) & 0xFF00_0000;
-        core::ptr::write_volatile(RCC_CSR, core::ptr::read_volatile(RCC_CSR) | RMVF);
-        flags
-    }
-}
-
-/// The reset flags' names, for the log and the CLI.
-pub const RESET_FLAGS: [(u32, &str); 7] = [
-    (1 << 25, "BOR"),
-    (1 << 26, "PIN"),
-    (1 << 27, "POR"),
-    (1 << 28, "SFT"),
-    (1 << 29, "IWDG"),
-    (1 << 30, "WWDG"),
-    (1 << 31, "LPWR"),
-];
 
 #[cfg(test)]
 mod tests {

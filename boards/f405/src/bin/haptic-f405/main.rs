@@ -104,7 +104,8 @@ mod firmware {
             fail("peripherals taken twice")
         };
         // The last run's black box kept before anything else (the reset's cause with it).
-        let Some((live_box, last_box)) = black_box::take_at_boot(black_box::reset_flags()) else {
+        let Some((live_box, last_box)) = black_box::take_at_boot(platform::reset_flags(&dp.RCC))
+        else {
             fail("the black box taken twice")
         };
         log_last_run(last_box);

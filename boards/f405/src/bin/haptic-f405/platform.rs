@@ -97,6 +97,14 @@ pub fn qemu_instructions(cycles: u32) -> u32 {
     (cycles as f32 * 1e9 / (168e6 * 8.0)) as u32
 }
 
+/// The reset's cause (RCC_CSR's flags, bits 24–31), read and then cleared (RMVF) so
+/// that the next boot reads only its own. QEMU models no RCC: 0.
+pub fn reset_flags(rcc: &stm32f4xx_hal::pac::RCC) -> u32 {
+    let flags = rcc.csr().read().bits() & 0xFF00_0000;
+    rcc.csr().modify(|_, w| w.rmvf().set_bit());
+    flags
+}
+
 /// Stops after a start-up failure: on the board the motor pins stay at their safe
 /// levels, the watchdog and the tick never start; in QEMU, exit with failure.
 pub fn stop() -> ! {
