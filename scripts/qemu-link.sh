@@ -16,6 +16,9 @@
 #   --icount-shift N  an instruction takes 2^N ns (default 3: 125,000 instructions a
 #                 1 kHz tick, the M4F at 168 MHz; 4 halves the core: its ticks overrun).
 #
+# QEMU_EXTRA, if set, is added to QEMU's options (the link tests open a QMP socket with
+# it, to read the board's RAM: how deep its stack went).
+#
 # Time counts instructions (`-icount shift=N,sleep=off`, as every QEMU run here): an idle
 # core's next tick comes at once, so the device's ticks run as fast as QEMU runs the
 # tick's instructions — about 1.3 ticks a millisecond of the host's on the simulated arm
@@ -59,7 +62,7 @@ cp "$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405" "$elf.tmp" && mv "$el
 rm -f "$socket"
 echo "qemu-link: running it in QEMU (netduinoplus2, --features $features), its link on unix:$socket" >&2
 qemu-system-arm -machine netduinoplus2 -display none -monitor none \
-  -semihosting-config enable=on,target=native -icount "shift=$shift,sleep=off" \
+  -semihosting-config enable=on,target=native -icount "shift=$shift,sleep=off" ${QEMU_EXTRA:-} \
   -serial null -chardev "socket,id=link,path=$socket,server=on,wait=off" -serial chardev:link \
   -kernel "$elf" < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
   | "$DECODER" "$elf"

@@ -256,7 +256,6 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
                 self.nudge_duty = Some([0; 3]);
                 return Ok(());
             }
-            self.nudges = Some(Nudges::default());
         }
         let nudges = self.nudges.get_or_insert_with(Nudges::default);
         match nudges.step(&check, counts) {

@@ -3,7 +3,8 @@
 //! keepalives at full gain, a tissue swapped mid-press without a telemetry gap over 50
 //! ticks, a tissue over the tick budget refused, a pose moved and tilted with the force
 //! along the tilted surface, friction reaching the hand, a replay equal to the host's,
-//! corrupted frames counted, silence faded, the mesh — then the 1-DOF board's live path
+//! corrupted frames counted, silence faded, the mesh, the stack's room above the statics
+//! (the board's RAM read through QMP) — then the 1-DOF board's live path
 //! on its simulated lever, and a board whose ticks overrun ending in its safe state.
 //! Each scenario runs its steps by name (a failure names its step); figures go out as
 //! `LINK` lines (docs/link.md).
@@ -52,7 +53,13 @@ fn start(name: &str, args: &[&str]) -> (Qemu, String) {
     let _ = std::fs::remove_file(&socket);
     std::fs::create_dir_all(root().join("target/qemu")).unwrap();
     let log = std::fs::File::create(root().join(format!("target/qemu/link-{name}.log"))).unwrap();
+    let qmp = qmp_socket(name);
+    let _ = std::fs::remove_file(&qmp);
     let child = Command::new("bash")
+        .env(
+            "QEMU_EXTRA",
+            format!("-qmp unix:{},server=on,wait=off", qmp.display()),
+        )
         .arg(root().join("scripts/qemu-link.sh"))
         .args(args)
         .arg(&socket)
@@ -451,6 +458,70 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
     step(s, "the worst tick within half a tick", || {
         worst_tick("arm-sim")
     });
+    // Last: its high-water mark covers every step before. (Two 500-tick black boxes once
+    // took the room a replay's start needs, and the stack overwrote the tick's statics.)
+    step(s, "the stack keeps 4 KiB free above the statics", || {
+        let (used, free) = stack_depth("arm-sim", "qemu-link-sim-arm");
+        println!("LINK case=stack used_bytes={used} free_bytes={free}");
+        assert!(free >= 4096, "the stack went {used} B deep: {free} B free");
+    });
+}
+
+/// Where QEMU `name` answers QMP (its monitor's protocol).
+fn qmp_socket(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("mccs-qemu-{name}-{}.qmp", std::process::id()))
+}
+
+/// A symbol's address in `elf` (rustup's `llvm-nm`, as scripts/size.py finds it).
+fn symbol(elf: &Path, name: &str) -> u32 {
+    let out = |c: &mut Command| String::from_utf8(c.output().unwrap().stdout).unwrap();
+    let sysroot = out(Command::new("rustc").args(["--print", "sysroot"]));
+    let host = out(Command::new("rustc").arg("-vV"));
+    let host = host.lines().find_map(|l| l.strip_prefix("host: ")).unwrap();
+    let nm = Path::new(sysroot.trim()).join(format!("lib/rustlib/{host}/bin/llvm-nm"));
+    let syms = out(Command::new(nm).arg(elf));
+    let line = syms
+        .lines()
+        .find(|l| l.split_whitespace().nth(2) == Some(name))
+        .unwrap_or_else(|| panic!("no {name} in {}", elf.display()));
+    u32::from_str_radix(line.split_whitespace().next().unwrap(), 16).unwrap()
+}
+
+/// How deep the board's stack has gone, and the room left above its statics, bytes: its
+/// RAM read through QMP (QEMU's RAM starts zeroed; the deepest word written between the
+/// end of `.bss` and the stack's top is the stack's high-water mark).
+fn stack_depth(name: &str, features: &str) -> (u32, u32) {
+    let elf = root().join(format!(
+        "target/thumbv7em-none-eabihf/release/haptic-f405-{features}"
+    ));
+    let (ebss, top) = (symbol(&elf, "__ebss"), symbol(&elf, "_stack_start"));
+    let dump = std::env::temp_dir().join(format!("mccs-qemu-{name}-{}.ram", std::process::id()));
+    let mut qmp = std::os::unix::net::UnixStream::connect(qmp_socket(name)).unwrap();
+    qmp.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let mut reader = std::io::BufReader::new(qmp.try_clone().unwrap());
+    let mut line = String::new();
+    let mut ask = |cmd: serde_json::Value| {
+        writeln!(qmp, "{cmd}").unwrap();
+        loop {
+            line.clear();
+            std::io::BufRead::read_line(&mut reader, &mut line).unwrap();
+            let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+            if v.get("return").is_some() || v.get("error").is_some() {
+                assert!(v.get("error").is_none(), "QMP: {v}");
+                break;
+            }
+        }
+    };
+    ask(serde_json::json!({"execute": "qmp_capabilities"}));
+    ask(serde_json::json!({"execute": "pmemsave", "arguments": {
+        "val": ebss, "size": top - ebss, "filename": dump.display().to_string()}}));
+    let ram = std::fs::read(&dump).unwrap();
+    let _ = std::fs::remove_file(&dump);
+    let deepest = ram
+        .chunks(4)
+        .position(|w| w.iter().any(|&b| b != 0))
+        .map_or(ram.len(), |i| i * 4) as u32;
+    (top - ebss - deepest, deepest)
 }
 
 /// The worst tick the board logged (its once-a-second line, `worst_tick_cycles`, the
