@@ -45,30 +45,21 @@
 //!   the tick after (its counts jump to the home pose).
 
 pub use crate::arm::direction::DirectionCheck;
+use crate::arm::runaway::Runaway;
 pub use crate::arm::runaway::SpeedLimits;
 pub use crate::arm::thermal::Thermal;
 pub use crate::arm::trims::Trims;
 pub use crate::arm::walls::Walls;
 
 use crate::arm::direction::{Nudge, Nudges};
-use crate::arm::encoder::{Extended, JointEncoder};
+use crate::arm::encoder::Extended;
+use crate::arm::joint::WriteFailed;
+pub use crate::arm::joint::{Joint, JointParts, PartFailed};
 use crate::arm::thermal::Heat;
 use crate::device::HapticDevice;
 use embedded_hal::digital::{InputPin, OutputPin};
-use embedded_hal::pwm::SetDutyCycle;
 use mccs::arm::OUTSIDE;
 use mccs::{Arm, ArmPose, Force, Length, PassivityLimits, PassivityObserver};
-
-/// One joint's parts.
-#[derive(Debug)]
-pub struct JointParts<E, P, D> {
-    /// Its counter.
-    pub encoder: E,
-    /// Its motor's PWM channel.
-    pub pwm: P,
-    /// Its motor's direction pin (high: the joint's angle grows).
-    pub direction: D,
-}
 
 /// Which part of the arm failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -98,43 +89,6 @@ pub enum ArmFault {
     Unmoved(u8),
 }
 
-/// A joint's part that failed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PartFailed;
-
-/// What a joint does for the device (its parts behind one interface, so that three
-/// joints of different timer and pin types make one device without an indirect call).
-pub trait Joint {
-    /// The counter now.
-    fn read(&mut self) -> Result<u16, PartFailed>;
-    /// A duty (counts, ≤ the channel's full scale).
-    fn duty(&mut self, duty: u16) -> Result<(), PartFailed>;
-    /// The direction pin.
-    fn direction(&mut self, forward: bool) -> Result<(), PartFailed>;
-    /// The channel's full scale.
-    fn max_duty(&self) -> u16;
-}
-
-impl<E: JointEncoder, P: SetDutyCycle, D: OutputPin> Joint for JointParts<E, P, D> {
-    fn read(&mut self) -> Result<u16, PartFailed> {
-        self.encoder.read().map_err(|_| PartFailed)
-    }
-    fn duty(&mut self, duty: u16) -> Result<(), PartFailed> {
-        self.pwm.set_duty_cycle(duty).map_err(|_| PartFailed)
-    }
-    fn direction(&mut self, forward: bool) -> Result<(), PartFailed> {
-        if forward {
-            self.direction.set_high()
-        } else {
-            self.direction.set_low()
-        }
-        .map_err(|_| PartFailed)
-    }
-    fn max_duty(&self) -> u16 {
-        self.pwm.max_duty_cycle()
-    }
-}
-
 /// A 3-DOF arm.
 #[derive(Debug)]
 pub struct ArmDevice<A, B, C, EN, HOME> {
@@ -148,11 +102,8 @@ pub struct ArmDevice<A, B, C, EN, HOME> {
     homed: bool,
     pose: Option<ArmPose>,
     duty: [i32; 3],
-    limits: SpeedLimits,
-    /// Ticks in a row over a limit: each joint's, the probe's.
-    over: [u8; 4],
-    /// The probe at the last read (None: not yet, or the homing tick).
-    last_probe: Option<[Length; 3]>,
+    /// The speed limits and the runs of ticks over them.
+    runaway: Runaway,
     /// Reads in a row the home input must be high, still, to home (at least 1).
     home_ticks: u32,
     /// The virtual walls (none by default).
@@ -200,9 +151,7 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             homed: false,
             pose: None,
             duty: [0; 3],
-            limits: SpeedLimits::NONE,
-            over: [0; 4],
-            last_probe: None,
+            runaway: Runaway::new(SpeedLimits::NONE),
             home_ticks: 1,
             home_since: None,
             fresh_home: false,
@@ -342,38 +291,8 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
 
     /// The device with speed limits (a runaway is a fault).
     pub fn with_speed_limits(mut self, limits: SpeedLimits) -> Self {
-        self.limits = limits;
+        self.runaway = Runaway::new(limits);
         self
-    }
-
-    /// Counts a tick over or within each limit: `deltas` the joints' changes of count,
-    /// `probe` where the probe is now; the fault once a run of ticks over reaches the
-    /// limit's.
-    fn check_speed(&mut self, deltas: [i32; 3], probe: [Length; 3]) -> Result<(), ArmFault> {
-        let mut fast = [false; 4];
-        for k in 0..3 {
-            fast[k] = deltas[k].unsigned_abs() > self.limits.joint_counts[k];
-        }
-        if let Some(last) = self.last_probe {
-            fast[3] = (0..3)
-                .any(|i| probe[i].saturating_sub(last[i]).saturating_abs() > self.limits.probe);
-        }
-        self.last_probe = Some(probe);
-        for k in 0..4 {
-            self.over[k] = if fast[k] {
-                self.over[k].saturating_add(1)
-            } else {
-                0
-            };
-            if self.over[k] >= self.limits.ticks {
-                return Err(if k < 3 {
-                    ArmFault::Overspeed(k as u8)
-                } else {
-                    ArmFault::ProbeSpeed
-                });
-            }
-        }
-        Ok(())
     }
 
     /// Enables the driver (duties still zero).
@@ -422,24 +341,17 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
     }
 }
 
-/// Writes one joint's duty (Q16, signed), a direction change through zero duty.
+/// Writes joint `k`'s duty (Q16, signed), its failure as the arm's fault.
 fn write_joint<J: Joint>(
     j: &mut J,
     forward_was: &mut Option<bool>,
     k: u8,
     duty_q16: i32,
 ) -> Result<(), ArmFault> {
-    let forward = duty_q16 > 0;
-    let max = j.max_duty() as i64;
-    let counts = ((duty_q16.unsigned_abs() as i64 * max) >> 16).min(max) as u16;
-    if counts > 0 && *forward_was != Some(forward) {
-        // Through zero duty: a failed pin write leaves the joint idle.
-        j.duty(0).map_err(|_| ArmFault::Pwm(k))?;
-        *forward_was = None;
-        j.direction(forward).map_err(|_| ArmFault::Direction(k))?;
-        *forward_was = Some(forward);
-    }
-    j.duty(counts).map_err(|_| ArmFault::Pwm(k))
+    j.write(forward_was, duty_q16).map_err(|e| match e {
+        WriteFailed::Pwm => ArmFault::Pwm(k),
+        WriteFailed::Direction => ArmFault::Direction(k),
+    })
 }
 
 impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
@@ -476,13 +388,13 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             self.fresh_home = true;
             // The counts jumped to the home pose: no speed this tick.
             deltas = [0; 3];
-            self.last_probe = None;
+            self.runaway.forget_probe();
         }
         let pose = self.arm.pose(counts);
         self.pose = Some(pose);
         if self.homed {
             // (Before homing the counts mean nothing and every duty is zero.)
-            self.check_speed(deltas, pose.probe)?;
+            self.runaway.check(deltas, pose.probe)?;
             if !settled {
                 self.check_direction(counts)?;
             }

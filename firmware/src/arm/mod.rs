@@ -9,6 +9,7 @@
 //! - [`direction`]: the start-up check that each motor turns its joint the way it is
 //!   driven;
 //! - [`trims`]: each amplifier's duty offset and dead band;
+//! - [`joint`]: a joint's counter, PWM channel and direction pin behind one interface;
 //! - [`encoder`]: a joint's quadrature counter, carried past its 16 bits;
 //! - [`sim`]: the arm's chain on a recorded motion (the demo on the arm);
 //! - [`plant`]: a simulated arm behind the board's own parts (the board's `sim` build);
@@ -18,6 +19,7 @@ pub mod device;
 pub mod direction;
 pub mod encoder;
 pub mod float;
+pub mod joint;
 pub mod plant;
 pub mod runaway;
 pub mod sim;

@@ -6,7 +6,7 @@
 //! budget, half a tick: the latest they may), through ten steps of the body a tick.
 
 use super::dynamics::{ArmBody, BodySpec, Hand};
-use super::twin::ArmTwin;
+pub use super::lead::{HoldAt, Lead, LEAD_TICKS};
 use embedded_hal::digital::{ErrorType, InputPin, OutputPin};
 use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm};
 use haptic_f405::config::BoardConfig;
@@ -14,10 +14,7 @@ use haptic_f405::device::{BoardController, BoardRoaming, DevicePart};
 use haptic_f405::tissue::TISSUE;
 use mccs::ArmSpec;
 use mccs_firmware::arm::device::{Joint, PartFailed};
-use mccs_firmware::arm::plant::{
-    APPROACH_HEIGHT_MM, APPROACH_TICKS, DESCENT_TICKS, HOME_TICKS, PALPATION_TICKS,
-};
-use mccs_firmware::probe_path::ProbePath;
+use mccs_firmware::arm::plant::HOME_TICKS;
 use nalgebra::Vector3;
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -28,8 +25,6 @@ pub const STEPS_PER_TICK: u32 = 10;
 pub const DELAY_STEPS: u32 = STEPS_PER_TICK / 2;
 /// A PWM channel's full scale (the board's TIM1 at 20 kHz from 168 MHz).
 const MAX_DUTY: u16 = 8400;
-/// The ticks before the palpation: the home pose, the rise and the descent.
-pub const LEAD_TICKS: u32 = HOME_TICKS + APPROACH_TICKS;
 
 /// What the board's parts read and were last given.
 #[derive(Clone, Copy, Debug, Default)]
@@ -95,102 +90,6 @@ impl InputPin for BodyHome {
 /// The board's controller on the body's parts.
 pub type BodyController =
     BoardController<LinkedArm<BodyJoint, BodyJoint, BodyJoint, BodyEnable, BodyHome>, BoardRoaming>;
-
-/// Where the hand leads the probe (device frame, mm) at each tick: home, a rise in joint
-/// space to above the palpation's start, straight down to it, then the palpation over
-/// and over; or held at one point from a tick on.
-pub struct Lead {
-    home: [f64; 3],
-    above: [f64; 3],
-    start: [f64; 3],
-    palpation: ProbePath<9>,
-    origin: [f64; 3],
-    twin: ArmTwin,
-    /// From a tick on, the hand goes to a point and holds it there.
-    pub hold: Option<HoldAt>,
-}
-
-/// A hold: from tick `from`, the hand waits `wait` ticks where it is led then, moves to
-/// `to` (device frame, mm) over `ramp` ticks (smoothly), and holds it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HoldAt {
-    /// See [`HoldAt`].
-    pub from: u32,
-    /// See [`HoldAt`].
-    pub wait: u32,
-    /// See [`HoldAt`].
-    pub ramp: u32,
-    /// See [`HoldAt`].
-    pub to: [f64; 3],
-}
-
-fn smooth(t: f64) -> f64 {
-    let t = t.clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
-impl Lead {
-    /// The demo's palpation at the board's tick rate, on the arm of `spec`.
-    pub fn palpation(config: &BoardConfig, spec: &ArmSpec) -> Lead {
-        let twin = ArmTwin { spec: *spec };
-        let palpation = mccs_firmware::palpation_path(config.tick_hz)
-            .unwrap_or_else(|e| panic!("the demo's palpation: {e:?}"));
-        let origin = spec.tissue_origin_mm;
-        let start: [f64; 3] =
-            std::array::from_fn(|k| palpation.at(0)[k].to_num::<f64>() + origin[k]);
-        let above = [start[0], start[1], start[2] + APPROACH_HEIGHT_MM];
-        let home_angles = spec.joints.map(|j| j.home_angle_deg.to_radians());
-        Lead {
-            home: twin.fk(home_angles),
-            above,
-            start,
-            palpation,
-            origin,
-            twin,
-            hold: None,
-        }
-    }
-
-    /// A point of the tissue's frame (mm) in the device frame.
-    pub fn device(&self, tissue: [f64; 3]) -> [f64; 3] {
-        std::array::from_fn(|k| tissue[k] + self.origin[k])
-    }
-
-    /// Where the probe is led at `tick`, device frame, mm.
-    pub fn at(&self, tick: u32) -> [f64; 3] {
-        match self.hold {
-            Some(h) if tick >= h.from => {
-                let p = self.path(h.from);
-                let t =
-                    smooth((tick - h.from).saturating_sub(h.wait) as f64 / h.ramp.max(1) as f64);
-                std::array::from_fn(|k| p[k] + (h.to[k] - p[k]) * t)
-            }
-            _ => self.path(tick),
-        }
-    }
-
-    /// Where the path leads at `tick` (no hold), device frame, mm.
-    fn path(&self, tick: u32) -> [f64; 3] {
-        let rise_end = LEAD_TICKS - DESCENT_TICKS;
-        if tick < HOME_TICKS {
-            self.home
-        } else if tick < rise_end {
-            let t = smooth((tick - HOME_TICKS) as f64 / (rise_end - HOME_TICKS) as f64);
-            let from = self.twin.spec.joints.map(|j| j.home_angle_deg.to_radians());
-            let to = self.twin.ik(self.above).unwrap_or(from);
-            self.twin
-                .fk(std::array::from_fn(|k| from[k] + (to[k] - from[k]) * t))
-        } else if tick < LEAD_TICKS {
-            let t = smooth((tick - rise_end) as f64 / DESCENT_TICKS as f64);
-            let mut p = self.above;
-            p[2] = self.start[2] + APPROACH_HEIGHT_MM * (1.0 - t);
-            p
-        } else {
-            let t = (tick - LEAD_TICKS) % PALPATION_TICKS;
-            self.device(self.palpation.at(t).map(|c| c.to_num::<f64>()))
-        }
-    }
-}
 
 /// The loop: the body, the hand, the board's controller, the lead.
 pub struct ClosedLoop {
@@ -312,7 +211,7 @@ impl ClosedLoop {
                 return 0.0;
             }
             let sign = if w.forward[k] { 1.0 } else { -1.0 };
-            sign * w.pwm[k] as f64 / MAX_DUTY as f64 * self.lead.twin.spec.joints[k].max_current_a
+            sign * w.pwm[k] as f64 / MAX_DUTY as f64 * self.lead.spec().joints[k].max_current_a
         })
     }
 
