@@ -15,9 +15,10 @@
 
 use mccs_link::black_box::{BlackBoxPart, BoxStop, BoxTick, StopCause, BOX_PART};
 
-/// Ticks a board's box keeps (125 ms at 1 kHz): what two boxes in 8 KiB hold, the room
-/// the board's stack leaves (docs/safety.md, "The black box").
-pub const BLACK_BOX_TICKS: usize = 125;
+/// Ticks a board's box keeps (500 ms at 1 kHz): two boxes take 32 KiB of the board's
+/// SRAM, which its statics and the main loop's stack leave (docs/safety.md, "The black
+/// box").
+pub const BLACK_BOX_TICKS: usize = 500;
 
 /// The mark of a box written by this layout ("MCBB", then the layout's version).
 const MARK: u32 = 0x4D43_4201;

@@ -1,4 +1,4 @@
-//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 8 KiB
+//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 32 KiB
 //! of SRAM ([`BLACK_BOX_ADDR`]), which `memory/stm32f405.x` leaves out of the linker's
 //! RAM, so that no section covers them: neither the start-up code (which zeroes `.bss`
 //! and copies `.data`) nor a loader writes them, and a reset leaves them as the run
@@ -21,12 +21,14 @@ use mccs_link::black_box::{box_flags, BoxTick, StopCause};
 /// The board's box.
 pub type BoardBox = BlackBox<BLACK_BOX_TICKS>;
 
-/// Where the two boxes lie: the last 8 KiB of the STM32F405's 128 KiB SRAM (the live
-/// box, then the last run's). No more: the main loop's stack reaches 77 KB deep (a
-/// replay's start), which with the 34 KB of statics leaves 16 KB (docs/safety.md).
-pub const BLACK_BOX_ADDR: usize = 0x2001_E000;
+/// Where the two boxes lie: the last 32 KiB of the STM32F405's 128 KiB SRAM (the live
+/// box, then the last run's); `memory/stm32f405.x` links RAM up to here. The statics
+/// (under 32 KiB) and the main loop's stack (some 43 KB at its deepest, a replay's or a
+/// tissue check's start) share the 96 KiB below; the test command's `link-qemu` stage
+/// holds 4 KiB of them free (docs/safety.md).
+pub const BLACK_BOX_ADDR: usize = 0x2001_8000;
 /// Their room.
-pub const BLACK_BOX_BYTES: usize = 0x2000;
+pub const BLACK_BOX_BYTES: usize = 0x8000;
 const _: () = assert!(2 * core::mem::size_of::<BoardBox>() <= BLACK_BOX_BYTES);
 
 /// The cause a controller's fault is kept as.
@@ -123,6 +125,32 @@ pub fn stop_in_handler(cause: StopCause, pc: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The memory map links RAM up to the boxes and no further, and the boxes end where
+    /// the STM32F405's 128 KiB of SRAM does: a map that covered them would let the
+    /// start-up code zero the last run's record.
+    #[test]
+    fn the_memory_map_leaves_the_boxes_out_of_the_linked_ram() {
+        let map = include_str!("../../../memory/stm32f405.x");
+        let ram = map
+            .lines()
+            .find(|l| l.trim_start().starts_with("RAM"))
+            .expect("a RAM line");
+        let field = |key: &str| {
+            let rest = &ram[ram.find(key).expect(key) + key.len()..];
+            let v = rest
+                .trim_start_matches([' ', '='])
+                .split([',', ' '])
+                .next()
+                .unwrap();
+            match v.strip_suffix('K') {
+                Some(k) => k.parse::<usize>().unwrap() * 1024,
+                None => usize::from_str_radix(v.trim_start_matches("0x"), 16).unwrap(),
+            }
+        };
+        assert_eq!(field("ORIGIN") + field("LENGTH"), BLACK_BOX_ADDR, "{ram}");
+        assert_eq!(BLACK_BOX_ADDR + BLACK_BOX_BYTES, 0x2002_0000);
+    }
 
     #[test]
     fn every_device_part_has_its_own_code_and_back() {

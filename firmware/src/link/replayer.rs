@@ -25,6 +25,10 @@ enum Contact<const EDGES: usize> {
 }
 
 /// A replay under way: its solver and contact, its path's samples, how far it is.
+///
+/// Built in place ([`ReplayRun::idle`], then [`ReplayRun::start`]): the board keeps it
+/// in `.bss`, and a 13 KB run built by value and moved there took two frames of 26 and
+/// 31 KB of the main loop's stack (docs/safety.md, "The stack").
 pub struct ReplayRun<
     const NODES: usize,
     const EDGES: usize,
@@ -32,7 +36,8 @@ pub struct ReplayRun<
     A: Arith,
     const P: usize,
 > {
-    solver: Solver<NODES, EDGES, S, A>,
+    /// `None` until started.
+    solver: Option<Solver<NODES, EDGES, S, A>>,
     contact: Contact<EDGES>,
     path: [[i32; 3]; P],
     samples: u32,
@@ -63,58 +68,76 @@ fn config_of(spec: &ReplaySpec) -> SolverConfig {
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: usize>
     ReplayRun<NODES, EDGES, S, A, P>
 {
-    /// A replay of `spec` on `table`; `narrow`: whether `A` is the narrow arithmetic (what
-    /// a spec must ask for). Out of line: its solver is built on this frame alone.
+    /// A run with nothing to replay (built where it stays; [`ReplayRun::start`] fills it).
+    pub const fn idle() -> Self {
+        Self {
+            solver: None,
+            contact: Contact::Glued,
+            path: [[0; 3]; P],
+            samples: 0,
+            received: 0,
+            done: 0,
+        }
+    }
+
+    /// Starts a replay of `spec` on `table` in this run (abandoning the one under way);
+    /// `narrow`: whether `A` is the narrow arithmetic (what a spec must ask for). On a
+    /// refusal the run replays nothing. Out of line: the solver is built on this frame
+    /// alone, and into its place.
     #[inline(never)]
-    pub fn new(spec: &ReplaySpec, table: ForceTable<S>, narrow: bool) -> Result<Self, NakReason> {
+    pub fn start(
+        &mut self,
+        spec: &ReplaySpec,
+        table: ForceTable<S>,
+        narrow: bool,
+    ) -> Result<(), NakReason> {
+        self.solver = None;
+        self.contact = Contact::Glued;
+        self.samples = 0;
+        self.received = 0;
+        self.done = 0;
         let option = |option, limit| NakReason::Option { option, limit };
         if spec.narrow != narrow {
             return Err(option(SpecOption::Arith, narrow as i32));
+        }
+        if matches!(&spec.roaming, Some(r) if r.cap_radius.is_some()) {
+            return Err(option(SpecOption::CapRadius, 0));
         }
         let config = config_of(spec);
         let grid = spec.grid as usize;
         let topo = Topology::<NODES, EDGES>::standard_patch(grid, spec.spacing_mm)
             .map_err(|_| option(SpecOption::Grid, max_grid::<NODES, EDGES>() as i32))?;
-        let mut solver =
+        let solver = self.solver.insert(
             Solver::<NODES, EDGES, S, A>::with_arith(topo, table, &config, A::default())
-                .map_err(|_| option(SpecOption::Config, 0))?;
-        let contact = match &spec.roaming {
-            None => Contact::Glued,
-            Some(r) if r.cap_radius.is_some() => return Err(option(SpecOption::CapRadius, 0)),
-            Some(r) => {
-                let proxy = solver
-                    .proxy(&ProxyConfig {
-                        grid,
-                        spacing: spec.spacing_mm,
-                        mu_s: r.mu_s,
-                        mu_k: r.mu_k,
-                        probe_radius: r.probe_radius,
-                    })
-                    .map_err(|_| option(SpecOption::Tissue, 64))?;
-                let window = solver
-                    .window(
-                        &WindowConfig {
-                            tissue_w: r.tissue_w as usize,
-                            tissue_h: r.tissue_h as usize,
-                            hysteresis: 0.1,
-                        },
-                        &Flat,
-                        &proxy,
-                        spec.start[0],
-                        spec.start[1],
-                    )
-                    .map_err(|_| option(SpecOption::Tissue, 64))?;
-                Contact::Roaming { proxy, window }
-            }
-        };
-        Ok(Self {
-            solver,
-            contact,
-            path: [[0; 3]; P],
-            samples: spec.samples,
-            received: 0,
-            done: 0,
-        })
+                .map_err(|_| option(SpecOption::Config, 0))?,
+        );
+        if let Some(r) = &spec.roaming {
+            let proxy = solver
+                .proxy(&ProxyConfig {
+                    grid,
+                    spacing: spec.spacing_mm,
+                    mu_s: r.mu_s,
+                    mu_k: r.mu_k,
+                    probe_radius: r.probe_radius,
+                })
+                .map_err(|_| option(SpecOption::Tissue, 64))?;
+            let window = solver
+                .window(
+                    &WindowConfig {
+                        tissue_w: r.tissue_w as usize,
+                        tissue_h: r.tissue_h as usize,
+                        hysteresis: 0.1,
+                    },
+                    &Flat,
+                    &proxy,
+                    spec.start[0],
+                    spec.start[1],
+                )
+                .map_err(|_| option(SpecOption::Tissue, 64))?;
+            self.contact = Contact::Roaming { proxy, window };
+        }
+        self.samples = spec.samples;
+        Ok(())
     }
 
     /// The first tick the device has no room for.
@@ -145,6 +168,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
     /// One tick, if its sample has arrived: its row to `out` (then, after the last, the
     /// end). Whether it ran, and whether the replay is over.
     pub fn step(&mut self, out: &mut dyn FnMut(&ToHost)) -> (bool, bool) {
+        let Some(solver) = self.solver.as_mut() else {
+            return (false, false);
+        };
         if self.done >= self.received {
             return (false, false);
         }
@@ -156,9 +182,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
             .unwrap_or([0; 3])
             .map(Length::from_bits);
         let row = match &mut self.contact {
-            Contact::Glued => mccs_link::replay::glued(&mut self.solver, tick, probe),
+            Contact::Glued => mccs_link::replay::glued(solver, tick, probe),
             Contact::Roaming { proxy, window } => {
-                mccs_link::replay::roaming(&mut self.solver, proxy, window, tick, probe)
+                mccs_link::replay::roaming(solver, proxy, window, tick, probe)
             }
         };
         out(&ToHost::ReplayRow(row));

@@ -319,6 +319,8 @@ impl<const S: usize> Session<S> {
     }
 
     /// The load checked whole, and its stability check started in `work`; or why not.
+    /// Out of line: the check's 8 KB is built on this frame, not the link's poll.
+    #[inline(never)]
     fn commit<const N: usize, const E: usize, A: Arith, const P: usize>(
         &mut self,
         work: &mut Work<N, E, S, A, P>,

@@ -37,7 +37,9 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
     }
 
     /// Starts a replay of `spec` on `table` (abandoning one under way); its first
-    /// credit, or why not. Refused during a tissue's check.
+    /// credit, or why not. Refused during a tissue's check. The replay is built where
+    /// it stays ([`ReplayRun::start`]); out of line, so that no caller's frame holds one.
+    #[inline(never)]
     pub fn begin_replay(
         &mut self,
         spec: &ReplaySpec,
@@ -47,11 +49,17 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
         if self.checking() {
             return Err(NakReason::Busy);
         }
-        *self = Self::Idle;
-        let run = ReplayRun::new(spec, table, narrow)?;
-        let credit = run.credit();
-        *self = Self::Replay(run);
-        Ok(credit)
+        if !self.replaying() {
+            *self = Self::Replay(ReplayRun::idle());
+        }
+        let started = match self {
+            Self::Replay(run) => run.start(spec, table, narrow).map(|()| run.credit()),
+            _ => Err(NakReason::Busy),
+        };
+        if started.is_err() {
+            *self = Self::Idle;
+        }
+        started
     }
 
     /// A replay's path samples; refused (and the replay abandoned) out of order.
@@ -77,7 +85,9 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
 
     /// A slice of the work: up to `replay_rows` replay ticks (their rows to `out`), or
     /// up to `check_steps` steps of a tissue's check; the check's outcome when it ends.
-    /// Whether anything ran.
+    /// Whether anything ran. Out of line, so that the link's poll does not hold its
+    /// frames (a tick's solver locals, a checked tissue) while it decodes.
+    #[inline(never)]
     pub fn run(
         &mut self,
         replay_rows: u32,

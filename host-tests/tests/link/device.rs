@@ -907,12 +907,9 @@ fn a_replay_beyond_the_device_is_refused_naming_the_option() {
         |_| false,
     );
     assert_eq!(r, ToHost::Nak(NakReason::Order));
-    let mut run = mccs_firmware::link::ReplayRun::<NODES, EDGES, 64, mccs::Wide, P>::new(
-        &spec(1000, [0.0; 3], None),
-        table2(),
-        false,
-    )
-    .unwrap();
+    let mut run = mccs_firmware::link::ReplayRun::<NODES, EDGES, 64, mccs::Wide, P>::idle();
+    run.start(&spec(1000, [0.0; 3], None), table2(), false)
+        .unwrap();
     for k in 0..P / PathPoint::PER_FRAME {
         run.path((k * PathPoint::PER_FRAME) as u32, &chunk).unwrap();
     }
