@@ -49,23 +49,31 @@ impl BlackBox {
     pub const CSV_HEADER: &'static str =
         "tick,count_a,count_b,count_c,fx_n,fy_n,fz_n,duty_a,duty_b,duty_c,gain,flags";
 
+    /// A tick's force, N per axis (kept in mN).
+    pub fn force_n(t: &BoxTick) -> [f64; 3] {
+        t.force_mn.map(|mn| mn as f64 / 1000.0)
+    }
+
+    /// A tick's duties, −1 … 1 (kept in Q15).
+    pub fn duties(t: &BoxTick) -> [f64; 3] {
+        t.duty_q15.map(|q| q as f64 / 32_768.0)
+    }
+
+    /// A tick's link gain, 0 … 1.
+    pub fn gain(t: &BoxTick) -> f64 {
+        t.gain as f64 / mccs_link::scale::GAIN_FULL as f64
+    }
+
     /// One tick as a CSV row (forces in N, duties and the gain as fractions of full).
     pub fn csv_row(t: &BoxTick) -> String {
-        let n = |mn: i16| mn as f64 / 1000.0;
-        let d = |q: i16| q as f64 / 32_768.0;
+        let ([fx, fy, fz], [da, db, dc]) = (Self::force_n(t), Self::duties(t));
         format!(
-            "{},{},{},{},{},{},{},{:.5},{:.5},{:.5},{:.5},{}",
+            "{},{},{},{},{fx},{fy},{fz},{da:.5},{db:.5},{dc:.5},{:.5},{}",
             t.tick,
             t.counts[0],
             t.counts[1],
             t.counts[2],
-            n(t.force_mn[0]),
-            n(t.force_mn[1]),
-            n(t.force_mn[2]),
-            d(t.duty_q15[0]),
-            d(t.duty_q15[1]),
-            d(t.duty_q15[2]),
-            t.gain as f64 / mccs_link::scale::GAIN_FULL as f64,
+            Self::gain(t),
             t.flags
         )
     }

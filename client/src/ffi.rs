@@ -515,3 +515,6 @@ pub unsafe extern "C" fn mccs_mesh(
         Ok(())
     })
 }
+
+mod black_box;
+pub use black_box::{mccs_black_box, mccs_stop_cause_name, McBlackBox, McBoxTick};

@@ -26,14 +26,15 @@
 //! - [`replay`]: a probe path replayed on the device's solver;
 //! - [`paramfile`], [`trajectory`]: the parameter and probe-path files; [`pose_text`]: a
 //!   pose as comma-separated numbers;
-//! - `ffi`: the C ABI (`include/mccs.h`), which the Python module uses.
+//! - [`ffi`]: the C ABI (`include/mccs.h`), which the Python module uses (callable from
+//!   Rust too, as its tests do).
 
 pub mod addr;
 pub mod black_box;
 pub mod device;
 pub mod error;
 mod facts;
-mod ffi;
+pub mod ffi;
 pub mod mesh;
 pub mod paramfile;
 pub mod pose_text;

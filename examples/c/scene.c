@@ -1,4 +1,5 @@
-/* A trainer scene's first lines in C: open the device, print its facts, load a tissue,
+/* A trainer scene's first lines in C: open the device, print its facts and what it kept
+ * of its last run (its black box), load a tissue,
  * arm it, hold 2 s reading telemetry, move and tilt the tissue, read one mesh, disarm.
  *
  *   cargo build --release -p mccs-client
@@ -33,6 +34,18 @@ int main(int argc, char **argv) {
            info.device_kind ? "arm" : "1-DOF", info.simulated ? " (simulated)" : "", info.tick_hz,
            info.roaming ? "roaming" : "glued", info.grid, info.grid, info.tissue_w, info.tissue_h,
            info.force_clamp_n, info.mu_s, info.mu_k);
+
+    /* What the device kept of its run before its last reset (none after a power-on). */
+    static mccs_box_tick ticks[512];
+    mccs_black_box_record last;
+    size_t kept = 0;
+    if (mccs_black_box(d, &last, ticks, 512, &kept) != MCCS_OK) return fail("black box");
+    if (last.kept)
+        printf("last run: stopped by %s at tick %u, ended by %s at tick %u, %zu ticks kept\n",
+               mccs_stop_cause_name(last.stopped_by), last.stop_tick,
+               mccs_stop_cause_name(last.ended_by), last.end_tick, kept);
+    else
+        printf("last run: none kept\n");
 
     uint32_t hash = 0;
     if (mccs_load_tissue(d, "params/table2-stiffer.toml", 0.5, 0.4, &hash) != MCCS_OK)

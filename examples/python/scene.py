@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""A trainer scene's first lines in Python: open the device, print its facts, load a
-tissue, arm it, hold 2 s reading telemetry, move and tilt the tissue, read one mesh,
-disarm. From the repository root:
+"""A trainer scene's first lines in Python: open the device, print its facts and what
+it kept of its last run (its black box), load a tissue, arm it, hold 2 s reading
+telemetry, move and tilt the tissue, read one mesh, disarm. From the repository root:
 
     cargo build --release -p mccs-client
     pip install ./client/python
@@ -20,6 +20,9 @@ def main(addr: str) -> int:
         print(f"device: {info.device}{' (simulated)' if info.simulated else ''}, {info.tick_hz} Hz, "
               f"{'roaming' if info.roaming else 'glued'} patch {info.grid}x{info.grid} on a "
               f"{info.tissue[0]}x{info.tissue[1]} tissue, clamp {info.force_clamp_n:.3g} N, mu {info.friction[0]:.2g}/{info.friction[1]:.2g}")
+        last = device.black_box()  # what it kept of its run before its last reset
+        print(f"last run: stopped by {last.stopped_by} at tick {last.stop_tick}, ended by {last.ended_by}, "
+              f"{len(last.ticks)} ticks kept" if last.kept else "last run: none kept")
         print(f"tissue: {device.load_tissue('params/table2-stiffer.toml', friction=(0.5, 0.4)):08x}")
         device.watch(20)
         device.watch_mesh(50)

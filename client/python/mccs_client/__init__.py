@@ -33,7 +33,11 @@ __all__ = [
     "Status",
     "Telemetry",
     "MeshNode",
+    "BlackBox",
+    "BoxTick",
     "FLAGS",
+    "BOX_FLAGS",
+    "RESET_FLAGS",
 ]
 
 OK = 0
@@ -60,6 +64,27 @@ FLAGS = {
     "checking": 1 << 7,
     "gain_limited": 1 << 8,
     "thermal": 1 << 9,
+}
+
+
+#: A black box tick's flag bits, by name.
+BOX_FLAGS = {
+    "homed": 1 << 0,
+    "at_limit": 1 << 1,
+    "thermal": 1 << 2,
+    "clamped": 1 << 3,
+    "faulted": 1 << 4,
+}
+
+#: The reset's cause bits (the STM32F4's RCC_CSR), by name.
+RESET_FLAGS = {
+    "BOR": 1 << 25,
+    "PIN": 1 << 26,
+    "POR": 1 << 27,
+    "SFT": 1 << 28,
+    "IWDG": 1 << 29,
+    "WWDG": 1 << 30,
+    "LPWR": 1 << 31,
 }
 
 
@@ -129,6 +154,31 @@ class _MeshNode(ctypes.Structure):
     ]
 
 
+class _BlackBox(ctypes.Structure):
+    _fields_ = [
+        ("kept", ctypes.c_int),
+        ("stopped_by", ctypes.c_int),
+        ("part", ctypes.c_int),
+        ("stop_tick", ctypes.c_uint32),
+        ("ended_by", ctypes.c_int),
+        ("end_tick", ctypes.c_uint32),
+        ("pc", ctypes.c_uint32),
+        ("reset_flags", ctypes.c_uint32),
+        ("ticks", ctypes.c_uint32),
+    ]
+
+
+class _BoxTick(ctypes.Structure):
+    _fields_ = [
+        ("tick", ctypes.c_uint32),
+        ("counts", ctypes.c_int32 * 3),
+        ("force_n", ctypes.c_double * 3),
+        ("duties", ctypes.c_double * 3),
+        ("gain", ctypes.c_double),
+        ("flags", ctypes.c_uint32),
+    ]
+
+
 @dataclass(frozen=True)
 class Info:
     """What the device says of itself."""
@@ -191,6 +241,73 @@ class MeshNode:
     position_mm: Tuple[float, float, float]
 
 
+def _number(x: float) -> str:
+    """A float as the CSV writes it (Rust's shortest form: ``1``, ``-0.25``)."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
+
+
+@dataclass(frozen=True)
+class BoxTick:
+    """One tick of a black box: counts, force (N), duties and gain (fractions of
+    full), flags (``BOX_FLAGS``)."""
+
+    tick: int
+    counts: Tuple[int, int, int]
+    force_n: Tuple[float, float, float]
+    duties: Tuple[float, float, float]
+    gain: float
+    flags: int
+
+    #: The CSV's columns (as ``mccs link blackbox`` prints them).
+    CSV_HEADER = "tick,count_a,count_b,count_c,fx_n,fy_n,fz_n,duty_a,duty_b,duty_c,gain,flags"
+
+    def flag(self, name: str) -> bool:
+        """Whether flag ``name`` (a key of ``BOX_FLAGS``) is set."""
+        return bool(self.flags & BOX_FLAGS[name])
+
+    def csv_row(self) -> str:
+        """The tick as ``mccs link blackbox`` prints its row."""
+        return ",".join(
+            [str(self.tick), *map(str, self.counts), *map(_number, self.force_n)]
+            + [f"{x:.5f}" for x in (*self.duties, self.gain)]
+            + [str(self.flags)]
+        )
+
+
+@dataclass(frozen=True)
+class BlackBox:
+    """What a device kept of its run before its last reset (docs/safety.md, "The black
+    box"): what first stopped the force and on which part (the board's code), what
+    ended the run, the reset's cause, its last ticks oldest first. ``kept`` is False
+    after a power-on (the rest empty)."""
+
+    kept: bool
+    stopped_by: str
+    part: int
+    stop_tick: int
+    ended_by: str
+    end_tick: int
+    pc: int
+    reset_flags: int
+    ticks: List[BoxTick]
+
+    def reset_names(self) -> str:
+        """The reset's flags by name, ``+``-joined (``none`` where the chip reported none)."""
+        names = [n for n, bit in RESET_FLAGS.items() if self.reset_flags & bit]
+        return "+".join(names) if names else "none"
+
+    def line(self) -> str:
+        """One line, as ``mccs link blackbox`` prints it (the part by its code)."""
+        if not self.kept:
+            return "blackbox kept=false"
+        return (
+            f"blackbox kept=true stopped_by={self.stopped_by} part={self.part} stop_tick={self.stop_tick} "
+            f"ended_by={self.ended_by} end_tick={self.end_tick} pc=0x{self.pc:08x} reset={self.reset_names()} "
+            f"reset_flags=0x{self.reset_flags:08x} ticks={len(self.ticks)}"
+        )
+
+
 def _load() -> ctypes.CDLL:
     names = {"posix": "libmccs_client.so", "nt": "mccs_client.dll"}
     if os.uname().sysname == "Darwin" if hasattr(os, "uname") else False:
@@ -243,6 +360,21 @@ _lib.mccs_mesh.argtypes = [
     ctypes.POINTER(ctypes.c_size_t),
     ctypes.POINTER(ctypes.c_uint32),
 ]
+
+_lib.mccs_black_box.argtypes = [
+    ctypes.c_void_p,
+    ctypes.POINTER(_BlackBox),
+    ctypes.POINTER(_BoxTick),
+    ctypes.c_size_t,
+    ctypes.POINTER(ctypes.c_size_t),
+]
+_lib.mccs_stop_cause_name.argtypes = [ctypes.c_int]
+_lib.mccs_stop_cause_name.restype = ctypes.c_char_p
+
+
+def _cause(code: int) -> str:
+    name = _lib.mccs_stop_cause_name(code)
+    return name.decode() if name else f"cause-{code}"
 
 
 def _check(code: int) -> None:
@@ -367,3 +499,28 @@ class Device:
         nodes = (_MeshNode * max(count.value, 1))()
         _check(_lib.mccs_mesh(self._handle(), nodes, count.value, ctypes.byref(count), ctypes.byref(seq)))
         return seq.value, [MeshNode(n.i, n.j, tuple(n.position_mm)) for n in nodes[: count.value]]
+
+    def black_box(self) -> BlackBox:
+        """The device's record of its last run, read whole (the board's 500 ticks take
+        some 125 requests: about 2 s over a 115,200-baud link)."""
+        head, count = _BlackBox(), ctypes.c_size_t()
+        ticks = (_BoxTick * 512)()
+        code = _lib.mccs_black_box(self._handle(), ctypes.byref(head), ticks, len(ticks), ctypes.byref(count))
+        if code == ERR_BUFFER:
+            ticks = (_BoxTick * count.value)()
+            code = _lib.mccs_black_box(self._handle(), ctypes.byref(head), ticks, count.value, ctypes.byref(count))
+        _check(code)
+        return BlackBox(
+            kept=bool(head.kept),
+            stopped_by=_cause(head.stopped_by),
+            part=head.part,
+            stop_tick=head.stop_tick,
+            ended_by=_cause(head.ended_by),
+            end_tick=head.end_tick,
+            pc=head.pc,
+            reset_flags=head.reset_flags,
+            ticks=[
+                BoxTick(t.tick, tuple(t.counts), tuple(t.force_n), tuple(t.duties), t.gain, t.flags)
+                for t in ticks[: count.value]
+            ],
+        )

@@ -7,6 +7,7 @@ mod device;
 mod messages;
 mod qemu;
 mod rig;
+mod scene_api;
 
 /// `mccs link --connect ADDR mesh --seconds S --every 1` on a device whose live patch is
 /// the standard one of `grid`: each mesh by its `seq`, as its tick and its nodes in
