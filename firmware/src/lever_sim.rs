@@ -8,7 +8,10 @@
 //! parity: the angle for ANGLECOM (the lever's travel over `mm_per_count` from `zero`),
 //! a running sensor for DIAAGC (`LF` = 1), an empty ERRFL — so the driver's every check
 //! runs on it. The motor's duty, direction and enable are recorded. The loop is open:
-//! the lever follows its path whatever force it is driven with.
+//! the lever follows its path whatever force it is driven with, but for its first
+//! [`NUDGE_FRAMES`]: it rests at the path's start, and the board's start-up nudges move
+//! it a count a frame the way they drive it (a duty over 1 %), as a lever wired right
+//! moves.
 
 use crate::drivers::as5047p::{ANGLECOM, DIAAGC, DIAAGC_LF};
 use crate::probe_path::{PathError, ProbePath, Waypoint};
@@ -31,6 +34,10 @@ pub fn press_path(tick_hz: u32) -> Result<ProbePath<5>, PathError> {
     ])
 }
 
+/// Frames the lever rests for its direction check before its path starts (0.4 s at
+/// 1 kHz; the board's check takes 74).
+pub const NUDGE_FRAMES: u32 = 400;
+
 /// What the lever's parts change.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LeverState {
@@ -44,6 +51,8 @@ pub struct LeverState {
     pub forward: bool,
     /// See `duty`.
     pub enabled: bool,
+    /// Counts the nudges moved it (up: the way the angle grows with `mm_per_count` > 0).
+    pub nudged: i32,
 }
 
 /// A simulated lever: its path, its encoder's mounting, and its parts' state.
@@ -76,11 +85,11 @@ impl Lever {
         self.state.get()
     }
 
-    /// The sensor's 14-bit angle at frame `frame`.
-    pub fn angle(&self, frame: u32) -> u16 {
-        let t = frame % self.period.max(1);
+    /// The sensor's 14-bit angle at frame `frame`, nudged `nudged` counts.
+    pub fn angle(&self, frame: u32, nudged: i32) -> u16 {
+        let t = frame.saturating_sub(NUDGE_FRAMES) % self.period.max(1);
         let z = self.path.at(t)[2].to_num::<f64>();
-        let counts = libm::round(z / self.mm_per_count) as i32;
+        let counts = libm::round(z / self.mm_per_count) as i32 + nudged;
         (self.zero as i32 + counts).rem_euclid(1 << 14) as u16
     }
 
@@ -123,14 +132,18 @@ impl SpiDevice<u8> for LeverSpi {
                 tx.get(1).copied().unwrap_or(0),
             ]) & 0x3FFF;
             let lever = self.0;
-            let (frame, last) = lever.state.update(|s| {
-                let out = (s.frames, s.last_command);
+            let up = if lever.mm_per_count > 0.0 { 1 } else { -1 };
+            let (frame, last, nudged) = lever.state.update(|s| {
+                if s.frames < NUDGE_FRAMES && s.enabled && s.duty > LEVER_MAX_DUTY / 100 {
+                    s.nudged += if s.forward { up } else { -up };
+                }
+                let out = (s.frames, s.last_command, s.nudged);
                 s.frames = s.frames.saturating_add(1);
                 s.last_command = command;
                 out
             });
             let answer = match last {
-                ANGLECOM => with_parity(lever.angle(frame)),
+                ANGLECOM => with_parity(lever.angle(frame, nudged)),
                 DIAAGC => with_parity(DIAAGC_LF),
                 _ => 0,
             };

@@ -32,6 +32,7 @@ pub mod command_line;
 pub mod controller;
 pub mod demo;
 pub mod device;
+pub mod direction;
 pub mod drivers;
 pub mod entry;
 pub mod float_patch;

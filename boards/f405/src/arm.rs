@@ -69,15 +69,13 @@ pub const RUNAWAY_TICKS: u8 = 5;
 pub const WALL_MARGIN_DEG: f64 = 3.0;
 /// How long the home input must stay high, with the arm still, before the arm homes, ms.
 pub const HOME_DEBOUNCE_MS: u32 = 50;
-pub use crate::device::{PASSIVITY_CREDIT_MJ, PASSIVITY_TRIP_MJ};
+pub use crate::device::{
+    NUDGE_SETTLE_MS, NUDGE_TIMEOUT_MS, PASSIVITY_CREDIT_MJ, PASSIVITY_TRIP_MJ,
+};
 /// The direction check's nudge at each joint, N·m (docs/safety.md).
 pub const NUDGE_TORQUE_NM: f64 = 0.2;
 /// Motor counts a nudge must move its joint.
 pub const NUDGE_COUNTS: u32 = 8;
-/// How long a nudge may take to move them, ms.
-pub const NUDGE_TIMEOUT_MS: u32 = 200;
-/// Zero duty before each nudge, ms.
-pub const NUDGE_SETTLE_MS: u32 = 30;
 
 /// The arm on `spec` and its parts, in its safe state (zero duty on every joint, the
 /// driver disabled) before it is returned; not homed (no force until the home input

@@ -159,7 +159,7 @@ mod tests {
             assert_eq!(DevicePart::from_code(p.code()), Some(*p));
         }
         assert_eq!(DevicePart::from_code(0), None);
-        assert_eq!(DevicePart::from_code(28), None);
+        assert_eq!(DevicePart::from_code(30), None);
         assert_eq!(
             DevicePart::JointReversed(7).code(),
             DevicePart::JointReversed(2).code()

@@ -15,7 +15,7 @@ use mccs::{
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
 use mccs_firmware::link::LinkedDevice;
-use mccs_firmware::one_dof::{OneDofDevice, OneDofError};
+use mccs_firmware::one_dof::{DirectionCheck, OneDofDevice, OneDofError, DIRECTION_COUNT_MM};
 use mccs_firmware::{Controller, Glued, HapticDevice, Roaming};
 
 /// The AS5047P's SPI mode (datasheet: CPOL = 0, CPHA = 1; data sampled on the falling
@@ -36,6 +36,29 @@ pub const PASSIVITY_TRIP_MJ: f64 = 2.0;
 /// The most the hand's earlier input may pay for later output, mJ: above what the
 /// tissue stores at the force clamp (3 N over 6 mm: 9 mJ).
 pub const PASSIVITY_CREDIT_MJ: f64 = 10.0;
+
+/// The lever's start-up nudge (`OneDofDevice::with_direction_check`), N at the probe:
+/// 0.2 N of the motor's 3 N at full duty, a little against the lever's friction.
+pub const LEVER_NUDGE_N: f64 = 0.2;
+/// How far a nudge must move the lever, mm (7 counts of the AS5047P on the shipped
+/// lever), in the check's counts of 2⁻¹⁰ mm.
+pub const LEVER_NUDGE_MM: f64 = 0.02;
+/// How long a nudge (the lever's, an arm joint's) may take to move it, ms.
+pub const NUDGE_TIMEOUT_MS: u32 = 200;
+/// Zero duty before each nudge, ms.
+pub const NUDGE_SETTLE_MS: u32 = 30;
+
+/// The lever's direction check on `config`.
+pub fn lever_check(config: &BoardConfig) -> DirectionCheck<1> {
+    let duty = (LEVER_NUDGE_N / config.force_at_full_duty).clamp(0.0, 1.0);
+    DirectionCheck::one(
+        config.tick_hz,
+        libm::round(duty * 65_536.0) as i32,
+        libm::round(LEVER_NUDGE_MM / DIRECTION_COUNT_MM) as u32,
+        NUDGE_TIMEOUT_MS,
+        NUDGE_SETTLE_MS,
+    )
+}
 
 /// The board's device on these parts.
 pub type BoardDevice<SPI, PWM, DIR, EN> = OneDofDevice<SPI, PWM, DIR, EN>;
@@ -113,6 +136,8 @@ impl<S, P, D, E> From<&OneDofError<S, P, D, E>> for DevicePart {
             OneDofError::Motor(MotorError::Direction(_)) => DevicePart::Direction,
             OneDofError::Motor(MotorError::Enable(_)) => DevicePart::Enable,
             OneDofError::EnergyOut => DevicePart::EnergyOut,
+            OneDofError::Reversed => DevicePart::LeverReversed,
+            OneDofError::Unmoved => DevicePart::LeverUnmoved,
         }
     }
 }
@@ -169,11 +194,15 @@ pub enum DevicePart {
     /// The force (the lever's or the arm's) put out energy beyond the passivity
     /// observer's trip.
     EnergyOut,
+    /// The lever moved against its start-up nudge.
+    LeverReversed,
+    /// The lever did not move when nudged at start-up.
+    LeverUnmoved,
 }
 
 impl DevicePart {
     /// Every part, by its code less one ([`DevicePart::code`]).
-    pub const ALL: [DevicePart; 27] = {
+    pub const ALL: [DevicePart; 29] = {
         use DevicePart::*;
         [
             Spi,
@@ -203,10 +232,12 @@ impl DevicePart {
             JointUnmoved(0),
             JointUnmoved(1),
             JointUnmoved(2),
+            LeverReversed,
+            LeverUnmoved,
         ]
     };
 
-    /// Its code in the black box (1 … 27, its place in [`DevicePart::ALL`]; 0 is no
+    /// Its code in the black box (1 … 29, its place in [`DevicePart::ALL`]; 0 is no
     /// part). A joint past C is C, as its name is.
     pub const fn code(self) -> u8 {
         const fn j(k: u8) -> u8 {
@@ -232,6 +263,8 @@ impl DevicePart {
             Self::EnergyOut => 21,
             Self::JointReversed(k) => 22 + j(k),
             Self::JointUnmoved(k) => 25 + j(k),
+            Self::LeverReversed => 28,
+            Self::LeverUnmoved => 29,
         }
     }
 
@@ -300,6 +333,8 @@ impl DevicePart {
                 ],
             ),
             Self::EnergyOut => "the force putting energy into the hand (passivity)",
+            Self::LeverReversed => "the lever moving against its drive (motor or encoder reversed)",
+            Self::LeverUnmoved => "the lever not moving when nudged (let go of it; reset)",
         }
     }
 }
@@ -377,7 +412,8 @@ where
     .with_passivity(mccs::PassivityLimits::new(
         PASSIVITY_TRIP_MJ,
         PASSIVITY_CREDIT_MJ,
-    ));
+    ))
+    .with_direction_check(lever_check(config));
     device.safe_state().map_err(StartError::SafeState)?;
     Ok(device)
 }

@@ -4,8 +4,9 @@
 //! the safe state at start-up and on a fault, and the run QEMU checks (an encoder that
 //! reads zeros), tick by tick. A wrong pin level, command or duty fails the mock.
 
-use embedded_hal::digital::{ErrorType as PinErrorType, OutputPin};
-use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
+mod common;
+
+use common::{moved_by, Log, Pin, Pwm, Sensor, CHECKED_BY};
 use embedded_hal::spi::{Phase, Polarity};
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinTx};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
@@ -19,8 +20,6 @@ use haptic_f405::{BoardConfig, BOARD};
 use mccs::{Force, ForceTable, ForceTable64, Length, Params};
 use mccs_firmware::drivers::as5047p::{read_command, ANGLECOM, DIAAGC, DIAAGC_LF};
 use mccs_firmware::{Fault, HapticDevice};
-use std::cell::RefCell;
-use std::rc::Rc;
 
 /// A response frame with even parity.
 fn frame(data: u16) -> u16 {
@@ -310,34 +309,41 @@ fn the_encoder_frames_from_power_up() {
 
 #[test]
 fn a_force_step_sets_the_direction_at_zero_duty_then_the_duty() {
-    // 1.5 N of the 3 N at full duty: half of 8400 steps.
-    let half = 4200;
-    let mut pwm = PwmMock::new(&[
-        PwmTx::max_duty_cycle(8400),
-        PwmTx::set_duty_cycle(0),    // start-up
-        PwmTx::set_duty_cycle(0),    // +z: zero first,
-        PwmTx::set_duty_cycle(half), // then the duty
-        PwmTx::set_duty_cycle(half), // +z again: no direction change
-        PwmTx::set_duty_cycle(0),    // −z: zero first,
-        PwmTx::set_duty_cycle(half),
-        PwmTx::set_duty_cycle(8400), // −6 N: saturates at full duty
-        PwmTx::set_duty_cycle(0),    // no force
-    ]);
-    let mut dir = PinMock::new(&[PinTx::set(State::High), PinTx::set(State::Low)]);
-    let mut en = PinMock::new(&[PinTx::set(State::Low)]);
-    let mut spi = SpiMock::new(&[]);
-    let mut dev =
-        device::device(&BOARD, spi.clone(), pwm.clone(), dir.clone(), en.clone()).unwrap();
+    // The lever at rest passes its start-up nudges first (the tissue's force after).
+    let log = Log::default();
+    let mut dev = device::device(
+        &BOARD,
+        Sensor::new(moved_by(&log, 1, |_| BOARD.encoder_zero)),
+        Pwm(log.clone()),
+        Pin(log.clone(), "dir"),
+        Pin(log.clone(), "enable"),
+    )
+    .unwrap();
     let z = |f: f64| [Force::ZERO, Force::ZERO, Force::from_num(f)];
+    for _ in 0..CHECKED_BY {
+        dev.read_position().unwrap();
+        dev.write_force(z(0.0)).unwrap();
+    }
+    assert!(dev.direction_checked());
+    log.0.borrow_mut().clear();
     for f in [1.5, 1.5, -1.5, -6.0, 0.0] {
         dev.write_force(z(f)).unwrap();
     }
-    // Forces along x and y are not rendered by a 1-DOF device: no call at all.
-    drop(dev);
-    spi.done();
-    pwm.done();
-    dir.done();
-    en.done();
+    // 1.5 N of the 3 N at full duty: half of 8400 steps; the nudges ended going down.
+    assert_eq!(
+        *log.0.borrow(),
+        [
+            "duty 0",
+            "dir high",
+            "duty 4200", // +z: zero first, the direction, the duty
+            "duty 4200", // +z again: no direction change
+            "duty 0",
+            "dir low",
+            "duty 4200", // −z
+            "duty 8400", // −6 N: saturates at full duty
+            "duty 0",    // no force
+        ]
+    );
 }
 
 /// The run QEMU makes: its SPI has no device behind it, so every frame reads zeros.
@@ -414,82 +420,6 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     dir.done();
 }
 
-/// What the motor saw, in order.
-#[derive(Clone, Default)]
-struct Log(Rc<RefCell<Vec<String>>>);
-
-struct Pwm(Log);
-impl PwmErrorType for Pwm {
-    type Error = core::convert::Infallible;
-}
-impl SetDutyCycle for Pwm {
-    fn max_duty_cycle(&self) -> u16 {
-        8400
-    }
-    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
-        self.0 .0.borrow_mut().push(format!("duty {duty}"));
-        Ok(())
-    }
-}
-struct Pin(Log, &'static str);
-impl PinErrorType for Pin {
-    type Error = core::convert::Infallible;
-}
-impl OutputPin for Pin {
-    fn set_low(&mut self) -> Result<(), Self::Error> {
-        self.0 .0.borrow_mut().push(format!("{} low", self.1));
-        Ok(())
-    }
-    fn set_high(&mut self) -> Result<(), Self::Error> {
-        self.0 .0.borrow_mut().push(format!("{} high", self.1));
-        Ok(())
-    }
-}
-
-/// An AS5047P on the SPI: answers the previous frame's command — DIAAGC running, the
-/// angle `angle(frame)` for ANGLECOM — with even parity.
-#[derive(Clone)]
-struct Sensor(Rc<RefCell<SensorState>>);
-
-/// The angle per frame, frames so far, the last command.
-type SensorState = (Box<dyn FnMut(usize) -> u16>, usize, u16);
-
-impl Sensor {
-    fn new(angle: impl FnMut(usize) -> u16 + 'static) -> Self {
-        Self(Rc::new(RefCell::new((Box::new(angle), 0, 0))))
-    }
-}
-
-impl embedded_hal::spi::ErrorType for Sensor {
-    type Error = core::convert::Infallible;
-}
-
-impl embedded_hal::spi::SpiDevice<u8> for Sensor {
-    fn transaction(
-        &mut self,
-        ops: &mut [embedded_hal::spi::Operation<'_, u8>],
-    ) -> Result<(), Self::Error> {
-        let mut s = self.0.borrow_mut();
-        for op in ops {
-            if let embedded_hal::spi::Operation::Transfer(rx, tx) = op {
-                let command = u16::from_be_bytes([tx[0], tx[1]]) & 0x3FFF;
-                let response = match s.2 {
-                    ANGLECOM => {
-                        let n = s.1;
-                        frame((s.0)(n))
-                    }
-                    DIAAGC => frame(DIAAGC_LF),
-                    _ => frame(0),
-                };
-                rx.copy_from_slice(&response.to_be_bytes());
-                s.2 = command;
-                s.1 += 1;
-            }
-        }
-        Ok(())
-    }
-}
-
 /// A press into the tissue: the probe goes 1 mm down at the fastest plausible speed
 /// and stays; the tissue pushes back along +z: the direction pin goes high at zero duty,
 /// then a duty in proportion to the force the controller returns.
@@ -497,11 +427,15 @@ impl embedded_hal::spi::SpiDevice<u8> for Sensor {
 fn a_press_renders_an_upward_force() {
     let press = (1.0 / BOARD.mm_per_count) as i32; // counts, 1 mm down: +z is up
     let step = BOARD.encoder().max_step as i32 - 1;
-    let angle = move |frame: usize| (-(frame as i32 * step).min(press)).rem_euclid(16384) as u16;
+    // After the start-up nudges.
+    let angle = move |frame: usize| {
+        let down = (frame.saturating_sub(CHECKED_BY) as i32 * step).min(press);
+        (BOARD.encoder_zero as i32 - down).rem_euclid(16384) as u16
+    };
     let log = Log::default();
     let dev = device::device(
         &BOARD,
-        Sensor::new(angle),
+        Sensor::new(moved_by(&log, 1, angle)),
         Pwm(log.clone()),
         Pin(log.clone(), "dir"),
         Pin(log.clone(), "enable"),
@@ -618,11 +552,14 @@ fn the_board_runs_a_table_of_any_knot_count() {
     fn press<const S: usize>(table: ForceTable<S>) -> f64 {
         let press = (1.0 / BOARD.mm_per_count) as i32;
         let step = BOARD.encoder().max_step as i32 - 1;
-        let angle = move |f: usize| (-(f as i32 * step).min(press)).rem_euclid(16384) as u16;
+        let angle = move |f: usize| {
+            let down = (f.saturating_sub(CHECKED_BY) as i32 * step).min(press);
+            (BOARD.encoder_zero as i32 - down).rem_euclid(16384) as u16
+        };
         let log = Log::default();
         let dev = device::device(
             &BOARD,
-            Sensor::new(angle),
+            Sensor::new(moved_by(&log, 1, angle)),
             Pwm(log.clone()),
             Pin(log.clone(), "dir"),
             Pin(log.clone(), "enable"),

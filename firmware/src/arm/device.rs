@@ -44,19 +44,19 @@
 //!   once the arm is homed (before, its counts mean nothing and its duty is zero), from
 //!   the tick after (its counts jump to the home pose).
 
-pub use crate::arm::direction::DirectionCheck;
 use crate::arm::runaway::Runaway;
 pub use crate::arm::runaway::SpeedLimits;
 pub use crate::arm::thermal::Thermal;
 pub use crate::arm::trims::Trims;
 pub use crate::arm::walls::Walls;
+pub use crate::direction::DirectionCheck;
 
-use crate::arm::direction::{Nudge, Nudges};
 use crate::arm::encoder::Extended;
 use crate::arm::joint::WriteFailed;
 pub use crate::arm::joint::{Joint, JointParts, PartFailed};
 use crate::arm::thermal::Heat;
 use crate::device::HapticDevice;
+use crate::direction::{Nudge, NudgeFault, Nudges};
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::arm::OUTSIDE;
 use mccs::{Arm, ArmPose, Force, Length, PassivityLimits, PassivityObserver};
@@ -216,7 +216,10 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> ArmDevice<A, B
             Nudge::Failed(fault) => {
                 self.nudge_duty = Some([0; 3]);
                 let _ = self.zero();
-                return Err(fault);
+                return Err(match fault {
+                    NudgeFault::Reversed(k) => ArmFault::Reversed(k),
+                    NudgeFault::Unmoved(k) => ArmFault::Unmoved(k),
+                });
             }
         }
         Ok(())

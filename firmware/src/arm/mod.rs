@@ -16,7 +16,6 @@
 //! - [`float`]: the same chain in `f32`, the bench's peer.
 
 pub mod device;
-pub mod direction;
 pub mod encoder;
 pub mod float;
 pub mod joint;

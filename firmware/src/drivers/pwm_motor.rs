@@ -151,6 +151,13 @@ impl<PWM: SetDutyCycle, DIR: OutputPin, EN: OutputPin> PwmMotor<PWM, DIR, EN> {
         duty.min(self.max_duty as u32) as u16
     }
 
+    /// The force a signed duty of `duty_q16` renders (65,536: 100 %, clamped to ±100 %):
+    /// what [`PwmMotor::write`] takes to drive that duty (the lever's direction check).
+    pub fn force_at(&self, duty_q16: i32) -> Force {
+        let d = duty_q16.clamp(-65_536, 65_536) as i64;
+        Force::from_bits(((self.full as i64 * d) >> 16) as i32)
+    }
+
     /// Renders a force along the device's axis. A direction change goes through zero
     /// duty; on a failed write the duty is set to zero if it can be.
     pub fn write(&mut self, force: Force) -> Result<(), ErrorOf<PWM, DIR, EN>> {
