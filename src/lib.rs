@@ -38,6 +38,7 @@ pub mod table;
 pub mod tissue_pose;
 pub mod topology;
 pub mod units;
+pub mod velocity;
 pub mod window;
 
 #[cfg(feature = "defmt")]
@@ -59,4 +60,5 @@ pub use table::{
 pub use tissue_pose::TissuePose;
 pub use topology::{Edge, End, Topology, TopologyError, GROUND};
 pub use units::{Force, Length, Stiffness, Strain, Velocity};
+pub use velocity::{TrackerError, TrackerGains, VelocityTracker};
 pub use window::{Window, WindowConfig};

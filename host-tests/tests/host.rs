@@ -68,3 +68,5 @@ mod table_bound;
 mod table_edges;
 #[path = "table_source.rs"]
 mod table_source;
+#[path = "velocity.rs"]
+mod velocity;

@@ -2,7 +2,6 @@
 //! [`Shape`], driven through a [`Proxy`]: the contact, the window's shift, the substeps.
 //! The window's start-up is `solver/window.rs`; its own shift rules `crate::window`.
 
-use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Frame, Proxy};
@@ -29,7 +28,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         };
         let o = window.origin();
         let mut p = in_frame(o);
-        let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
+        let probe_vel = self.probe_velocity(p, probe);
         let frame = Frame {
             shape: window.shape(),
             origin: o,

@@ -538,6 +538,11 @@ pub fn roaming_controller_with<D: HapticDevice, const S: usize>(
     enable: impl FnOnce(&mut D) -> Result<(), D::Error>,
 ) -> Result<(), (StartError<D::Error>, D)> {
     let built = solver(config, table).and_then(|mut s| {
+        // The arm's probe velocity for the coupling's damping: the tracker's, from
+        // counts of 64 µm (docs/safety.md, "The probe's velocity").
+        let gains = mccs::TrackerGains::default_at(config.tick_hz)
+            .map_err(|_| StartError::Config(BoardConfigError::Tick))?;
+        s.set_velocity_tracker(Some(gains));
         let contact = roaming(config, &mut s).map_err(StartError::Contact)?;
         Ok((s, contact))
     });

@@ -272,10 +272,12 @@ fn device_share(core: CoreArg, device: DeviceArg, patch_tick: u64) -> (u64, Stri
             let contact = roaming.saturating_sub(glued);
             let chain = figure(core.name(), "arm_kinematics", "instructions").unwrap_or(0);
             let link = figure(core.name(), "tick_link", "instructions").unwrap_or(0);
+            let observer = figure(core.name(), "passivity_observer", "instructions").unwrap_or(0);
+            let tracker = figure(core.name(), "velocity_tracker", "instructions").unwrap_or(0);
             (
-                patch_tick + contact + chain + link,
+                patch_tick + contact + chain + link + observer + tracker,
                 format!(
-                    "plus the arm board's: the roaming contact with friction {contact} (the demo's roaming tick less its glued tick, measured at N = {}), the arm's chain {chain}, the link's share {link}",
+                    "plus the arm board's: the roaming contact with friction {contact} (the demo's roaming tick less its glued tick, measured at N = {}), the arm's chain {chain}, the link's share {link}, the passivity observer {observer}, the velocity tracker {tracker}",
                     core.demo_grid()
                 ),
             )

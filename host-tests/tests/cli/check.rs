@@ -133,10 +133,10 @@ fn what_does_not_fit_or_cannot_run_says_why() {
 
 /// `--device arm`: the arm board's whole tick on the M4F's N = 8 patch is the bare
 /// patch's bound plus the contact's own cost (the demo's roaming tick less its glued
-/// tick), the arm's chain and the link's share, each from the baseline; it fits half a
-/// tick.
+/// tick), the arm's chain, the link's share, the passivity observer and the velocity
+/// tracker, each from the baseline; it fits half a tick.
 #[test]
-fn the_arm_boards_trainer_tick_adds_the_contact_the_chain_and_the_link() {
+fn the_arm_boards_trainer_tick_adds_the_contact_the_chain_the_link_and_the_watch() {
     let out = mccs_ok(&["check", "--params", "params/table2.toml", "--device", "arm"]);
     let (_, tick, budget, fits) = parse(String::from_utf8(out.stdout).unwrap().trim());
     let c = |case: &str| baseline("m4f", case, "instructions");
@@ -144,7 +144,9 @@ fn the_arm_boards_trainer_tick_adds_the_contact_the_chain_and_the_link() {
         + c("tick_roaming_bound")
         - c("tick")
         + c("arm_kinematics")
-        + c("tick_link");
+        + c("tick_link")
+        + c("passivity_observer")
+        + c("velocity_tracker");
     assert_eq!(tick, want);
     assert!(fits && tick <= budget);
     let err = String::from_utf8(out.stderr).unwrap();

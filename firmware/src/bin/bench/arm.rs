@@ -6,7 +6,7 @@
 use super::fw_common::exit;
 use super::harness::Harness;
 use core::hint::black_box;
-use mccs::{Arm, Force, Length, PassivityLimits, PassivityObserver};
+use mccs::{Arm, Force, Length, PassivityLimits, PassivityObserver, TrackerGains, VelocityTracker};
 use mccs_firmware::arm::device::WOODENHAPTICS;
 use mccs_firmware::arm::float::ArmF32;
 
@@ -47,6 +47,22 @@ pub fn passivity_observer(h: &Harness) -> u32 {
     h.measure(4, || {
         probe[2] -= Length::from_num(0.01);
         black_box(observer.tick(black_box(probe), black_box(force), black_box(limits)));
+    })
+}
+
+/// One tick of the velocity tracker (`case=velocity_tracker`, three axes), the probe
+/// moving, averaged over 4.
+#[inline(never)]
+pub fn velocity_tracker(h: &Harness) -> u32 {
+    let Ok(gains) = TrackerGains::default_at(1000) else {
+        exit(false)
+    };
+    let mut tracker = VelocityTracker::new();
+    let mut probe = [Length::from_num(1.5), Length::ZERO, Length::from_num(-0.7)];
+    tracker.update(&gains, probe);
+    h.measure(4, || {
+        probe[2] -= Length::from_num(0.01);
+        black_box(tracker.update(&gains, black_box(probe)));
     })
 }
 

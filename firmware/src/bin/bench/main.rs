@@ -248,7 +248,7 @@ mod firmware {
         }
 
         /// Whole ticks: the demo's, through a proxy, the link's share, the arm's chain
-        /// and its peer, the passivity observer; the start-up and a tissue's check.
+        /// and its peer, the passivity observer, the velocity tracker; the start-up and a tissue's check.
         fn ticks(&mut self) {
             let (h, table, empty) = (&self.h, self.table, self.empty);
             let f = &mut self.figs;
@@ -263,6 +263,8 @@ mod firmware {
             f.report("arm_kinematics_f32", arm::arm_kinematics_f32(h) - empty);
             // The passivity observer's tick (the arm board's).
             f.report("passivity_observer", arm::passivity_observer(h) - empty);
+            // The probe's velocity from its quantised positions (the tracker, 3 axes).
+            f.report("velocity_tracker", arm::velocity_tracker(h) - empty);
             // The solver's start-up for the demo's patch, once (millions of instructions).
             let grid = mccs_firmware::demo::spec_for(CORE).grid as u32;
             report::startup(f, grid, ticks::startup(h, table));
