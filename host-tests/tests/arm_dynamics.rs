@@ -184,6 +184,13 @@ fn the_device_file_s_stable_region_is_what_the_simulated_arm_measures() {
     );
 }
 
+/// The board's own copy of the region (`haptic_f405::arm::STABLE_REGION`, what it checks
+/// its coupling against at start-up) is the device file's.
+#[test]
+fn the_board_s_stable_region_is_the_device_file_s() {
+    assert_eq!(region().points, haptic_f405::arm::STABLE_REGION.to_vec());
+}
+
 /// What a direction check on the closed loop did.
 struct Checked {
     /// The board's fault, if any.

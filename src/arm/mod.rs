@@ -36,6 +36,7 @@ pub mod inverse;
 mod pose;
 pub mod recip;
 mod spec;
+pub mod stable_region;
 
 pub use drive::Drive;
 pub use pose::{ArmPose, LIMITS, LIMIT_A, LIMIT_B, LIMIT_C, OUTSIDE};

@@ -8,6 +8,7 @@
 use crate::config::BoardConfig;
 use crate::device::{
     roaming_controller_with, BoardController, BoardRoaming, DevicePart, StartError, StartFault,
+    UnstableCoupling,
 };
 use embedded_hal::digital::{InputPin, OutputPin};
 use mccs::{Arm, ArmSpec, ForceTable, PassivityLimits};
@@ -20,6 +21,34 @@ use mccs_firmware::HapticDevice;
 /// The arm the board drives: the firmware's WoodenHaptics constant, which a host test
 /// holds equal to `devices/woodenhaptics.toml`. A port to another arm replaces it.
 pub const ARM: ArmSpec = mccs_firmware::arm::device::WOODENHAPTICS;
+
+/// The arm's stable region, `(coupling damping N·s/m, stiffness N/mm)`: the shipped
+/// device file's `[stability]` (`mccs arm stability` measured it on the simulated arm;
+/// a host test holds the two equal). A port to another arm measures its own.
+pub const STABLE_REGION: [(f64, f64); 5] = [
+    (0.0, 16.0),
+    (0.5, 64.0),
+    (1.0, 64.0),
+    (2.0, 64.0),
+    (5.0, 64.0),
+];
+
+/// Whether `config`'s coupling is within half of [`STABLE_REGION`] at its damping, as
+/// `mccs check --device arm` allows (start-up: floating point); else the refusal with
+/// its figures.
+pub fn check_coupling(config: &BoardConfig) -> Result<(), UnstableCoupling> {
+    let milli = |x: f64| libm::round((x * 1000.0).clamp(0.0, u32::MAX as f64)) as u32;
+    let half = mccs::arm::stable_region::stable_coupling(&STABLE_REGION, config.coupling_damping)
+        .map(|k| k / 2.0);
+    match half {
+        Some(limit) if config.coupling_stiffness <= limit => Ok(()),
+        _ => Err(UnstableCoupling {
+            stiffness_mn_mm: milli(config.coupling_stiffness),
+            damping_mn_s_m: milli(config.coupling_damping),
+            limit_mn_mm: half.map(milli),
+        }),
+    }
+}
 
 /// The board's arm on these parts.
 pub type BoardArm<A, B, C, EN, HOME> = ArmDevice<A, B, C, EN, HOME>;
@@ -37,6 +66,7 @@ impl StartError<ArmFault> {
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
+            Self::Coupling(c) => StartFault::Coupling(*c),
         }
     }
 }
@@ -137,4 +167,28 @@ pub fn arm_controller_into<
     slot: &mut Option<BoardController<LinkedArm<A, B, C, EN, HOME>, BoardRoaming, S>>,
 ) -> Result<(), (StartError<ArmFault>, BoardArm<A, B, C, EN, HOME>)> {
     roaming_controller_with(config, table, device, slot, |d| d.enable())
+}
+
+/// The board's start-up: [`arm_controller_into`] once the coupling is within half the
+/// arm's stable region ([`check_coupling`]; the device handed back, never enabled, if
+/// not). The simulated arm's measurement of the region calls [`arm_controller_into`]
+/// itself, to run couplings beyond it.
+#[allow(clippy::type_complexity, clippy::result_large_err)]
+pub fn arm_start_into<
+    A: Joint,
+    B: Joint,
+    C: Joint,
+    EN: OutputPin,
+    HOME: InputPin,
+    const S: usize,
+>(
+    config: &BoardConfig,
+    table: ForceTable<S>,
+    device: BoardArm<A, B, C, EN, HOME>,
+    slot: &mut Option<BoardController<LinkedArm<A, B, C, EN, HOME>, BoardRoaming, S>>,
+) -> Result<(), (StartError<ArmFault>, BoardArm<A, B, C, EN, HOME>)> {
+    if let Err(c) = check_coupling(config) {
+        return Err((StartError::Coupling(c), device));
+    }
+    arm_controller_into(config, table, device, slot)
 }

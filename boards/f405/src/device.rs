@@ -108,6 +108,8 @@ pub enum StartError<E> {
     Solver(SolverError),
     /// The roaming contact: its proxy or window.
     Contact(ProxyError),
+    /// The coupling over half the arm's stable region at its damping.
+    Coupling(UnstableCoupling),
 }
 
 impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
@@ -121,6 +123,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
             Self::Topology(e) => StartFault::Topology(*e),
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
+            Self::Coupling(c) => StartFault::Coupling(*c),
         }
     }
 }
@@ -142,6 +145,39 @@ impl<S, P, D, E> From<&OneDofError<S, P, D, E>> for DevicePart {
     }
 }
 
+/// A coupling the arm's stable region does not allow (`arm::check_coupling`), in
+/// thousandths: mN/mm and mN·s/m.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnstableCoupling {
+    /// The coupling's stiffness.
+    pub stiffness_mn_mm: u32,
+    /// Its damping.
+    pub damping_mn_s_m: u32,
+    /// Half the region's stiffness at that damping (`None`: the damping is outside the
+    /// measured region).
+    pub limit_mn_mm: Option<u32>,
+}
+
+impl core::fmt::Display for UnstableCoupling {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let n = |m: u32| m as f64 / 1000.0;
+        match self.limit_mn_mm {
+            Some(limit) => write!(
+                f,
+                "coupling: {:.3} N/mm at {:.3} N·s/m is over half the arm's stable region there, {:.3} N/mm (docs/safety.md)",
+                n(self.stiffness_mn_mm),
+                n(self.damping_mn_s_m),
+                n(limit)
+            ),
+            None => write!(
+                f,
+                "coupling: its damping, {:.3} N·s/m, is outside the arm's measured stable region (docs/safety.md)",
+                n(self.damping_mn_s_m)
+            ),
+        }
+    }
+}
+
 /// Why the board could not start, as its log says it: a [`StartError`] without the HAL's
 /// error types, which vary by board (`Copy`, for the tick to hand to `main`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -158,6 +194,8 @@ pub enum StartFault {
     Solver(SolverError),
     /// The roaming contact: its proxy or window.
     Contact(ProxyError),
+    /// The coupling over half the arm's stable region at its damping.
+    Coupling(UnstableCoupling),
 }
 
 /// A part of the board's device.
@@ -360,6 +398,7 @@ impl core::fmt::Display for StartFault {
             Self::Topology(e) => write!(f, "{e}"),
             Self::Solver(e) => write!(f, "solver: {e}"),
             Self::Contact(e) => write!(f, "{e}"),
+            Self::Coupling(c) => write!(f, "{c}"),
         }
     }
 }
@@ -382,6 +421,20 @@ impl defmt::Format for StartFault {
             Self::Topology(e) => defmt::write!(f, "{}", e),
             Self::Solver(e) => defmt::write!(f, "solver: {}", e),
             Self::Contact(e) => defmt::write!(f, "{=str}", e.message()),
+            Self::Coupling(c) => match c.limit_mn_mm {
+                Some(limit) => defmt::write!(
+                    f,
+                    "coupling: {=u32} mN/mm at {=u32} mN·s/m is over half the arm's stable region there, {=u32} mN/mm (docs/safety.md)",
+                    c.stiffness_mn_mm,
+                    c.damping_mn_s_m,
+                    limit
+                ),
+                None => defmt::write!(
+                    f,
+                    "coupling: its damping, {=u32} mN·s/m, is outside the arm's measured stable region (docs/safety.md)",
+                    c.damping_mn_s_m
+                ),
+            },
         }
     }
 }
@@ -466,6 +519,7 @@ fn widen<E>(e: StartError<core::convert::Infallible>) -> StartError<E> {
         StartError::Topology(t) => StartError::Topology(t),
         StartError::Solver(s) => StartError::Solver(s),
         StartError::Contact(c) => StartError::Contact(c),
+        StartError::Coupling(c) => StartError::Coupling(c),
         StartError::SafeState(never) => match never {},
     }
 }

@@ -12,7 +12,7 @@ use embedded_hal::digital::{
 use embedded_hal::pwm::{ErrorKind as PwmErrorKind, ErrorType as PwmErrorType, SetDutyCycle};
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinTx};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmTx};
-use haptic_f405::arm::{arm_controller_into, arm_device, LinkedArm, ARM};
+use haptic_f405::arm::{arm_controller_into, arm_device, arm_start_into, LinkedArm, ARM};
 use haptic_f405::device::{BoardController, BoardRoaming, DevicePart, StartError};
 use haptic_f405::tissue::TISSUE;
 use haptic_f405::BOARD;
@@ -254,7 +254,7 @@ fn start_up_is_zero_duty_and_the_driver_off_then_on_in_that_order() {
     )
     .unwrap_or_else(|_| panic!("the arm's device"));
     let mut slot = None;
-    assert!(arm_controller_into(&BOARD, TISSUE, device, &mut slot).is_ok());
+    assert!(arm_start_into(&BOARD, TISSUE, device, &mut slot).is_ok());
     drop(slot);
     for mut m in pwm {
         m.done();
@@ -503,6 +503,59 @@ fn start_up_errors_name_the_part_and_the_joint() {
         e.fault().to_string(),
         "joint: counts_per_rev and ratio must be finite and > 0, a joint turn 16 to 2^30 counts (joint C)"
     );
+}
+
+/// A coupling over half the arm's stable region at its damping (what `mccs check
+/// --device arm` refuses) is refused at start-up with its figures, the driver never
+/// enabled; a damping outside the measured region too. The board's own passes.
+#[test]
+fn a_coupling_beyond_half_the_stable_region_is_refused_at_start_up() {
+    use haptic_f405::arm::check_coupling;
+    use haptic_f405::BoardConfig;
+    assert_eq!(check_coupling(&BOARD), Ok(()));
+    let at = |k: f64, b: f64| BoardConfig {
+        coupling_stiffness: k,
+        coupling_damping: b,
+        ..BOARD
+    };
+    // Half of 64 N/mm at 0.5 N·s/m: 32 passes, 33 does not.
+    assert_eq!(check_coupling(&at(32.0, 0.5)), Ok(()));
+    for (config, said) in [
+        (
+            at(33.0, 0.5),
+            "coupling: 33.000 N/mm at 0.500 N·s/m is over half the arm's stable region there, 32.000 N/mm (docs/safety.md)",
+        ),
+        (
+            at(9.0, 0.25),
+            "coupling: 9.000 N/mm at 0.250 N·s/m is over half the arm's stable region there, 8.000 N/mm (docs/safety.md)",
+        ),
+        (
+            at(1.0, 7.0),
+            "coupling: its damping, 7.000 N·s/m, is outside the arm's measured stable region (docs/safety.md)",
+        ),
+    ] {
+        let enable = Part::default();
+        let joint = || JointParts {
+            encoder: Counter(Part::default()),
+            pwm: Pwm(Part::default()),
+            direction: Out(Part::default()),
+        };
+        let device = arm_device(
+            &config,
+            &ARM,
+            (joint(), joint(), joint()),
+            Out(enable.clone()),
+            In(Part::default()),
+        )
+        .unwrap_or_else(|_| panic!("the arm's device"));
+        let mut slot = None;
+        let Err((e, _device)) = arm_start_into(&config, TISSUE, device, &mut slot) else {
+            panic!("{said}: started")
+        };
+        assert_eq!(e.fault().to_string(), said);
+        assert!(slot.is_none());
+        assert_eq!(enable.value.get(), 0, "the driver enabled");
+    }
 }
 
 /// The simulated arm board's own loop (its plant palpating, the board's arm device and

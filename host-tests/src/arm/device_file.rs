@@ -78,14 +78,7 @@ impl StableRegion {
     /// The region's stiffness at `damping`: a measured one's, or between two the lower
     /// of theirs (nothing is known between them; None: outside them).
     pub fn max_coupling(&self, damping: f64) -> Option<f64> {
-        let p = &self.points;
-        if let Some(&(_, k)) = p.iter().find(|(b, _)| *b == damping) {
-            return Some(k);
-        }
-        p.windows(2).find_map(|w| {
-            let ((b0, k0), (b1, k1)) = (w[0], w[1]);
-            (b0 < damping && damping < b1).then_some(k0.min(k1))
-        })
+        mccs::arm::stable_region::stable_coupling(&self.points, damping)
     }
 }
 

@@ -56,7 +56,7 @@ impl BoardVariant for SimArm {
         device: Self::Device,
         slot: &mut Option<CtlOf<Self>>,
     ) -> Result<(), (StartFault, Self::Device)> {
-        arm::arm_controller_into(config, table, device, slot).map_err(|(e, d)| (e.fault(), d))
+        arm::arm_start_into(config, table, device, slot).map_err(|(e, d)| (e.fault(), d))
     }
 
     fn log_second(t: &BoardTelemetry) {
