@@ -60,5 +60,5 @@ pub use table::{
 pub use tissue_pose::TissuePose;
 pub use topology::{Edge, End, Topology, TopologyError, GROUND};
 pub use units::{Force, Length, Stiffness, Strain, Velocity};
-pub use velocity::{TrackerError, TrackerGains, VelocityTracker};
+pub use velocity::{TrackedVelocity, TrackerError, TrackerGains, VelocityTracker};
 pub use window::{Window, WindowConfig};

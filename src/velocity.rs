@@ -20,7 +20,7 @@
 //! [`VelocityTracker::update`] in integers.
 //!
 //! A reading farther from the prediction than [`JUMP_MM_S`] would move in a tick (a
-//! homing, a probe that read out of range) is a jump, not a motion: the tracker starts
+//! homing, a probe that read out of range) is a jump, not a motion: that axis starts
 //! again from it, at rest, instead of ringing for a hundred milliseconds.
 //!
 //! # Range and cost
@@ -61,8 +61,8 @@ pub struct TrackerGains {
     beta_q31: i32,
     /// The tick rate, Hz.
     tick_hz: i32,
-    /// A jump: an error beyond this, Q24 mm.
-    jump: i32,
+    /// A jump: an error beyond this, Q24 mm (at most 20 mm: 100 Hz at 2 m/s).
+    jump: u32,
 }
 
 impl TrackerGains {
@@ -94,7 +94,7 @@ impl TrackerGains {
             alpha_q31: a as i32,
             beta_q31: b as i32,
             tick_hz: tick_hz as i32,
-            jump: crate::units::from_f64(JUMP_MM_S / tick_hz as f64, LEN_FRAC),
+            jump: crate::units::from_f64(JUMP_MM_S / tick_hz as f64, LEN_FRAC).unsigned_abs(),
         })
     }
 
@@ -120,12 +120,6 @@ pub struct VelocityTracker {
     started: bool,
 }
 
-/// `2 · mulhi(e, g)`: `e · g` for a Q31 gain `g`, in `e`'s units.
-#[inline(always)]
-fn gain(e: i32, g: i32) -> i32 {
-    q::mulhi(e, g).saturating_mul(2)
-}
-
 impl VelocityTracker {
     /// At rest, not started: the first reading is taken as it is.
     pub const fn new() -> Self {
@@ -145,29 +139,52 @@ impl VelocityTracker {
     /// after a start, a reset or a jump gives zero.
     pub fn update(&mut self, gains: &TrackerGains, p: [Length; 3]) -> [Velocity; 3] {
         const SH: u32 = LEN_FRAC - 16;
+        let started = self.started;
+        self.started = true;
         let p = p.map(Length::to_bits);
-        let off = |i: usize| {
-            let e = p[i].saturating_sub(self.x[i].saturating_add(self.w[i]));
-            e.saturating_abs() > gains.jump
-        };
-        if !self.started || off(0) || off(1) || off(2) {
-            *self = Self {
-                x: p,
-                w: [0; 3],
-                started: true,
-            };
-            return [Velocity::ZERO; 3];
-        }
         core::array::from_fn(|i| {
             let predicted = self.x[i].saturating_add(self.w[i]);
             let e = p[i].saturating_sub(predicted);
-            let step = gain(e, gains.alpha_q31);
+            if !started || e.unsigned_abs() > gains.jump {
+                // A start or a jump: from here, at rest.
+                self.x[i] = p[i];
+                self.w[i] = 0;
+                return Velocity::ZERO;
+            }
+            // |e| ≤ the jump, at most 20 mm (2²⁹ in Q24) at 100 Hz: `2e` fits.
+            let step = q::mulhi(e << 1, gains.alpha_q31);
             self.x[i] = predicted.saturating_add(step);
-            self.w[i] = self.w[i].saturating_add(gain(e, gains.beta_q31));
+            self.w[i] = self.w[i].saturating_add(q::mulhi(e << 1, gains.beta_q31));
             // The estimate's move this tick, `ŵ + α e`, times the tick rate.
             let moved = self.w[i].saturating_add(step);
             Velocity::from_bits(q::sat(q::mul_wide(moved, gains.tick_hz) >> SH))
         })
+    }
+}
+
+/// A tracker with its gains: what a contact holds to give the solver the probe's
+/// velocity ([`crate::Solver::step_roaming_at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TrackedVelocity {
+    /// The gains.
+    pub gains: TrackerGains,
+    /// The state.
+    pub tracker: VelocityTracker,
+}
+
+impl TrackedVelocity {
+    /// A tracker with `gains`, not started.
+    pub const fn new(gains: TrackerGains) -> Self {
+        Self {
+            gains,
+            tracker: VelocityTracker::new(),
+        }
+    }
+
+    /// [`VelocityTracker::update`] with its gains.
+    #[inline(always)]
+    pub fn update(&mut self, p: [Length; 3]) -> [Velocity; 3] {
+        self.tracker.update(&self.gains, p)
     }
 }
 

@@ -67,20 +67,42 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Contact<N
 
 /// The probe touching a tissue of shape `Sh` (flat by default, or a cap) through a proxy
 /// with friction, the patch following the contact as a window
-/// ([`Solver::step_roaming`]); the probe in the tissue frame.
+/// ([`Solver::step_roaming_at`]); the probe in the tissue frame.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Roaming<const EDGES: usize, Sh: Shape = Flat> {
     /// The proxy (from `Solver::proxy`).
     pub proxy: Proxy,
     /// The window (from `Solver::window`).
     pub window: Window<EDGES, Sh>,
+    /// The probe's velocity for the coupling's damping: a tracker on the probe's
+    /// quantised positions (the arm's: `mccs::velocity`); `None`, the solver's one-tick
+    /// difference.
+    pub velocity: Option<mccs::TrackedVelocity>,
+}
+
+impl<const EDGES: usize, Sh: Shape> Roaming<EDGES, Sh> {
+    /// The contact on `proxy` and `window`, its velocity the one-tick difference.
+    pub fn new(proxy: Proxy, window: Window<EDGES, Sh>) -> Self {
+        Self {
+            proxy,
+            window,
+            velocity: None,
+        }
+    }
+
+    /// Its velocity from a tracker with `gains`.
+    pub fn with_velocity_tracker(mut self, gains: mccs::TrackerGains) -> Self {
+        self.velocity = Some(mccs::TrackedVelocity::new(gains));
+        self
+    }
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, Sh: Shape>
     Contact<NODES, EDGES, S, A> for Roaming<EDGES, Sh>
 {
     fn step(&mut self, solver: &mut Solver<NODES, EDGES, S, A>, probe: [Length; 3]) -> [Force; 3] {
-        solver.step_roaming(probe, &mut self.proxy, &mut self.window)
+        let velocity = self.velocity.as_mut().map(|v| v.update(probe));
+        solver.step_roaming_at(probe, velocity, &mut self.proxy, &mut self.window)
     }
 
     fn window_shifts(&self) -> u32 {

@@ -192,7 +192,7 @@ impl DemoSpec {
         let window = solver
             .window(&WINDOW, &Flat, &proxy, x, y)
             .map_err(DemoError::Contact)?;
-        Ok(Roaming { proxy, window })
+        Ok(Roaming::new(proxy, window))
     }
 
     /// The proxy: the demo's friction and a point probe on this spec's patch.

@@ -565,7 +565,7 @@ enum Mode {
 fn roaming(s: &mut Solver<10, 61, 64>) -> Roaming<61> {
     let (proxy, wc) = roaming_parts(s);
     let window = s.window(&wc, &mccs::Flat, &proxy, 0.0, 0.0).unwrap();
-    Roaming { proxy, window }
+    Roaming::new(proxy, window)
 }
 
 /// [`roaming`] over a cap of radius 150 mm (its top under the probe).
@@ -573,7 +573,7 @@ fn roaming_cap(s: &mut Solver<10, 61, 64>) -> Roaming<61, mccs::Cap> {
     let (proxy, wc) = roaming_parts(s);
     let cap = mccs::Sphere { radius_mm: 150.0 };
     let window = s.window(&wc, &cap, &proxy, 0.0, 0.0).unwrap();
-    Roaming { proxy, window }
+    Roaming::new(proxy, window)
 }
 
 fn roaming_parts(s: &Solver<10, 61, 64>) -> (mccs::Proxy, WindowConfig) {

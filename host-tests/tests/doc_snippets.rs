@@ -40,7 +40,7 @@ fn firmware_md_a_roaming_controller() -> Result<(), Box<dyn Error>> {
     let (x0, y0) = (0.0, 0.0);
     let proxy = solver.proxy(&ProxyConfig { grid: 5, spacing: 2.5, mu_s: 0.6, mu_k: 0.4, probe_radius: 0.0 })?;
     let window = solver.window(&WindowConfig { tissue_w: 64, tissue_h: 64, hysteresis: 0.1 }, &Flat, &proxy, x0, y0)?;
-    let ctl = Controller::with_contact(solver, Roaming { proxy, window }, device, u32::MAX);
+    let ctl = Controller::with_contact(solver, Roaming::new(proxy, window), device, u32::MAX);
     let mut ctl = ctl;
     for _ in 0..10 {
         ctl.tick(None);

@@ -217,7 +217,7 @@ fn short_run<A: Arith>(
             let window = s
                 .window(&wc, &mccs::Flat, &proxy, 0.0, 0.0)
                 .map_err(|e| TestCaseError::fail(e.to_string()))?;
-            let ctl = Controller::with_contact(s, Roaming { proxy, window }, dev, 0);
+            let ctl = Controller::with_contact(s, Roaming::new(proxy, window), dev, 0);
             drive(case, ctl, true, seen)
         }
     }

@@ -196,3 +196,59 @@ fn a_jump_starts_again_and_a_step_settles_within_300_ms() {
     }
     assert!(v.iter().all(|x| x.to_num::<f64>().abs() < 1.0), "{v:?}");
 }
+
+/// The arm board's roaming contact pressed 1 mm into its tissue and held on the edge of
+/// a 64 µm count (its reading dithering between two counts), at a coupling damping of
+/// 5 N·s/m: on the one-tick difference the damping swings the force with each flip; on
+/// the tracker (what the board runs) it barely does. Still, both give the same force.
+#[test]
+fn the_tracker_takes_a_count_s_dither_out_of_the_coupling_s_damping() {
+    use haptic_f405::config::{BoardConfig, SPACING_MM};
+    use haptic_f405::BOARD;
+    use mccs_firmware::Contact;
+    let config = BoardConfig {
+        coupling_damping: 5.0,
+        ..BOARD
+    };
+    let spread = |tracked: bool, dither: bool| {
+        let topo = mccs::Topology::standard_patch(config.grid, SPACING_MM).unwrap();
+        let mut solver = mccs::Solver::<
+            { haptic_f405::device::NODES },
+            { haptic_f405::device::EDGES },
+            { haptic_f405::tissue::SEGMENTS },
+        >::new(topo, haptic_f405::tissue::TISSUE, &config.solver())
+        .unwrap();
+        let mut contact = haptic_f405::device::roaming(&config, &mut solver).unwrap();
+        if tracked {
+            contact = contact.with_velocity_tracker(TrackerGains::default_at(TICK_HZ).unwrap());
+        }
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        for k in 0..3000 {
+            // Down to 1 mm in over the first second, then held.
+            let z = -(k.min(1000) as f64 / 1000.0) - if dither && k % 2 == 1 { 0.064 } else { 0.0 };
+            let probe = [Length::ZERO, Length::ZERO, Length::from_num(z)];
+            let f = contact.step(&mut solver, probe)[2].to_num::<f64>();
+            if k >= 2000 {
+                (lo, hi) = (lo.min(f), hi.max(f));
+            }
+        }
+        (lo, hi)
+    };
+    let (plain, tracked) = (spread(false, true), spread(true, true));
+    println!(
+        "VELOCITY case=dithered_press damping_n_s_m=5 tick_difference_swing_n={:.3} tracker_swing_n={:.3}",
+        plain.1 - plain.0,
+        tracked.1 - tracked.0
+    );
+    assert!(plain.1 - plain.0 > 0.3, "{plain:?}");
+    assert!(
+        tracked.1 - tracked.0 < 0.3 * (plain.1 - plain.0),
+        "{tracked:?} against {plain:?}"
+    );
+    let (still, still_tracked) = (spread(false, false), spread(true, false));
+    assert!(
+        (still.0 - still_tracked.0).abs() < 1e-3,
+        "{still:?} {still_tracked:?}"
+    );
+    assert!(still.0 > 0.1, "the press pushes back: {still:?}");
+}

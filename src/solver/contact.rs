@@ -2,6 +2,7 @@
 //! nodes as the proxy sees them (its ring at the rest heights of the tissue's shape), and
 //! the tick.
 
+use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Frame, Proxy, ProxyConfig, ProxyError, Surface};
@@ -153,7 +154,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
     /// device must render (N, held to the coupling's maximum in magnitude).
     pub fn step_proxy(&mut self, probe: [Length; 3], proxy: &mut Proxy) -> [Force; 3] {
         let p = probe.map(Length::to_bits);
-        let probe_vel = self.probe_velocity(p, probe);
+        let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
         // Past the patch's edge, the goal is the point above the nearest point of it.
         let flat = Frame {

@@ -74,12 +74,6 @@ pub struct Solver<const NODES: usize, const EDGES: usize, const S: usize, A: Ari
     reaction: V3,
     /// Coupling force on the contact node in the last substep, Q20 N.
     coupling_force: V3,
-    /// The probe's velocity tracker, if one is set ([`Solver::set_velocity_tracker`]);
-    /// else the one-tick difference.
-    tracker: Option<(
-        crate::velocity::TrackerGains,
-        crate::velocity::VelocityTracker,
-    )>,
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize> Solver<NODES, EDGES, S> {
@@ -122,7 +116,6 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
             probe_prev: [0; 3],
             reaction: [0; 3],
             coupling_force: [0; 3],
-            tracker: None,
         })
     }
 
@@ -183,20 +176,5 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         self.probe_prev = [0; 3];
         self.reaction = [0; 3];
         self.coupling_force = [0; 3];
-        if let Some((_, t)) = &mut self.tracker {
-            t.reset();
-        }
-    }
-
-    /// The probe's velocity, for the coupling's damping, from a [`crate::VelocityTracker`]
-    /// with `gains` (its noise and lag on quantised positions: `crate::velocity`), or
-    /// with `None` the one-tick difference of positions (the default). Starts afresh.
-    pub fn set_velocity_tracker(&mut self, gains: Option<crate::velocity::TrackerGains>) {
-        self.tracker = gains.map(|g| (g, crate::velocity::VelocityTracker::new()));
-    }
-
-    /// Whether the probe's velocity comes from a tracker.
-    pub fn tracks_velocity(&self) -> bool {
-        self.tracker.is_some()
     }
 }

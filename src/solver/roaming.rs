@@ -2,22 +2,38 @@
 //! [`Shape`], driven through a [`Proxy`]: the contact, the window's shift, the substeps.
 //! The window's start-up is `solver/window.rs`; its own shift rules `crate::window`.
 
+use super::step::tick_velocity;
 use super::Solver;
 use crate::arith::Arith;
 use crate::proxy::{Frame, Proxy};
 use crate::shape::Shape;
 use crate::state::Node;
 use crate::topology::Edge;
-use crate::units::{Force, Length};
+use crate::units::{Force, Length, Velocity};
 use crate::window::{continued, Window, NONE};
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
     /// One haptic tick on the tissue with the probe at `probe` (mm, tissue frame)
     /// touching it through `proxy`; the window follows the contact (see [`Window`]).
-    /// Returns the force the device must render (N).
+    /// The probe's velocity is the one-tick difference of its positions. Returns the
+    /// force the device must render (N).
     pub fn step_roaming<Sh: Shape>(
         &mut self,
         probe: [Length; 3],
+        proxy: &mut Proxy,
+        window: &mut Window<EDGES, Sh>,
+    ) -> [Force; 3] {
+        self.step_roaming_at(probe, None, proxy, window)
+    }
+
+    /// [`Solver::step_roaming`] with the probe's velocity given (mm/s, e.g. a
+    /// [`crate::velocity::TrackedVelocity`]'s from quantised counts); `None`: the
+    /// one-tick difference.
+    #[inline(always)]
+    pub fn step_roaming_at<Sh: Shape>(
+        &mut self,
+        probe: [Length; 3],
+        velocity: Option<[Velocity; 3]>,
         proxy: &mut Proxy,
         window: &mut Window<EDGES, Sh>,
     ) -> [Force; 3] {
@@ -28,7 +44,10 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
         };
         let o = window.origin();
         let mut p = in_frame(o);
-        let probe_vel = self.probe_velocity(p, probe);
+        let probe_vel = match velocity {
+            Some(v) => v.map(Velocity::to_bits),
+            None => tick_velocity(self.probe_prev, p, self.c.tick_hz),
+        };
         let frame = Frame {
             shape: window.shape(),
             origin: o,

@@ -38,22 +38,11 @@ pub(super) fn tick_velocity(from: V3, to: V3, tick_hz: i32) -> V3 {
 }
 
 impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NODES, EDGES, S, A> {
-    /// The probe's velocity this tick (Q16 mm/s): its tracker's, from `probe` (in the
-    /// frame the caller reads it, where a window's shift is no jump), or the one-tick
-    /// difference from the last tick's `p` (Q24 mm, patch frame).
-    #[inline(always)]
-    pub(super) fn probe_velocity(&mut self, p: V3, probe: [Length; 3]) -> V3 {
-        match &mut self.tracker {
-            Some((g, t)) => t.update(g, probe).map(crate::units::Velocity::to_bits),
-            None => tick_velocity(self.probe_prev, p, self.c.tick_hz),
-        }
-    }
-
     /// One haptic tick with the probe at `probe` (mm, patch frame). Returns the force the
     /// device must render on the probe (N per axis, clamped to the coupling maximum).
     pub fn step(&mut self, probe: [Length; 3]) -> [Force; 3] {
         let p = probe.map(Length::to_bits);
-        let probe_vel = self.probe_velocity(p, probe);
+        let probe_vel = tick_velocity(self.probe_prev, p, self.c.tick_hz);
         self.probe_prev = p;
         let drive = Drive::Probe {
             probe: p,
@@ -151,54 +140,6 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith> Solver<NO
 #[cfg(test)]
 mod tests {
     use super::tick_velocity;
-    use crate::{ForceTable64, Length, Params, Solver, SolverConfig, Topology, TrackerGains};
-
-    /// A glued probe pressed 1 mm in and held on the edge of a 64 µm count (dithering
-    /// between two readings): the coupling's damping on the one-tick difference swings
-    /// the force with each flip; on the tracker it barely does. Both settle to the same
-    /// force on a still probe.
-    #[test]
-    fn the_tracker_takes_a_count_s_dither_out_of_the_coupling_s_damping() {
-        let table = ForceTable64::new(&Params::TABLE2).unwrap();
-        let config = SolverConfig {
-            coupling: crate::Coupling {
-                damping: 5.0,
-                ..SolverConfig::default().coupling
-            },
-            ..SolverConfig::default()
-        };
-        let spread = |tracked: bool, dither: bool| {
-            let topo = Topology::<10, 61>::standard_patch(5, 2.5).unwrap();
-            let mut s = Solver::<10, 61, 64>::new(topo, table, &config).unwrap();
-            if tracked {
-                s.set_velocity_tracker(Some(TrackerGains::default_at(1000).unwrap()));
-            }
-            assert_eq!(s.tracks_velocity(), tracked);
-            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-            for k in 0..3000 {
-                let z = if dither && k % 2 == 1 { -1.064 } else { -1.0 };
-                let f = s.step([Length::ZERO, Length::ZERO, Length::from_num(z)])[2];
-                if k >= 2000 {
-                    lo = lo.min(f.to_num::<f64>());
-                    hi = hi.max(f.to_num::<f64>());
-                }
-            }
-            (lo, hi)
-        };
-        let (plain, tracked) = (spread(false, true), spread(true, true));
-        // The one-tick difference: ±64 mm/s through 5 N·s/m, and the spring's 64 µm
-        // (0.46 N measured); the tracker: about the spring's alone (0.07 N).
-        assert!(plain.1 - plain.0 > 0.3, "{plain:?}");
-        assert!(
-            tracked.1 - tracked.0 < 0.2 * (plain.1 - plain.0),
-            "{tracked:?} {plain:?}"
-        );
-        let (still, still_tracked) = (spread(false, false), spread(true, false));
-        assert!(
-            (still.0 - still_tracked.0).abs() < 1e-3,
-            "{still:?} {still_tracked:?}"
-        );
-    }
 
     /// The velocity of a tick against the 64-bit formula, saturated to `i32`, for every
     /// pair of extreme positions (a difference that wraps `i32` either way) and rates

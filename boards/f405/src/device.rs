@@ -548,7 +548,7 @@ pub fn roaming<const S: usize>(
         0.0,
         0.0,
     )?;
-    Ok(Roaming { proxy, window })
+    Ok(Roaming::new(proxy, window))
 }
 
 /// [`controller_into`] for any device (the arm's too, [`crate::arm`]), glued: the patch
@@ -596,9 +596,8 @@ pub fn roaming_controller_with<D: HapticDevice, const S: usize>(
         // counts of 64 µm (docs/safety.md, "The probe's velocity").
         let gains = mccs::TrackerGains::default_at(config.tick_hz)
             .map_err(|_| StartError::Config(BoardConfigError::Tick))?;
-        s.set_velocity_tracker(Some(gains));
         let contact = roaming(config, &mut s).map_err(StartError::Contact)?;
-        Ok((s, contact))
+        Ok((s, contact.with_velocity_tracker(gains)))
     });
     let (solver, contact) = match built {
         Ok(b) => b,
