@@ -9,6 +9,7 @@
 //!   but the pins, held to the parts' limits, and the HAL's clock arithmetic;
 //! - [`arm`]: the arm variant's device (`--features arm`: the WoodenHaptics arm);
 //! - [`device`]: the device wiring from any embedded-hal 1.0 parts, and the controller;
+//! - [`device_part`]: each part of a device that can fail, its name and its code;
 //! - [`safe_stop`]: the motor cut every way out of the firmware takes first;
 //! - [`black_box`]: the last ticks and the stop of a run, kept across a reset;
 //! - [`telemetry`]: the tick statistics and the verdict of a QEMU run;
@@ -25,6 +26,7 @@ pub mod arm_pins;
 pub mod black_box;
 pub mod config;
 pub mod device;
+pub mod device_part;
 #[cfg(target_os = "none")]
 pub mod pins;
 pub mod safe_stop;
