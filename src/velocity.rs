@@ -4,17 +4,17 @@
 //! position estimate, not its velocity state.
 //!
 //! A one-tick difference of the arm's counts (64 µm at the probe) comes in 64 mm/s steps:
-//! 26 mm/s RMS of noise on a palpation. A window that averages it down to 5 mm/s lags
-//! half its length, about 2.5 ms. The tracker predicts the next position from its
-//! velocity, corrects both by the error `e` to the reading (`x̂ += α e`, `ŵ += β e`, in
-//! millimetres a tick), and gives `(ŵ + α e) · tick_hz`: the velocity state alone is
-//! smooth but lags its own loop (13 ms at the default gains); with `α e` added back the
-//! low frequencies pass with no delay (the output's transfer from the true velocity is
-//! `(2ζωs + ω²)/(s² + 2ζωs + ω²)`, flat with zero phase near DC) while the reading's noise
-//! is weighed by `α`. The gains put the loop's two poles where the continuous loop's
-//! would be, at a natural frequency `ω` and damping `ζ` ([`TrackerGains::new`]); the
-//! default, 100 rad/s and 0.7, measured on a palpation of 64 µm counts with 20 µm of
-//! noise: about 4 mm/s RMS and no lag (`host-tests/tests/velocity.rs`, docs/safety.md).
+//! some 30 mm/s RMS of noise. A window that averages it down to 5 mm/s lags half its
+//! length, about 2.5 ms. The tracker predicts the next position from its velocity,
+//! corrects both by the error `e` to the reading (`x̂ += α e`, `ŵ += β e`, in millimetres
+//! a tick), and gives `(ŵ + α e) · tick_hz`: the velocity state alone is smooth but lags
+//! its own loop; with `α e` added back the low frequencies pass with no delay (the
+//! output's transfer from the true velocity is `(2ζωs + ω²)/(s² + 2ζωs + ω²)`, flat with
+//! zero phase near DC) while the reading's noise is weighed by `α`. The gains put the
+//! loop's two poles where the continuous loop's would be, at a natural frequency `ω` and
+//! damping `ζ` ([`TrackerGains::new`]). At the default, 100 rad/s and 0.7, its noise and
+//! lag on the arm's counts are measured by `host-tests/tests/velocity.rs` and quoted in
+//! docs/safety.md ("The probe's velocity"): under 5 mm/s RMS and 1 ms.
 //!
 //! Config apart from state: [`TrackerGains`] at start-up (floating point), the tick's
 //! [`VelocityTracker::update`] in integers.
@@ -25,11 +25,10 @@
 //!
 //! # Range and cost
 //! Positions are ±128 mm (I8F24); the estimate's error `e` and every sum saturate, never
-//! wrap. The velocity is
-//! I16F16 mm/s, saturated at ±32,768 mm/s. `α`, `β` are Q31 fractions below 1. A tick
-//! per axis: two high-word products, saturating adds, one 32 × 32 → 64 product by the
-//! tick rate (as the one-tick difference); no division, no float, no panic path. The
-//! bench's `velocity_tracker` case measures it.
+//! wrap. The velocity is I16F16 mm/s, saturated at ±32,768 mm/s. `α`, `β` are Q31
+//! fractions below 1. A tick per axis: two high-word products, saturating adds, one
+//! 32 × 32 → 64 product by the tick rate (as the one-tick difference); no division, no
+//! float, no panic path. The bench's `velocity_tracker` case measures it.
 
 use crate::q;
 use crate::units::{Length, Velocity, LEN_FRAC};
