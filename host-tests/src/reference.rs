@@ -40,6 +40,11 @@ pub struct Reference {
     d2: f64,
     /// `A = H G d⁴ / (8 n)`.
     a: f64,
+    /// `A^(1/3)`, `F_T^(1/3)` and `F_C^(1/3)`, each taken once (the inverse's time is
+    /// mostly cube roots).
+    a3: f64,
+    y_t: f64,
+    y_c: f64,
 }
 
 impl Reference {
@@ -68,15 +73,23 @@ impl Reference {
             shear_modulus: g,
         } = *cone;
         let gd4 = g * d.powi(4);
+        let (f_t, f_c, a) = (
+            gd4 * h / (8.0 * n * d2.powi(3)),
+            gd4 * h / (8.0 * n * d1.powi(3)),
+            h * gd4 / (8.0 * n),
+        );
         Self {
             k: gd4 / (2.0 * n * (d1 * d1 + d2 * d2) * (d1 + d2)),
-            f_t: gd4 * h / (8.0 * n * d2.powi(3)),
-            f_c: gd4 * h / (8.0 * n * d1.powi(3)),
+            f_t,
+            f_c,
             series: None,
             h,
             d1,
             d2,
-            a: h * gd4 / (8.0 * n),
+            a,
+            a3: a.cbrt(),
+            y_t: f_t.cbrt(),
+            y_c: f_c.cbrt(),
         }
     }
 
@@ -109,9 +122,14 @@ impl Reference {
 
     /// The cone's strain in its nonlinear phase, in `y = F^(1/3)`.
     fn cone_strain(&self, y: f64) -> f64 {
-        let a3 = self.a.cbrt();
         self.h / (self.d2 - self.d1)
-            * (self.d2 - 0.75 * a3 / y - self.d1.powi(4) * y.powi(3) / (4.0 * self.a))
+            * (self.d2 - 0.75 * self.a3 / y - self.d1.powi(4) * y.powi(3) / (4.0 * self.a))
+    }
+
+    /// The cone's `dΔ/dF` in its nonlinear phase at `f`, `y = F^(1/3)`.
+    fn cone_compliance(&self, f: f64, y: f64) -> f64 {
+        // d/dF of H/(D2−D1)[−¾ A^(1/3) F^(−1/3) − D1⁴ F/(4A)]
+        self.h / (self.d2 - self.d1) * (0.25 * self.a3 / (y * f) - self.d1.powi(4) / (4.0 * self.a))
     }
 
     /// Forward law `Δ(F) = Δ_cone(F) + max(0, F − P)/k_p`, every phase (`F < 0` is
@@ -133,10 +151,7 @@ impl Reference {
         let cone = if f <= self.f_t {
             1.0 / self.k
         } else if f <= self.f_c {
-            // d/dF of H/(D2−D1)[−¾ A^(1/3) F^(−1/3) − D1⁴ F/(4A)]
-            let a3 = self.a.cbrt();
-            self.h / (self.d2 - self.d1)
-                * (0.25 * a3 / (f.cbrt() * f) - self.d1.powi(4) / (4.0 * self.a))
+            self.cone_compliance(f, f.cbrt())
         } else {
             0.0
         };
@@ -154,13 +169,28 @@ impl Reference {
             return self.force_bracketed(delta);
         }
         for _ in 0..3 {
-            let next = f - (self.delta(f) - delta) / self.compliance(f);
+            let (strain, slope) = self.delta_and_compliance(f);
+            let next = f - (strain - delta) / slope;
             if !(next > lo && next < hi) {
                 break;
             }
             f = next;
         }
         f
+    }
+
+    /// [`Reference::delta`] and [`Reference::compliance`] at `f`, one cube root for
+    /// both inside the nonlinear phase.
+    fn delta_and_compliance(&self, f: f64) -> (f64, f64) {
+        if f > self.f_t && f < self.f_c {
+            let y = f.cbrt();
+            (
+                self.cone_strain(y) + self.series_strain(f),
+                self.cone_compliance(f, y) + self.series_compliance(f),
+            )
+        } else {
+            (self.delta(f), self.compliance(f))
+        }
     }
 
     /// Tangent stiffness `dF/dΔ = 1/Δ'(F)` at strain `delta` (`k` at the kink `F_T`).
@@ -194,8 +224,8 @@ impl Reference {
         let w = self.d2 - self.d1;
         let qa = 1.0 / k_p - self.h * self.d1.powi(4) / (4.0 * self.a * w);
         let qb = self.h * self.d2 / w - preload / k_p - delta;
-        let qc = -0.75 * self.h * self.a.cbrt() / w;
-        let (lo, hi) = (self.f_t.cbrt(), self.f_c.cbrt());
+        let qc = -0.75 * self.h * self.a3 / w;
+        let (lo, hi) = (self.y_t, self.y_c);
         let roots = depressed_quartic_roots(qa, qb, qc);
         // The root inside [F_T^(1/3), F_C^(1/3)]; rounding may put it a hair outside.
         let y = roots
