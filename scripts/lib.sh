@@ -4,7 +4,9 @@
 #   run_stage NAME COMMAND...   runs COMMAND with its output in $LOG_DIR/NAME.log; prints
 #                               "… NAME (12 s)" every 10 s while it runs, then
 #                               "ok   NAME (34 s)" or "FAIL NAME (34 s): see LOG";
-#                               returns COMMAND's status.
+#                               returns COMMAND's status. STAGES gets
+#                               "result|NAME|seconds|CPU seconds" (user + system of
+#                               COMMAND and what it waited for).
 #   say TEXT                    one line on stderr.
 #   $TARGET_DIR                 cargo's target folder ($CARGO_TARGET_DIR, else target).
 #   build_decoder [ARGS]        builds the defmt log decoder, $DECODER (its own cargo
@@ -27,11 +29,26 @@ build_decoder() {
 
 say() { printf '%s\n' "$*" >&2; }
 
+# CHILDREN_CPU_MS: the user + system CPU time, in ms, of this shell's children that have
+# ended and been waited for (bash's `times`, second line: `0m1.250s 0m0.310s`). It sets
+# a variable rather than printing: `times` in a command substitution's subshell counts
+# that subshell's children only.
+children_cpu() {
+  local user sys
+  times > "$LOG_DIR/.times.$BASHPID"
+  { read -r _ _; read -r user sys; } < "$LOG_DIR/.times.$BASHPID"
+  CHILDREN_CPU_MS=$(awk -v u="$user" -v s="$sys" 'function ms(t, m) {
+      split(t, m, /[ms]/); return (m[1] * 60 + m[2]) * 1000 }
+    BEGIN { printf "%d\n", ms(u) + ms(s) }')
+}
+
 run_stage() {
   local name=$1
   shift
   local log="$LOG_DIR/$name.log"
-  local start=$SECONDS
+  local start=$SECONDS cpu_start
+  children_cpu
+  cpu_start=$CHILDREN_CPU_MS
   say "...  $name"
   "$@" > "$log" 2>&1 < /dev/null &
   local pid=$!
@@ -46,14 +63,16 @@ run_stage() {
   wait "$pid" || status=$?
   kill "$ticker" 2> /dev/null || true
   wait "$ticker" 2> /dev/null || true
-  local took=$((SECONDS - start))
+  local took=$((SECONDS - start)) cpu
+  children_cpu
+  cpu=$(((CHILDREN_CPU_MS - cpu_start + 500) / 1000))
   if [ "$status" = 0 ]; then
     say "ok   $name ($took s)"
-    STAGES+=("ok|$name|$took")
+    STAGES+=("ok|$name|$took|$cpu")
   else
     say "FAIL $name ($took s): exit $status; see $log"
     tail -n 15 "$log" | sed 's/^/     | /' >&2
-    STAGES+=("FAIL|$name|$took")
+    STAGES+=("FAIL|$name|$took|$cpu")
   fi
   return "$status"
 }

@@ -360,7 +360,9 @@ start_host_tests() {
   (
     renice -n 10 "$BASHPID" > /dev/null
     host_tests > "$HOST_BG.log" 2>&1 < /dev/null
-    echo $? > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
+    local status=$?
+    children_cpu && echo "$CHILDREN_CPU_MS" > "$HOST_BG.cpu_ms"
+    echo $status > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
   ) &
 }
 
@@ -412,10 +414,15 @@ host_passed=$(grep -Eo 'test result: [a-zA-Z]+\. [0-9]+ passed' "$host_log" 2> /
 host_failed=$(grep -Eo '[0-9]+ failed;' "$host_log" 2> /dev/null | awk '{s += $1} END {print s + 0}')
 passed=$host_passed
 failed=$host_failed
-printf '\n%-28s %-6s %s\n' stage result seconds
+# (CPU: user + system seconds of the stage's processes; the host-tests row gives the
+# background run's, beside the other stages: its wall time is the wait at the end.)
+printf '\n%-28s %-6s %7s %7s\n' stage result seconds cpu
 for s in "${STAGES[@]}"; do
-  IFS='|' read -r result name took <<< "$s"
-  printf '%-28s %-6s %s\n' "$name" "$result" "$took"
+  IFS='|' read -r result name took cpu <<< "$s"
+  if [ "$name" = host-tests ] && [ -e "$HOST_BG.cpu_ms" ]; then
+    cpu=$((($(cat "$HOST_BG.cpu_ms") + 500) / 1000))
+  fi
+  printf '%-28s %-6s %7s %7s\n' "$name" "$result" "$took" "$cpu"
   if [ "$name" = host-tests ]; then
     # Counted by its tests; a failure without a failed test (a build error) counts one.
     if [ "$result" != ok ] && [ "$host_failed" = 0 ]; then failed=$((failed + 1)); fi
