@@ -261,9 +261,22 @@ impl Device {
         let mut all: Vec<ToDevice> = msgs.to_vec();
         all.push(ToDevice::Status);
         let poses = msgs.iter().any(|m| matches!(m, ToDevice::Pose(_)));
-        match self.request(&all, "status", self.options.answer_timeout, |m| {
-            matches!(m, ToHost::Status(_)) || (poses && pose_nak(m))
-        })? {
+        // The device answers an `Arm` and a `Disarm` with a `Status` of its own: every
+        // one is this request's (`Session::wait_statuses`).
+        let statuses = 1 + msgs
+            .iter()
+            .filter(|m| matches!(m, ToDevice::Arm | ToDevice::Disarm))
+            .count();
+        let answer = {
+            let (_turn, from) = self.session.begin();
+            for m in &all {
+                self.session.send(m)?;
+            }
+            let timeout = self.options.answer_timeout;
+            self.session
+                .wait_statuses(from, "status", timeout, statuses, |m| poses && pose_nak(m))?
+        };
+        match answer {
             ToHost::Status(s) => Ok(Status { raw: s }),
             other => Err(self.unexpected(other)),
         }

@@ -143,6 +143,86 @@ impl Session {
         (turn, from)
     }
 
+    /// The answers of a request that ends in `statuses` `Status` replies (its own
+    /// `Status` last, after the one the device sends for each `Arm` and `Disarm`), within
+    /// `timeout`: waits for every one of them, so that none is left over to answer a
+    /// later request as if it were its own (the device answers in order, so the last is
+    /// a fence behind everything the request caused), then takes them, and the replies
+    /// before the last that `refused` takes, from the replies. The first refusal, if
+    /// any, as [`Error::Refused`]; else the first `Status` (an `Arm`'s or a `Disarm`'s
+    /// own, where the request has one).
+    pub(crate) fn wait_statuses(
+        &self,
+        from: u64,
+        what: &'static str,
+        timeout: Duration,
+        statuses: usize,
+        refused: impl Fn(&ToHost) -> bool,
+    ) -> Result<ToHost, Error> {
+        let deadline = Instant::now() + timeout;
+        let mut s = self.shared();
+        loop {
+            let ours = |(n, m): &(u64, ToHost)| *n >= from && matches!(m, ToHost::Status(_));
+            let fence = s
+                .replies
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| ours(r))
+                .nth(statuses.saturating_sub(1))
+                .map(|(i, _)| i);
+            if let Some(fence) = fence {
+                let take: Vec<usize> = (0..=fence)
+                    .filter(|&i| {
+                        let r = &s.replies[i];
+                        ours(r) || (r.0 >= from && refused(&r.1))
+                    })
+                    .collect();
+                // (From the back, so that each index still names its reply.)
+                let mut taken: Vec<ToHost> = take
+                    .iter()
+                    .rev()
+                    .filter_map(|&i| s.replies.remove(i).map(|(_, m)| m))
+                    .collect();
+                taken.reverse();
+                let mut first = None;
+                for m in taken {
+                    match m {
+                        ToHost::Nak(r) => {
+                            return Err(Error::Refused {
+                                addr: self.addr.clone(),
+                                refusal: Refusal(r),
+                            })
+                        }
+                        m => {
+                            first.get_or_insert(m);
+                        }
+                    }
+                }
+                return first.ok_or_else(|| Error::Timeout {
+                    addr: self.addr.clone(),
+                    what,
+                    waited: timeout,
+                });
+            }
+            if let Some(why) = &s.lost {
+                return Err(self.lost_error(why));
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(Error::Timeout {
+                    addr: self.addr.clone(),
+                    what,
+                    waited: timeout,
+                });
+            }
+            s = self
+                .cond
+                .wait_timeout(s, deadline - now)
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+    }
+
     /// The first reply numbered `from` or later that `want` takes, within `timeout`;
     /// `want` takes the refusals that answer this request (a `Nak` it takes is returned
     /// as [`Error::Refused`]); what it leaves stays for other requests.

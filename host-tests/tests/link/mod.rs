@@ -6,6 +6,7 @@ mod codec;
 mod device;
 mod messages;
 mod qemu;
+mod replies;
 mod rig;
 mod scene_api;
 
