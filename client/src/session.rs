@@ -159,68 +159,30 @@ impl Session {
         statuses: usize,
         refused: impl Fn(&ToHost) -> bool,
     ) -> Result<ToHost, Error> {
-        let deadline = Instant::now() + timeout;
-        let mut s = self.shared();
-        loop {
-            let ours = |(n, m): &(u64, ToHost)| *n >= from && matches!(m, ToHost::Status(_));
-            let fence = s
-                .replies
+        let ours = |(n, m): &(u64, ToHost)| *n >= from && matches!(m, ToHost::Status(_));
+        self.wait_until(what, timeout, |replies| {
+            let (fence, _) = replies
                 .iter()
                 .enumerate()
                 .filter(|(_, r)| ours(r))
-                .nth(statuses.saturating_sub(1))
-                .map(|(i, _)| i);
-            if let Some(fence) = fence {
-                let take: Vec<usize> = (0..=fence)
-                    .filter(|&i| {
-                        let r = &s.replies[i];
-                        ours(r) || (r.0 >= from && refused(&r.1))
-                    })
-                    .collect();
-                // (From the back, so that each index still names its reply.)
-                let mut taken: Vec<ToHost> = take
-                    .iter()
-                    .rev()
-                    .filter_map(|&i| s.replies.remove(i).map(|(_, m)| m))
-                    .collect();
-                taken.reverse();
-                let mut first = None;
-                for m in taken {
-                    match m {
-                        ToHost::Nak(r) => {
-                            return Err(Error::Refused {
-                                addr: self.addr.clone(),
-                                refusal: Refusal(r),
-                            })
-                        }
-                        m => {
-                            first.get_or_insert(m);
-                        }
-                    }
-                }
-                return first.ok_or_else(|| Error::Timeout {
-                    addr: self.addr.clone(),
-                    what,
-                    waited: timeout,
-                });
-            }
-            if let Some(why) = &s.lost {
-                return Err(self.lost_error(why));
-            }
-            let now = Instant::now();
-            if now >= deadline {
-                return Err(Error::Timeout {
-                    addr: self.addr.clone(),
-                    what,
-                    waited: timeout,
-                });
-            }
-            s = self
-                .cond
-                .wait_timeout(s, deadline - now)
-                .unwrap_or_else(|e| e.into_inner())
-                .0;
-        }
+                .nth(statuses.saturating_sub(1))?;
+            let take: Vec<usize> = (0..=fence)
+                .filter(|&i| ours(&replies[i]) || (replies[i].0 >= from && refused(&replies[i].1)))
+                .collect();
+            // (From the back, so that each index still names its reply.)
+            let mut taken: Vec<ToHost> = take
+                .iter()
+                .rev()
+                .filter_map(|&i| replies.remove(i).map(|(_, m)| m))
+                .collect();
+            taken.reverse();
+            // The first refusal, else the first `Status`.
+            let i = taken
+                .iter()
+                .position(|m| matches!(m, ToHost::Nak(_)))
+                .unwrap_or(0);
+            (i < taken.len()).then(|| taken.swap_remove(i))
+        })
     }
 
     /// The first reply numbered `from` or later that `want` takes, within `timeout`;
@@ -233,14 +195,24 @@ impl Session {
         timeout: Duration,
         want: impl Fn(&ToHost) -> bool,
     ) -> Result<ToHost, Error> {
+        self.wait_until(what, timeout, |replies| {
+            let i = replies.iter().position(|(n, m)| *n >= from && want(m))?;
+            replies.remove(i).map(|(_, m)| m)
+        })
+    }
+
+    /// Waits, within `timeout`, until `take` takes its answer from the replies (a `Nak`
+    /// is returned as [`Error::Refused`]), or the connection is lost.
+    fn wait_until(
+        &self,
+        what: &'static str,
+        timeout: Duration,
+        mut take: impl FnMut(&mut VecDeque<(u64, ToHost)>) -> Option<ToHost>,
+    ) -> Result<ToHost, Error> {
         let deadline = Instant::now() + timeout;
         let mut s = self.shared();
         loop {
-            if let Some(i) = s.replies.iter().position(|(n, m)| *n >= from && want(m)) {
-                let (_, m) = s
-                    .replies
-                    .remove(i)
-                    .unwrap_or((0, ToHost::Ack { tissue: 0 }));
+            if let Some(m) = take(&mut s.replies) {
                 return match m {
                     ToHost::Nak(r) => Err(Error::Refused {
                         addr: self.addr.clone(),
