@@ -372,6 +372,13 @@ impl Device {
                 })?;
             }
             self.session.send(&ToDevice::TissueCommit)?;
+            // A fence: every refusal of the frames above comes before its answer, and is
+            // taken here, so that none is left over to refuse a later load (a refused
+            // `TissueBegin` is followed by a `Nak(Order)` for each chunk and the commit).
+            self.session.send(&ToDevice::Status)?;
+            let timeout = self.options.answer_timeout;
+            self.session
+                .wait_statuses(from, "the tissue load", timeout, 1, tissue_nak)?;
             from
         };
         // (The turn is free while the device checks: other requests go on.)
