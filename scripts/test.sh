@@ -356,14 +356,19 @@ client_windows() {
 # other core until the end; at the same priority the tests ended early and the last
 # stages ran on one core.
 HOST_BG=$LOG_DIR/host-tests-background
+# (Started from a subshell that ends at once, so that the run is not this shell's child:
+# its CPU time, which it writes to $HOST_BG.cpu_ms, would otherwise be added to
+# whichever stage was running when it ended, in the table's CPU column.)
 start_host_tests() {
   (
-    renice -n 10 "$BASHPID" > /dev/null
-    host_tests > "$HOST_BG.log" 2>&1 < /dev/null
-    local status=$?
-    children_cpu && echo "$CHILDREN_CPU_MS" > "$HOST_BG.cpu_ms"
-    echo $status > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
-  ) &
+    (
+      renice -n 10 "$BASHPID" > /dev/null
+      host_tests > "$HOST_BG.log" 2>&1 < /dev/null
+      local status=$?
+      children_cpu && echo "$CHILDREN_CPU_MS" > "$HOST_BG.cpu_ms"
+      echo $status > "$HOST_BG.status.tmp" && mv "$HOST_BG.status.tmp" "$HOST_BG.status"
+    ) &
+  )
 }
 
 # (Without the background run, as when the host build failed, the tests run here.)
