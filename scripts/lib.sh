@@ -37,6 +37,7 @@ children_cpu() {
   local user sys
   times > "$LOG_DIR/.times.$BASHPID"
   { read -r _ _; read -r user sys; } < "$LOG_DIR/.times.$BASHPID"
+  rm -f "$LOG_DIR/.times.$BASHPID"
   CHILDREN_CPU_MS=$(awk -v u="$user" -v s="$sys" 'function ms(t, m) {
       split(t, m, /[ms]/); return (m[1] * 60 + m[2]) * 1000 }
     BEGIN { printf "%d\n", ms(u) + ms(s) }')
