@@ -6,6 +6,7 @@
 
 pub mod arm;
 pub mod cli;
+pub mod eigenvalues;
 pub mod fit;
 pub mod fuzz_checks;
 pub mod link;

@@ -32,6 +32,8 @@ mod doc_commands;
 mod doc_snippets;
 #[path = "docs.rs"]
 mod docs;
+#[path = "eigenvalues.rs"]
+mod eigenvalues;
 #[path = "fit.rs"]
 mod fit;
 #[path = "float_patch.rs"]
