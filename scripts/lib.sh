@@ -13,13 +13,7 @@
 #                               profile, `tool`: unoptimised, it builds in half the time),
 #                               linted as it builds (clippy's driver as the workspace's
 #                               rustc wrapper, warnings denied): the test command's
-#                               host build leaves it out.
-#   host_cargo ARGS…            cargo for the host with clippy's driver as the
-#                               workspace's rustc wrapper and warnings denied: the
-#                               workspace's crates are linted as they are built, so that
-#                               one build serves the lints and the tests (every host
-#                               cargo call of the test command goes through it: a plain
-#                               `cargo` builds the workspace's crates again).
+#                               clippy-host stage leaves it out.
 
 LOG_DIR=${LOG_DIR:-target/logs}
 mkdir -p "$LOG_DIR"
@@ -31,11 +25,6 @@ DECODER=$TARGET_DIR/tool/defmt-log
 build_decoder() {
   RUSTFLAGS=-Dwarnings RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver)" \
     cargo build -p defmt-log --profile tool "$@"
-}
-
-host_cargo() {
-  RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver)" \
-    CLIPPY_ARGS=-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__ cargo "$@"
 }
 
 say() { printf '%s\n' "$*" >&2; }

@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
-# The test command: formatting, the host build (linted as it builds), the thumb lints and
-# builds, the firmware on all three cores in QEMU (the main job under a pseudo-terminal),
-# the tick-path check, the bench and its budgets, the firmware's size, the host tests,
-# and the docs' figures against the code.
+# The test command: formatting, clippy, the thumb builds, the firmware on all three cores
+# in QEMU (the main job under a pseudo-terminal), the tick-path check, the bench and its
+# budgets, the firmware's size, the host tests, and the docs' figures against the code.
 # The host tests run in the background from the end of the host build on, beside the
 # firmware stages; their stage waits for them near the end.
 #
@@ -259,7 +258,7 @@ board_faults() {
 # The property tests on a fixed seed, so that a run is reproducible (`cargo test` alone
 # draws a new one each time, and so does scripts/long.sh: they explore).
 host_tests() {
-  PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-2026} host_cargo test --workspace --no-fail-fast -- --show-output \
+  PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-2026} cargo test --workspace --no-fail-fast -- --show-output \
     --skip link::qemu::
 }
 
@@ -267,7 +266,7 @@ host_tests() {
 # with the link's QEMU feature): one test, its figures in target/qemu/link.log.
 link_qemu() {
   # (--workspace: the host build's features, so that the test binary is not rebuilt.)
-  MCCS_LINK_QEMU=1 host_cargo test --workspace --test host -- link::qemu:: --show-output \
+  MCCS_LINK_QEMU=1 cargo test --workspace --test host -- link::qemu:: --show-output \
     > target/qemu/link.log 2>&1
   local status=$?
   grep -E '^LINK |test result' target/qemu/link.log
@@ -305,7 +304,7 @@ sim_board() {
 # build the examples name, in 26 s, where the release build from scratch took 129 s.)
 scene_examples() {
   local sock=target/qemu/scene.sock venv=target/venv-scene qemu_pid status=0 lib=$TARGET_DIR/debug
-  host_cargo build -p mccs-client || return 1
+  cargo build -p mccs-client || return 1
   gcc examples/c/scene.c -I client/include -L "$lib" -lmccs_client \
     -o target/qemu/scene-c || return 1
   if [ ! -x "$venv/bin/python" ]; then python3 -m venv "$venv" || return 1; fi
@@ -345,7 +344,7 @@ client_windows() {
     echo "rustup target add x86_64-pc-windows-gnu (the scene's library, checked for Windows)"
     rustup target add x86_64-pc-windows-gnu || return 1
   fi
-  host_cargo check --quiet -p mccs-client --target x86_64-pc-windows-gnu
+  cargo check --quiet -p mccs-client --target x86_64-pc-windows-gnu
 }
 
 # The host tests need only the host build, and they run beside the firmware stages (a
@@ -387,15 +386,11 @@ run_stage fmt cargo fmt --all -- --check
 # The host build first, so that the host tests start in the background as early as they
 # can and fill what the stages after leave of the two cores (clippy's and the links'
 # serial stretches): the wait for them after the last stage 18–21 s → 3 s
-# (docs/performance.md, "The test command's time"). Linted as it builds (`host_cargo`:
-# clippy's driver compiles the workspace's crates, warnings denied): a separate `cargo
-# clippy` checked every dependency again in its own mode, 68 s of a fresh clone's run
-# (114 s of CPU), where the lints add 5 s to the build. The tests' targets and the bench
-# (`fit`); not `--all-targets`, which would build the `test = false` binaries in test
-# mode, the firmware's among them, 52 more units with their dependencies (the fresh host
-# build took 326 s with them, 266 s before the lints joined it); the thumb lints lint
-# the firmware's binaries, and the host build those the tests run.
-run_stage host-build host_cargo test --workspace --no-run --lib --tests --bench fit && start_host_tests
+# (docs/performance.md, "The test command's time").
+run_stage host-build cargo test --workspace --no-run && start_host_tests
+# (The log decoder is linted where it is built, in firmware-builds: `build_decoder`.
+# Checked here too, its dependencies, defmt-decoder's tree, took a third of this stage.)
+run_stage clippy-host cargo clippy --workspace --exclude defmt-log --all-targets -- -D warnings
 run_stage clippy-thumb clippy_thumb
 run_stage firmware-builds firmware_builds
 run_stage demo-m4f-in-a-terminal demo_in_a_terminal
