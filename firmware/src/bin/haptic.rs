@@ -27,8 +27,11 @@ fn main() {
 mod fw_common;
 
 #[cfg(target_os = "none")]
+mod stack_paint;
+
+#[cfg(target_os = "none")]
 mod firmware {
-    use super::fw_common;
+    use super::{fw_common, stack_paint};
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
     use cortex_m_rt::{entry, exception};
     use fw_common::exit;
@@ -100,6 +103,9 @@ mod firmware {
         let Some(mut cp) = cortex_m::Peripherals::take() else {
             fail("peripherals taken twice")
         };
+        // The free stack painted before the start-up's build and swap, read at the end
+        // (`finish`).
+        stack_paint::paint();
         // The tick owns the controller: its first run builds it (the counter is still
         // stopped, so nothing is timed yet), on the interrupt's stack.
         SCB::set_pendst();
@@ -175,9 +181,31 @@ mod firmware {
         }
     }
 
-    /// The run's last lines (the longest tick, the `SUMMARY`), then the exit: success
-    /// unless telemetry `t` holds a fault.
+    /// The least stack the run may leave unused, bytes: below it the next frame to grow
+    /// writes over the statics under the stack (without a fault: defmt's state is the
+    /// first it reaches), so the run fails here instead.
+    const MIN_FREE_STACK: u32 = 64;
+
+    /// The run's last lines (the longest tick, the stack, the `SUMMARY`), then the exit:
+    /// success unless telemetry `t` holds a fault or the stack came within
+    /// [`MIN_FREE_STACK`] of the statics.
     fn finish(t: &Telemetry) -> ! {
+        let (used, free) = stack_paint::used_and_free();
+        defmt::info!(
+            "STACK core={=str} used_bytes={=u32} free_bytes={=u32} min_free_bytes={=u32}",
+            SPEC.core,
+            used,
+            free,
+            MIN_FREE_STACK
+        );
+        if free < MIN_FREE_STACK {
+            defmt::error!(
+                "the stack came within {=u32} bytes of the statics (at least {=u32} must stay free)",
+                free,
+                MIN_FREE_STACK
+            );
+            exit(false)
+        }
         // Counts → instructions under -icount: SYSTICK_HZ · 2^shift / 1e9 per one.
         let per_instruction = SYSTICK_HZ as f32 * (1u32 << SPEC.icount_shift) as f32 / 1e9;
         defmt::info!(

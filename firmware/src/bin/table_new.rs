@@ -21,6 +21,9 @@ fn main() {
 mod fw_common;
 
 #[cfg(target_os = "none")]
+mod stack_paint;
+
+#[cfg(target_os = "none")]
 #[path = "bench/harness.rs"]
 #[allow(dead_code)] // (`Harness::measure`: the bench's, not used here)
 mod harness;
@@ -29,53 +32,13 @@ mod harness;
 mod firmware {
     use super::fw_common::exit;
     use super::harness;
+    use super::stack_paint;
     use core::hint::black_box;
     use cortex_m_rt::entry;
     use mccs::{ForceTable64, Params};
     use mccs_firmware::target::CORE;
 
     static EMITTED: ForceTable64 = include!("../../../tables/table2.rs");
-
-    extern "C" {
-        /// The top of the stack (cortex-m-rt's linker script).
-        static _stack_start: u32;
-        /// The end of static RAM, where the stack may grow down to (cortex-m-rt).
-        static __ebss: u32;
-    }
-
-    /// What the free stack is painted with before the build.
-    const PAINT: u32 = 0x5AFE_57AC;
-
-    /// Paints the free stack below the caller's frame (less a margin for this function's
-    /// own) down to the end of static RAM.
-    #[inline(never)]
-    fn paint() {
-        // SAFETY: the words from the end of static RAM up to 256 bytes under this
-        // function's stack pointer are free stack: nothing lives there now.
-        unsafe {
-            let sp = cortex_m::register::msp::read() as usize - 256;
-            let mut p = core::ptr::addr_of!(__ebss) as usize;
-            while p < sp {
-                core::ptr::write_volatile(p as *mut u32, PAINT);
-                p += 4;
-            }
-        }
-    }
-
-    /// The stack used since [`paint`], bytes: from its top to the lowest word no longer
-    /// painted.
-    #[inline(never)]
-    fn stack_used() -> u32 {
-        // SAFETY: reads of the painted words, which lie in RAM.
-        unsafe {
-            let top = core::ptr::addr_of!(_stack_start) as usize;
-            let mut p = core::ptr::addr_of!(__ebss) as usize;
-            while p < top && core::ptr::read_volatile(p as *const u32) == PAINT {
-                p += 4;
-            }
-            (top - p) as u32
-        }
-    }
 
     #[entry]
     fn main() -> ! {
@@ -84,13 +47,13 @@ mod firmware {
         };
         let h = harness::start(cp.SYST);
         let mut built = None;
-        paint();
+        stack_paint::paint();
         let instructions = h.measure_long(|| {
             built = Some(black_box(mccs_firmware::entry::table_new(black_box(
                 &Params::TABLE2,
             ))));
         });
-        let stack = stack_used();
+        let (stack, _) = stack_paint::used_and_free();
         let same = matches!(built, Some(Ok(t)) if t == EMITTED);
         defmt::println!(
             "BENCH core={=str} case=table_new instructions={=u64} ms_at_clock={=u64} stack_bytes={=u32}",

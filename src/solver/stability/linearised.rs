@@ -9,6 +9,7 @@ use crate::q;
 use crate::solver::SolverConfig;
 use crate::topology::{Edge, Topology, GROUND};
 use crate::units::DIR_FRAC;
+use position::PositionStep;
 
 /// Steps of each run of the linearised step ([`Linearised::growth`]). At 768, a lightly
 /// damped patch's slowly growing mode stayed hidden under its slowly decaying ones, and
@@ -39,13 +40,15 @@ const STATE_BITS: u32 = 21;
 
 /// A state component at or above this after a step: the step grew the state over 2⁹-fold
 /// in one step, which no stable step does.
-const STATE_LIMIT: u64 = 1 << 30;
+const STATE_LIMIT: u32 = 1 << 30;
 
 /// The patch linearised at rest, as the estimate runs it.
 pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     topo: &'a Topology<NODES, EDGES>,
-    /// Per spring: `k_max / l0`, N/mm.
-    springs: [f32; EDGES],
+    /// The table's largest tangent stiffness, N (each spring's `k_max / l0`:
+    /// [`spring_of`], computed where it is needed rather than held, for the M0's start-up
+    /// stack).
+    k_max: f64,
     /// The stiffest spring's `k_max / l0` and the largest sum of them on one free node,
     /// N/mm; the most springs on one free node.
     k_spring: f32,
@@ -68,8 +71,8 @@ pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
 /// [`Linearised::advance`]): its state, its coefficients and how far it is.
 #[derive(Clone, Debug)]
 pub(super) struct Run<const NODES: usize, const EDGES: usize> {
-    x: [[i32; 3]; NODES],
-    v: [[i32; 3]; NODES],
+    nodes: [NodeState; NODES],
+    /// Per spring `2 κ` (Q24): what its product takes.
     kappa: [i32; EDGES],
     chi: i32,
     chi_node: i32,
@@ -91,7 +94,9 @@ pub const STEPS_PER_RUN: u32 = RUN_STEPS as u32;
 /// a damping over the run, measured up to 0.4 in the logarithm of a lightly damped
 /// patch's growth): one instruction where the core has a long multiply, else out of
 /// line (the M0 builds it from 16-bit pieces: inlined at each of the step's thirteen
-/// products it made the estimate 2.4 KB larger).
+/// products it made the estimate 2.4 KB larger). The springs' loop takes
+/// [`q::mulhi_round`] itself, inlined on every core: its seven products a spring are
+/// most of the M0's step (inlined, 1.5 % faster for 1.2 KB of flash).
 #[inline(always)]
 fn mulhi(a: i32, b: i32) -> i32 {
     if q::HAS_LONG_MULTIPLY {
@@ -123,24 +128,18 @@ fn coeff(x: f32) -> Option<i32> {
 fn along(xa: &[i32; 3], xb: &[i32; 3], d: &[i32; 3]) -> i32 {
     const _: () = assert!(STATE_BITS + 1 + (32 - DIR_FRAC) < 32);
     (0..3)
-        .map(|j| mulhi((xb[j] - xa[j]) << (32 - DIR_FRAC), d[j]))
+        .map(|j| q::mulhi_round((xb[j] - xa[j]) << (32 - DIR_FRAC), d[j]))
         .sum()
 }
 
 impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     pub(super) fn new(topo: &'a Topology<NODES, EDGES>, k_max: f64, config: &SolverConfig) -> Self {
-        let mut springs = [0.0f32; EDGES];
         let mut row = [(0.0f32, 0u32); NODES];
-        let (k_spring, k_row, degree) = spring_rows(
-            topo.edges(),
-            topo.node_count().min(NODES),
-            k_max,
-            &mut springs,
-            &mut row,
-        );
+        let (k_spring, k_row, degree) =
+            spring_rows(topo.edges(), topo.node_count().min(NODES), k_max, &mut row);
         Self {
             topo,
-            springs,
+            k_max,
             k_spring,
             k_row,
             degree,
@@ -226,21 +225,22 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             return Err(f32::INFINITY);
         };
         let mut kappa = [0i32; EDGES];
-        for (kq, k) in kappa.iter_mut().zip(self.springs.iter()) {
-            *kq = libm::roundf(up * k * (1u32 << COEFF_FRAC) as f32) as i32;
+        for (kq, e) in kappa.iter_mut().zip(self.topo.edges()) {
+            let k = spring_of(self.k_max, e);
+            // (Below 2³⁰: each spring's coefficient is below 32, in Q24.)
+            *kq = 2 * libm::roundf(up * k * (1u32 << COEFF_FRAC) as f32) as i32;
         }
-        let mut x = [[0i32; 3]; NODES];
+        let mut nodes = [NodeState::default(); NODES];
         // A fixed pseudo-random start in every degree of freedom, ±0.5 mm in Q20.
         let mut seed: u32 = 0x2545_f491;
-        for xi in x[..n].iter_mut().skip(1) {
-            for c in xi.iter_mut() {
+        for node in nodes[..n].iter_mut().skip(1) {
+            for c in node.x.iter_mut() {
                 seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
                 *c = ((seed >> 8) as i32 - (1 << 23)) >> 4;
             }
         }
         Ok(Run {
-            x,
-            v: [[0i32; 3]; NODES],
+            nodes,
             kappa,
             chi,
             chi_node,
@@ -269,19 +269,18 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             contact: self.topo.contact() as usize,
         };
         let last = run.step.saturating_add(steps as usize).min(RUN_STEPS);
-        let mut dv = [[0i32; 3]; NODES];
+        let mut sums = [NodeSums::default(); NODES];
         while run.step < last {
             if run.step == RUN_STEPS - RUN_WINDOW {
-                run.at_window = (self.energy(&run.x, &run.v, run.h, run.g), run.exp);
+                run.at_window = (self.energy(&run.nodes, run.h, run.g), run.exp);
             }
             run.step += 1;
             let edges = self.topo.edges();
             if !step_once(
                 edges,
                 &run.kappa,
-                &mut run.x,
-                &mut run.v,
-                &mut dv,
+                &mut run.nodes,
+                &mut sums,
                 &k,
                 &mut run.exp,
             ) {
@@ -293,7 +292,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         if run.step < RUN_STEPS {
             return None;
         }
-        let e = self.energy(&run.x, &run.v, run.h, run.g);
+        let e = self.energy(&run.nodes, run.h, run.g);
         let (e0, exp0) = run.at_window;
         Some(if e0 > 0.0 {
             libm::ldexpf(e / e0, 2 * (run.exp - exp0))
@@ -305,12 +304,11 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// The energy at displacements `x` and velocities per step `v` (substep `h`), over
     /// `2^(2 exp)` of the state's exponent: elastic `½ Σ k ((x_b − x_a)·d)²` and the
     /// coupling's (N/mm · units²), kinetic `½ m (v/h)²` in the same unit.
-    fn energy(&self, x: &[[i32; 3]; NODES], v: &[[i32; 3]; NODES], h: f32, g: u32) -> f32 {
+    fn energy(&self, nodes: &[NodeState; NODES], h: f32, g: u32) -> f32 {
         energy_of(
             self.topo.edges(),
-            &self.springs,
-            x,
-            v,
+            self.k_max,
+            nodes,
             self.topo.node_count().min(NODES),
             self.topo.contact() as usize,
             self.k_c,
@@ -321,30 +319,32 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     }
 }
 
-/// Each spring's `k_max / l0` into `springs`, each node's sum of them and count into
-/// `row`; the stiffest spring, the largest node's sum and the most springs on a node
-/// (on slices: one copy for every capacity).
+/// A spring's `k_max / l0` (N/mm) for the table's largest tangent stiffness `k_max` (N).
+fn spring_of(k_max: f64, e: &Edge) -> f32 {
+    (k_max / crate::topology::rest_length(e)) as f32
+}
+
+/// Each node's sum of its springs' `k_max / l0` and their count into `row`; the
+/// stiffest spring, the largest node's sum and the most springs on a node (on slices:
+/// one copy for every capacity).
 #[inline(never)]
 fn spring_rows(
     edges: &[Edge],
     nodes: usize,
     k_max: f64,
-    springs: &mut [f32],
     row: &mut [(f32, u32)],
 ) -> (f32, f32, u32) {
-    for (s, e) in springs.iter_mut().zip(edges) {
-        *s = (k_max / crate::topology::rest_length(e)) as f32;
-        for end in [e.a, e.b] {
-            if let Some(r) = row.get_mut(end as usize).filter(|_| end != GROUND) {
-                *r = (r.0 + *s, r.1 + 1);
-            }
-        }
-    }
     // (Compares, not `f32::max`: a library call on the M4F.)
     let (mut k_spring, mut k_row, mut degree) = (0.0f32, 0.0f32, 0);
-    for &k in springs.iter().take(edges.len()) {
-        if k > k_spring {
-            k_spring = k;
+    for e in edges {
+        let s = spring_of(k_max, e);
+        if s > k_spring {
+            k_spring = s;
+        }
+        for end in [e.a, e.b] {
+            if let Some(r) = row.get_mut(end as usize).filter(|_| end != GROUND) {
+                *r = (r.0 + s, r.1 + 1);
+            }
         }
     }
     for r in row.iter().take(nodes) {
@@ -354,6 +354,25 @@ fn spring_rows(
         degree = degree.max(r.1);
     }
     (k_spring, k_row, degree)
+}
+
+/// One node of a run: its displacement and velocity per step.
+#[derive(Clone, Copy, Debug, Default)]
+struct NodeState {
+    x: [i32; 3],
+    v: [i32; 3],
+}
+
+/// What a step sums on one node, side by side so that a spring reaches each end's
+/// through one address (a step's scratch, on the stack of [`Linearised::advance`]: not
+/// in the [`Run`], which the M0's start-up holds more than once on its 16 KiB).
+#[derive(Clone, Copy, Debug, Default)]
+struct NodeSums {
+    /// Its velocity as the springs' damping takes it, `χ V` (one product per node, not
+    /// per spring).
+    damped: [i32; 3],
+    /// The springs' change to its velocity.
+    dv: [i32; 3],
 }
 
 /// A run's fixed coefficients and its patch's shape, for [`step_once`].
@@ -372,8 +391,9 @@ struct StepCoeffs {
 
 /// One step of the linearised patch (see [`Linearised::start`]), on slices: one copy of
 /// the loop for every patch's capacity (monomorphised per capacity, it was five copies
-/// of 10 KB in the bench firmware). `dv` is scratch, as long as `x`. False where a
-/// component grew past [`STATE_LIMIT`] (the step is unstable).
+/// of 10 KB in the bench firmware). False where a
+/// component grew past [`STATE_LIMIT`] (the step is unstable). Every sum is an `i32`
+/// (the bounds are argued where each is formed; [`PositionStep`] for the positions').
 // Whole on purpose (over 80 lines): the kernel mirrors the solver's substep line by line
 // (springs, then nodes, then the coupling), which is what the stability proof relies on;
 // split, it would no longer read against the substep in `solver/step.rs`.
@@ -381,9 +401,8 @@ struct StepCoeffs {
 fn step_once(
     edges: &[Edge],
     kappa: &[i32],
-    x: &mut [[i32; 3]],
-    v: &mut [[i32; 3]],
-    dv: &mut [[i32; 3]],
+    nodes: &mut [NodeState],
+    sums: &mut [NodeSums],
     k: &StepCoeffs,
     exp: &mut i32,
 ) -> bool {
@@ -397,64 +416,58 @@ fn step_once(
         n,
         contact: c,
     } = *k;
-    for d in dv.iter_mut() {
-        *d = [0; 3];
+    // One length for both (so that an index checked once is in bounds of each).
+    let len = nodes.len().min(sums.len());
+    let (nodes, sums) = (&mut nodes[..len], &mut sums[..len]);
+    for (node, sum) in nodes.iter().zip(sums.iter_mut()) {
+        sum.dv = [0; 3];
+        sum.damped = node.v.map(|vj| mulhi(vj << 8, chi));
     }
     // (Slot 0 is the ground: its state stays zero, and what its springs add to its
     // velocity change is never read.) With components within ±2^STATE_BITS (2²¹) the
     // extension is within 2^23.6, so a spring's stretch and push are within `κ` · 2^23.6
-    // < 2^28.6 and its damping within `χ` · 2²² < 2²⁷; a node's sum, within its row's
-    // 64 · 2^23.6, fits an `i32`. Each product is a high word (`⌊a b / 2³²⌋`, exact)
-    // with its operands shifted up within 2³¹: `along · κ / 2²⁴`, `stretch · d / 2²³`,
-    // `ΔV · χ / 2²⁴`.
+    // < 2^28.6 and its damping `χ V_b − χ V_a` within 2 · 2²¹ · 32 = 2²⁷; a node's
+    // sum, within its row's 64 · 2^23.6, fits an `i32`. Each product is a rounded high
+    // word (`a b / 2³²`, exact) with its operands shifted up within 2³¹:
+    // `along · κ / 2²⁴`, `stretch · d / 2²³`, and once per node `V χ / 2²⁴`.
     const _: () = assert!(COEFF_FRAC == 24 && DIR_FRAC == 23 && STATE_BITS == 21);
     for (e, &kq) in edges.iter().zip(kappa.iter()) {
         let (a, b) = (e.a as usize, e.b as usize);
-        let (Some(xa), Some(xb), Some(va), Some(vb)) = (x.get(a), x.get(b), v.get(a), v.get(b))
-        else {
+        if a >= len || b >= len {
             continue;
-        };
-        let stretch = mulhi(along(xa, xb, &e.dir) << 7, kq << 1);
-        let on_a: [i32; 3] = core::array::from_fn(|j| {
-            mulhi(stretch << 2, e.dir[j] << 7) + mulhi((vb[j] - va[j]) << 8, chi)
-        });
-        if let Some(da) = dv.get_mut(a) {
-            for j in 0..3 {
-                da[j] = da[j].wrapping_add(on_a[j]);
-            }
         }
-        if let Some(db) = dv.get_mut(b) {
-            for j in 0..3 {
-                db[j] = db[j].wrapping_sub(on_a[j]);
-            }
+        let stretch = q::mulhi_round(along(&nodes[a].x, &nodes[b].x, &e.dir) << 7, kq);
+        for j in 0..3 {
+            let on_a = q::mulhi_round(stretch << 2, e.dir[j] << 7)
+                + (sums[b].damped[j] - sums[a].damped[j]);
+            sums[a].dv[j] = sums[a].dv[j].wrapping_add(on_a);
+            sums[b].dv[j] = sums[b].dv[j].wrapping_sub(on_a);
         }
     }
+    let position = PositionStep::new(symplectic, g);
     let mut magnitude = 0u32;
-    for i in 1..n.min(x.len()).min(v.len()).min(dv.len()) {
+    for (i, (node, sum)) in nodes
+        .iter_mut()
+        .zip(sums.iter())
+        .enumerate()
+        .take(n)
+        .skip(1)
+    {
         for j in 0..3 {
-            let (xi, vi) = (x[i][j], v[i][j]);
+            let (xi, vi) = (node.x[j], node.v[j]);
             // The springs' change within 2^29.6 (their row), each node term within 2²⁶
-            // (`χ`, `κ` < 32 on components within 2²¹): all within `i32`, and so are
-            // `V'`, `V + V'` and `X'` (below 2^30.5).
-            let mut dvi = dv[i][j] - mulhi(vi << 8, chi_node);
+            // (`χ`, `κ` < 32 on components within 2²¹): all within `i32`.
+            let mut dvi = sum.dv[j] - mulhi(vi << 8, chi_node);
             if i == c {
                 dvi -= mulhi(xi << 8, kappa_c) + mulhi(vi << 8, chi_c);
             }
             let v_new = vi + dvi;
-            // (`X` in half units of `V / 2^g`: the position step, rounded.)
-            let step = if symplectic {
-                2 * v_new as i64
-            } else {
-                vi as i64 + v_new as i64
-            };
-            let x_new = xi as i64 + ((step + ((1i64 << g) >> 1)) >> g);
-            let grown = x_new.unsigned_abs() | v_new.unsigned_abs() as u64;
-            if grown >= STATE_LIMIT {
+            let Some(x_new) = position.advance(xi, vi, v_new) else {
                 return false;
-            }
-            x[i][j] = x_new as i32;
-            v[i][j] = v_new;
-            magnitude |= grown as u32;
+            };
+            node.x[j] = x_new;
+            node.v[j] = v_new;
+            magnitude |= x_new.unsigned_abs() | v_new.unsigned_abs();
         }
     }
     // Renormalise: the largest component back into [2^(STATE_BITS − 2), 2^STATE_BITS)
@@ -466,12 +479,12 @@ fn step_once(
         0
     };
     if up != 0 {
-        for (xi, vi) in x.iter_mut().zip(v.iter_mut()).take(n) {
+        for node in nodes.iter_mut().take(n) {
             for j in 0..3 {
-                (xi[j], vi[j]) = if up > 0 {
-                    (xi[j] << up, vi[j] << up)
+                (node.x[j], node.v[j]) = if up > 0 {
+                    (node.x[j] << up, node.v[j] << up)
                 } else {
-                    (xi[j] >> -up, vi[j] >> -up)
+                    (node.x[j] >> -up, node.v[j] >> -up)
                 };
             }
         }
@@ -485,9 +498,8 @@ fn step_once(
 #[allow(clippy::too_many_arguments)]
 fn energy_of(
     edges: &[Edge],
-    springs: &[f32],
-    x: &[[i32; 3]],
-    v: &[[i32; 3]],
+    k_max: f64,
+    nodes: &[NodeState],
     n: usize,
     c: usize,
     k_c: f32,
@@ -495,28 +507,31 @@ fn energy_of(
     h: f32,
     g: u32,
 ) -> f32 {
-    let at = |i: u16| x.get(i as usize).copied().unwrap_or([0; 3]);
+    let at = |i: u16| nodes.get(i as usize).map_or([0; 3], |node| node.x);
     let mut elastic = 0.0f32;
-    for (e, k) in edges.iter().zip(springs.iter()) {
+    for e in edges {
         let s = along(&at(e.a), &at(e.b), &e.dir) as f32;
-        elastic += 0.125 * k * s * s;
+        elastic += 0.125 * spring_of(k_max, e) * s * s;
     }
     // ½ m v² with m = 1000/per_mass kg and v = V/h: in N·mm per unit² (as the elastic
     // part), 0.5e-3 m / h².
     let w_v = 0.5 / (per_mass * h * h * (1u32 << (2 * g)) as f32);
     let mut kinetic = 0.0f32;
-    for vi in v.iter().take(n).skip(1) {
-        for c in vi {
+    for node in nodes.iter().take(n).skip(1) {
+        for c in &node.v {
             kinetic += (*c as f32) * (*c as f32);
         }
     }
-    if let Some(xc) = x.get(c).filter(|_| c != 0 && c < n) {
-        for c in xc {
+    if let Some(node) = nodes.get(c).filter(|_| c != 0 && c < n) {
+        for c in &node.x {
             elastic += 0.125 * k_c * (*c as f32) * (*c as f32);
         }
     }
     elastic + w_v * kinetic
 }
 
+mod position;
 #[cfg(test)]
 mod test_growth;
+#[cfg(test)]
+mod test_step;
