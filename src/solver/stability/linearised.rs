@@ -92,11 +92,10 @@ pub const STEPS_PER_RUN: u32 = RUN_STEPS as u32;
 
 /// [`q::mulhi_round`] (`a b / 2³²` rounded to nearest, exact: a floor's bias acts as
 /// a damping over the run, measured up to 0.4 in the logarithm of a lightly damped
-/// patch's growth): one instruction where the core has a long multiply, else out of
-/// line (the M0 builds it from 16-bit pieces: inlined at each of the step's thirteen
-/// products it made the estimate 2.4 KB larger). The springs' loop takes
-/// [`q::mulhi_round`] itself, inlined on every core: its seven products a spring are
-/// most of the M0's step (inlined, 1.5 % faster for 1.2 KB of flash).
+/// patch's growth) for the step's products per node: one instruction where the core has
+/// a long multiply, else out of line (the M0 builds it from 16-bit pieces). The springs'
+/// loop takes [`q::mulhi_round`] itself, inlined on every core: its seven products a
+/// spring are most of the M0's step (inlined there, 1.5 % faster for 1.2 KB of flash).
 #[inline(always)]
 fn mulhi(a: i32, b: i32) -> i32 {
     if q::HAS_LONG_MULTIPLY {
@@ -391,9 +390,9 @@ struct StepCoeffs {
 
 /// One step of the linearised patch (see [`Linearised::start`]), on slices: one copy of
 /// the loop for every patch's capacity (monomorphised per capacity, it was five copies
-/// of 10 KB in the bench firmware). False where a
-/// component grew past [`STATE_LIMIT`] (the step is unstable). Every sum is an `i32`
-/// (the bounds are argued where each is formed; [`PositionStep`] for the positions').
+/// of 10 KB in the bench firmware). False where a component grew past [`STATE_LIMIT`]
+/// (the step is unstable). Every sum is an `i32` (the bounds are argued where each is
+/// formed; [`PositionStep`] for the positions').
 // Whole on purpose (over 80 lines): the kernel mirrors the solver's substep line by line
 // (springs, then nodes, then the coupling), which is what the stability proof relies on;
 // split, it would no longer read against the substep in `solver/step.rs`.
@@ -446,6 +445,7 @@ fn step_once(
     }
     let position = PositionStep::new(symplectic, g);
     let mut magnitude = 0u32;
+    // (An iterator, not indices: 1.5 % fewer instructions in the M4F's check.)
     for (i, (node, sum)) in nodes
         .iter_mut()
         .zip(sums.iter())

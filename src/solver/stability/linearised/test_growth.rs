@@ -33,12 +33,12 @@ fn growth_f64<const NODES: usize, const EDGES: usize>(
     let energy = |x: &[[f64; 3]; NODES], v: &[[f64; 3]; NODES]| -> f64 {
         let mut e = 0.0;
         for edge in lin.topo.edges() {
-            let k = &spring_of(lin.k_max, edge);
+            let k = spring_of(lin.k_max, edge);
             let dd = dir(edge);
             let s: f64 = (0..3)
                 .map(|j| (x[edge.b as usize][j] - x[edge.a as usize][j]) * dd[j])
                 .sum();
-            e += 0.5 * *k as f64 * s * s;
+            e += 0.5 * k as f64 * s * s;
         }
         for j in 0..3 {
             e += 0.5 * lin.k_c as f64 * x[c][j] * x[c][j];
@@ -58,12 +58,12 @@ fn growth_f64<const NODES: usize, const EDGES: usize>(
         }
         let mut f = [[0.0f64; 3]; NODES];
         for edge in lin.topo.edges() {
-            let k = &spring_of(lin.k_max, edge);
+            let k = spring_of(lin.k_max, edge);
             let (a, b) = (edge.a as usize, edge.b as usize);
             let dd = dir(edge);
             let s: f64 = (0..3).map(|j| (x[b][j] - x[a][j]) * dd[j]).sum();
             for j in 0..3 {
-                let on_a = *k as f64 * s * dd[j] + lin.c_spring as f64 * (v[b][j] - v[a][j]);
+                let on_a = k as f64 * s * dd[j] + lin.c_spring as f64 * (v[b][j] - v[a][j]);
                 f[a][j] += on_a;
                 f[b][j] -= on_a;
             }
