@@ -125,6 +125,57 @@ fn torques_are_the_virtual_work_of_the_forward_kinematics() {
     println!("ARM case=jt max_rel_err={worst:.2e}");
 }
 
+/// `drive` takes all of `Force`'s range (±2,048 N): at every corner of it, the torques
+/// are the virtual work of the twin's kinematics (no product wraps; it held the force to
+/// ±1,024 N until its sums were taken in Q18 N, 2026-11-30).
+#[test]
+fn the_drive_takes_the_whole_force_range() {
+    let spec = ArmSpec {
+        gravity: None,
+        ..woodenhaptics()
+    };
+    let arm = Arm::new(&spec).unwrap();
+    let twin = ArmTwin { spec };
+    let mut rng = ChaCha8Rng::seed_from_u64(59);
+    for _ in 0..2_000 {
+        let c = counts_in(&spec, &twin, &mut rng);
+        let t = twin.angles(c.map(f64::from));
+        for corner in 0..8 {
+            let f: [Force; 3] = std::array::from_fn(|k| {
+                if corner >> k & 1 == 1 {
+                    Force::MAX
+                } else {
+                    Force::MIN
+                }
+            });
+            let fixed = arm
+                .drive(&arm.pose(c), f)
+                .torque_q8
+                .map(|t| t as f64 / 256.0);
+            let h = 1e-6;
+            let fd: [f64; 3] = std::array::from_fn(|k| {
+                let (mut a, mut b) = (t, t);
+                a[k] += h;
+                b[k] -= h;
+                let (pa, pb) = (twin.fk(a), twin.fk(b));
+                (0..3)
+                    .map(|n| f[n].to_num::<f64>() * (pa[n] - pb[n]))
+                    .sum::<f64>()
+                    / (2.0 * h)
+            });
+            let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for k in 0..3 {
+                assert!(
+                    (fixed[k] - fd[k]).abs() <= 0.005 * scale + 4.0 / 256.0,
+                    "joint {k} at {f:?}: {} against {} N·mm",
+                    fixed[k],
+                    fd[k]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn gravity_is_the_gradient_of_the_potential() {
     let spec = woodenhaptics();

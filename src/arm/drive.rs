@@ -17,24 +17,39 @@ pub struct Drive {
 }
 
 /// 100 % duty, Q16.
-const FULL: i64 = 1 << 16;
+const FULL_DUTY_Q16: i32 = 1 << 16;
+
+/// `m · 2^up`, saturated at the ends of `i32` (`up` < 32): a compare each way and a
+/// shift on every core (a saturating multiply is a 64-bit product on the M0).
+#[inline(always)]
+fn shl_saturating(m: i32, up: u32) -> i32 {
+    let limit = i32::MAX >> up;
+    if m > limit {
+        i32::MAX
+    } else if m < !limit {
+        i32::MIN
+    } else {
+        m << up
+    }
+}
 
 impl Arm {
-    /// The duties that render `force` (N, tissue frame) at `pose`. The force is held to
-    /// ±1,024 N per component.
+    /// The duties that render `force` (N, tissue frame: all of `Force`'s ±2,048 N) at
+    /// `pose`.
     pub fn drive(&self, pose: &ArmPose, force: [Force; 3]) -> Drive {
         let [(ca, sa), (cb, sb), (cc, sc)] = pose.cos_sin;
-        let [fx, fy, fz] = force.map(|f| f.to_bits().clamp(-(1 << 30), 1 << 30));
-        // Along the arm's plane (u) and across it (v), Q19 N (Q31 × Q20 / 2³²).
+        // Q19 N: each product below within half of `i32`, so that two sum within it.
+        let [fx, fy, fz] = force.map(|f| f.to_bits() >> 1);
+        // Along the arm's plane (u) and across it (v), Q18 N (Q31 × Q19 / 2³²).
         let u = hi(ca, fx) + hi(sa, fy);
         let v = hi(ca, fy) - hi(sa, fx);
         let fz = fz >> 1;
-        // τ_A = r v: Q17 × Q19 = Q36 → Q8. τ_B = Lb (cos B u − sin B F_z),
-        // τ_C = Lc (cos C u + sin C F_z): Q31 × Q19 / 2³² = Q18 N, × Q17 mm = Q35 → Q8.
+        // τ_A = r v: Q17 × Q18 = Q35 → Q8. τ_B = Lb (cos B u − sin B F_z),
+        // τ_C = Lc (cos C u + sin C F_z): Q31 × Q18 / 2³² = Q17 N, × Q17 mm = Q34 → Q8.
         let jt = [
-            ((pose.reach_q17 as i64 * v as i64) >> 28) as i32,
-            ((self.upper_q17 as i64 * (hi(cb, u) - hi(sb, fz)) as i64) >> 27) as i32,
-            ((self.fore_q17 as i64 * (hi(cc, u) + hi(sc, fz)) as i64) >> 27) as i32,
+            ((pose.reach_q17 as i64 * v as i64) >> 27) as i32,
+            ((self.upper_q17 as i64 * (hi(cb, u) - hi(sb, fz)) as i64) >> 26) as i32,
+            ((self.fore_q17 as i64 * (hi(cc, u) + hi(sc, fz)) as i64) >> 26) as i32,
         ];
         // ∂U/∂θ: B: −G_B sin B, C: G_C sin C (Q16 × Q31 / 2³² = Q15 → Q8).
         let gravity = [
@@ -43,31 +58,31 @@ impl Arm {
             hi(self.gravity_c_q16, sc) >> 7,
         ];
         let mut torque_q8 = [0i32; 3];
-        let mut duty = [0i64; 3];
-        let mut most = 0i64;
+        let mut duty = [0i32; 3];
+        let mut most = 0u32;
         for k in 0..3 {
             torque_q8[k] = jt[k].saturating_add(gravity[k]);
             let j = &self.joints[k];
-            duty[k] = (torque_q8[k] as i64 * j.duty_gain as i64) >> j.duty_shift;
-            most = most.max(duty[k].abs());
+            // In `i32`: the duty's high word, then its shift (`Arm::new`'s `duty_gain`).
+            duty[k] = shl_saturating(hi(torque_q8[k], j.duty_gain), j.duty_up) >> j.duty_down;
+            most = most.max(duty[k].unsigned_abs());
         }
-        let scaled = most > FULL;
+        let scaled = most > FULL_DUTY_Q16 as u32;
         if scaled {
             // d / most for each, through one reciprocal: `most` and the duties shifted
-            // alike so that `most` lies in [2³⁰, 2³¹).
-            let lz = (most as u64).leading_zeros() as i64;
-            let shift = 33 - lz;
+            // alike so that `most` lies in [2³⁰, 2³¹) (`most` ≤ 2³¹, over 2¹⁶ here).
+            let shift = 1 - most.leading_zeros() as i32;
             let (m, d) = if shift >= 0 {
-                (most >> shift, duty.map(|d| d >> shift))
+                ((most >> shift) as i64, duty.map(|d| (d >> shift) as i64))
             } else {
-                (most << -shift, duty.map(|d| d << -shift))
+                ((most << -shift) as i64, duty.map(|d| (d as i64) << -shift))
             };
             let y = recip(m);
-            duty = d.map(|d| (d * y) >> 46);
+            duty = d.map(|d| ((d * y) >> 46) as i32);
         }
         Drive {
             torque_q8,
-            duty_q16: duty.map(|d| d.clamp(-FULL, FULL) as i32),
+            duty_q16: duty.map(|d| d.clamp(-FULL_DUTY_Q16, FULL_DUTY_Q16)),
             scaled,
         }
     }

@@ -45,6 +45,24 @@ pub use spec::{ArmError, ArmFieldError, ArmSpec, GravitySpec, JointSpec};
 /// A full turn in phase units (2³²), as `f64`.
 const TURN: f64 = 4_294_967_296.0;
 
+/// `k` (Q16 duty per Q8 N·mm, sign included) as `(gain, up, down)` with `k ≈ gain ·
+/// 2^(up − down − 32)`, `|gain|` in `[2³⁰, 2³¹)` (31 bits), `up` ≤ 30 and `down` ≤ 31,
+/// one of them 0. Past those ends (`|k|` ≥ 2²⁹ or < 2⁻³³: no motor's) the gain is held
+/// at its end: every duty then saturates, or is within a quarter of its last bit of 0.
+fn duty_gain(k: f64) -> (i32, u32, u32) {
+    let (mut g, mut e) = (k.abs() * TURN, 0i32);
+    while g >= TURN / 2.0 && e < 30 {
+        g /= 2.0;
+        e += 1;
+    }
+    while g < TURN / 4.0 && e > -31 {
+        g *= 2.0;
+        e -= 1;
+    }
+    let g = libm::round(g).min(i32::MAX as f64) * k.signum();
+    (g as i32, e.max(0) as u32, (-e).max(0) as u32)
+}
+
 /// One joint's gains, from its [`JointSpec`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Joint {
@@ -54,12 +72,16 @@ struct Joint {
     home_count: i32,
     /// Phase per count, Q16 (sign included).
     phase_per_count: i64,
-    /// The joint's range, phases relative to home (signed).
+    /// The joint's range, phases relative to home (signed): from `min_phase`, `phase_span`
+    /// more.
     min_phase: i32,
-    max_phase: i32,
-    /// Duty (Q16) per torque (Q8 N·mm): `(τ · gain) >> shift` (`gain` < 2²¹).
+    phase_span: u32,
+    /// Duty (Q16) per torque (Q8 N·mm): `⌊τ · gain / 2³²⌋`, saturated times `2^duty_up`,
+    /// then shifted down `duty_down` (one of the two is 0): `|gain|` in `[2³⁰, 2³¹)` but
+    /// where the shifts reach their ends ([`duty_gain`]).
     duty_gain: i32,
-    duty_shift: u32,
+    duty_up: u32,
+    duty_down: u32,
 }
 
 /// An arm, its constants folded into gains (start-up code: floating point).
@@ -96,20 +118,18 @@ impl Arm {
             // Q16 duty per Q8 N·mm: sign / (ratio · Kt · Imax · 1000 N·mm per N·m), then
             // raised to 2²⁰ … 2²¹ with a shift, for the product's precision.
             let k = j.sign / (j.ratio * j.torque_constant_nm_per_a * j.max_current_a * 1000.0);
-            let mut shift = 0u32;
-            let mut gain = k * 256.0;
-            while gain.abs() < (1u64 << 20) as f64 && shift < 60 {
-                gain *= 2.0;
-                shift += 1;
-            }
+            let (duty_gain, duty_up, duty_down) = duty_gain(k * 256.0);
             Joint {
                 home_phase: phase(j.home_angle_deg) as i64 as u32,
                 home_count: j.home_count,
                 phase_per_count: libm::round(j.sign * TURN * 65_536.0 / per_turn) as i64,
                 min_phase: phase(j.min_angle_deg - j.home_angle_deg) as i32,
-                max_phase: phase(j.max_angle_deg - j.home_angle_deg) as i32,
-                duty_gain: libm::round(gain) as i32,
-                duty_shift: shift,
+                phase_span: (phase(j.max_angle_deg - j.home_angle_deg) as i32)
+                    .wrapping_sub(phase(j.min_angle_deg - j.home_angle_deg) as i32)
+                    as u32,
+                duty_gain,
+                duty_up,
+                duty_down,
             }
         };
         let q = |mm: f64, bits: u32| libm::round(mm * (1u64 << bits) as f64) as i64;
@@ -138,5 +158,33 @@ impl Arm {
             ) as i32,
             gravity_c_q16: q(g.g * g.forearm_mass_kg * g.forearm_com_mm, 16) as i32,
         })
+    }
+}
+
+#[cfg(test)]
+mod test_duty_gain {
+    use super::{duty_gain, TURN};
+
+    /// Every gain from 2⁻³³ to 2²⁹ (each sign) is held to 31 bits: `|gain|` in `[2³⁰,
+    /// 2³¹)`, one shift 0, `gain · 2^(up − down − 32)` within 2⁻³⁰ of it; past the ends the
+    /// gain is held there.
+    #[test]
+    fn each_gain_keeps_31_bits_and_its_ends_hold() {
+        for e in -33..29 {
+            for f in [1.0, 1.1, 1.5, 1.999_999_999] {
+                for sign in [1.0, -1.0] {
+                    let k = sign * f * libm::exp2(e as f64);
+                    let (g, up, down) = duty_gain(k);
+                    assert!(up == 0 || down == 0, "{k}");
+                    assert!(up <= 30 && down <= 31, "{k}");
+                    let m = g.unsigned_abs() as f64;
+                    assert!((TURN / 4.0..TURN / 2.0).contains(&m), "{k}: {g}");
+                    let back = g as f64 * libm::exp2(up as f64 - down as f64 - 32.0);
+                    assert!(((back - k) / k).abs() <= libm::exp2(-30.0), "{k}: {back}");
+                }
+            }
+        }
+        assert_eq!(duty_gain(libm::exp2(40.0)), (i32::MAX, 30, 0));
+        assert_eq!(duty_gain(-libm::exp2(-70.0)), (0, 0, 31));
     }
 }

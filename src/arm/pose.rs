@@ -1,7 +1,7 @@
 //! Counts to the probe: the joints' phases, their cosines and sines, the forward
 //! kinematics in the device frame, the probe in the tissue's frame, the joints' limits.
 
-use super::Arm;
+use super::{Arm, Joint};
 use crate::units::Length;
 
 /// Bit of [`ArmPose::flags`]: joint A outside its range.
@@ -42,6 +42,24 @@ impl ArmPose {
 /// [`crate::q::mulhi`] (one `smull` on the M3/M4F, four 16-bit products on the M0).
 pub(super) use crate::q::mulhi as hi;
 
+impl Joint {
+    /// The joint's `(cos, sin)` at `count` (Q31), and whether it is outside its range.
+    /// Out of line: one joint's values fit the registers, where three inlined side by
+    /// side spilled (on the M4F).
+    #[inline(never)]
+    fn cos_sin(&self, count: i32) -> ((i32, i32), bool) {
+        // The phase from home, wrapping with the angle (a turn is 2³²).
+        let from_home = ((count.wrapping_sub(self.home_count) as i64)
+            .wrapping_mul(self.phase_per_count)
+            >> 16) as i32;
+        // Outside `min_phase ..= max_phase`, as one unsigned compare.
+        let outside = from_home.wrapping_sub(self.min_phase) as u32 > self.phase_span;
+        let phase = self.home_phase.wrapping_add(from_home as u32);
+        // (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the lengths.)
+        (idsp::cossin(phase as i32), outside)
+    }
+}
+
 /// 128 mm in Q16, the tissue frame's end.
 const HOLD_Q16: i32 = (1 << 23) - 1;
 
@@ -51,17 +69,9 @@ impl Arm {
         let mut cos_sin = [(0i32, 0i32); 3];
         let mut flags = 0u8;
         for k in 0..3 {
-            let j = &self.joints[k];
-            // The phase from home, wrapping with the angle (a turn is 2³²).
-            let from_home = ((counts[k].wrapping_sub(j.home_count) as i64)
-                .wrapping_mul(j.phase_per_count)
-                >> 16) as i32;
-            if from_home < j.min_phase || from_home > j.max_phase {
-                flags |= 1 << k;
-            }
-            let phase = j.home_phase.wrapping_add(from_home as u32);
-            // (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the lengths.)
-            cos_sin[k] = idsp::cossin(phase as i32);
+            let (cs, outside) = self.joints[k].cos_sin(counts[k]);
+            cos_sin[k] = cs;
+            flags |= (outside as u8) << k;
         }
         let [(ca, sa), (cb, sb), (cc, sc)] = cos_sin;
         // Q18 mm × Q31 / 2³² = Q17; Q17 × Q31 / 2³² = Q16.
