@@ -6,21 +6,25 @@
 # Exit status: QEMU's (0 when the firmware exits through semihosting with success).
 # `--arm`: the arm variant (--features arm,qemu): its counters read and its home input
 # stays low in QEMU, so it is never homed: no fault, zero duty on every joint throughout.
-#   scripts/f405-qemu.sh [--arm]
+# `--arm-sim`: the arm variant on its simulated arm (--features arm,sim,qemu): homed, its
+# direction checked, then one palpation of the tissue (5.5 s of ticks), ending with the
+# trainer's tick at its worst (`BENCH core=m4f case=trainer_tick …`) and the SUMMARY.
+#   scripts/f405-qemu.sh [--arm | --arm-sim]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 features=qemu
 case "${1:-}" in
   "") ;;
   --arm) features=arm,qemu ;;
-  *) echo "usage: scripts/f405-qemu.sh [--arm] (not '$1')" >&2; exit 2 ;;
+  --arm-sim) features=arm,sim,qemu ;;
+  *) echo "usage: scripts/f405-qemu.sh [--arm | --arm-sim] (not '$1')" >&2; exit 2 ;;
 esac
 source scripts/lib.sh  # build_decoder, $DECODER
 echo "f405-qemu: building the board firmware (--features $features) and the log decoder" >&2
 build_decoder --quiet
 cargo build --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 --features "$features"
 elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
-echo "f405-qemu: running it in QEMU (netduinoplus2, a second of ticks)" >&2
+echo "f405-qemu: running it in QEMU (netduinoplus2, a second of ticks; the simulated arm 5.5 s)" >&2
 timeout --foreground 300 cargo run --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf \
     --bin haptic-f405 --features "$features" < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
   | "$DECODER" "$elf"

@@ -225,6 +225,24 @@ board_f405_arm() {
   tail -n 1 target/qemu/f405-arm.log | grep -q '^SUMMARY board=f405-arm .* verdict=ok$'
 }
 
+# The arm board on its simulated arm, no link (scripts/f405-qemu.sh --arm-sim): homed, its
+# direction checked, one palpation of the tissue; its SUMMARY held to the fault rules,
+# the tissue touched (a force logged), and its worst tick — the trainer's whole tick,
+# `BENCH core=m4f case=trainer_tick` — held to the board's budget in bench/budgets.txt
+# (`BOARD_BUDGET`: the bench firmware does not run the board's tick).
+board_f405_arm_sim() {
+  local log=target/qemu/f405-arm-sim.log worst max
+  bash scripts/f405-qemu.sh --arm-sim > "$log" || { tail -n 5 "$log"; return 1; }
+  grep '^BENCH core=m4f case=trainer_tick ' "$log" && tail -n 1 "$log"
+  tail -n 1 "$log" | grep -q '^SUMMARY board=f405-arm-sim .* verdict=ok$' || return 1
+  grep -q 'force_n=[0-9.]*[1-9]' "$log" || { echo "the simulated arm never touched the tissue ($log)"; return 1; }
+  worst=$(sed -n 's/^BENCH core=m4f case=trainer_tick .* worst_instructions=\([0-9]*\).*/\1/p' "$log")
+  max=$(sed -n 's/^BOARD_BUDGET core=m4f case=trainer_tick max=\([0-9]*\) status=enforced$/\1/p' bench/budgets.txt)
+  [ -n "$worst" ] && [ -n "$max" ] || { echo "no trainer_tick figure or budget"; return 1; }
+  echo "BOARD_BUDGET core=m4f case=trainer_tick value=$worst limit=$max result=$([ "$worst" -le "$max" ] && echo ok || echo OVER)"
+  [ "$worst" -le "$max" ]
+}
+
 # Every way out of the board firmware cuts the motor first (boards/f405/src/safe_stop.rs):
 # each fault class injected after 100 ticks (--features fault-test, the class on the
 # semihosting command line) must reach its handler, which logs `stop: <class>, the motor
@@ -405,6 +423,7 @@ run_stage bench-truncated-fails bench_truncated
 run_stage firmware-size sizes
 run_stage board-f405 board_f405
 run_stage board-f405-arm board_f405_arm
+run_stage board-f405-arm-sim board_f405_arm_sim
 run_stage board-faults board_faults
 run_stage link-qemu link_qemu
 run_stage scene-examples scene_examples

@@ -117,7 +117,7 @@ impl QemuMismatch {
     /// The message.
     pub const fn message(&self) -> &'static str {
         match self {
-            Self::Ticks => "the run did not last qemu_ticks ticks",
+            Self::Ticks => "the run did not last its ticks",
             Self::Overrun => "a tick overran its period",
             Self::Fault => "the encoder's zeros did not fault the read on the expected tick",
             Self::SafeState => "the safe state reported an error",
@@ -126,16 +126,17 @@ impl QemuMismatch {
     }
 }
 
-/// Holds a QEMU run to the fault rules: the safe state entered through a failed read on
+/// Holds a QEMU run to its length, `ticks` (the variant's: `BoardConfig::qemu_ticks`, or
+/// the simulated arm's palpation), and to the fault rules: the safe state entered through a failed read on
 /// `fault_tick` (the 1-DOF board: its SPI reads zeros, [`zeros_fault_tick`]) or never
 /// (`None`: the arm, whose counters read and whose home input stays low), and no duty on
 /// an arm that was never homed.
 pub fn qemu_verdict(
-    config: &BoardConfig,
+    ticks: u32,
     t: &BoardTelemetry,
     fault_tick: Option<u32>,
 ) -> Result<(), QemuMismatch> {
-    if t.run.ticks != config.qemu_ticks {
+    if t.run.ticks != ticks {
         return Err(QemuMismatch::Ticks);
     }
     if t.run.overruns != 0 {

@@ -393,24 +393,27 @@ fn an_encoder_reading_zeros_ends_in_the_safe_state_on_the_expected_tick() {
     assert_eq!(t.part, Some(device::DevicePart::Encoder));
     assert_eq!(t.fault_tick, Some(fault_tick));
     assert_eq!(t.encoder.diagnostic, fault_tick);
-    assert_eq!(qemu_verdict(&BOARD, &t, zeros_fault_tick(&BOARD)), Ok(()));
+    assert_eq!(
+        qemu_verdict(BOARD.qemu_ticks, &t, zeros_fault_tick(&BOARD)),
+        Ok(())
+    );
     // The verdict fails a run that is anything else.
     let mut late = t;
     late.fault_tick = Some(fault_tick + 1);
     assert_eq!(
-        qemu_verdict(&BOARD, &late, zeros_fault_tick(&BOARD)),
+        qemu_verdict(BOARD.qemu_ticks, &late, zeros_fault_tick(&BOARD)),
         Err(QemuMismatch::Fault)
     );
     let mut short = t;
     short.run.ticks -= 1;
     assert_eq!(
-        qemu_verdict(&BOARD, &short, zeros_fault_tick(&BOARD)),
+        qemu_verdict(BOARD.qemu_ticks, &short, zeros_fault_tick(&BOARD)),
         Err(QemuMismatch::Ticks)
     );
     let mut overrun = t;
     overrun.run.overruns = 1;
     assert_eq!(
-        qemu_verdict(&BOARD, &overrun, zeros_fault_tick(&BOARD)),
+        qemu_verdict(BOARD.qemu_ticks, &overrun, zeros_fault_tick(&BOARD)),
         Err(QemuMismatch::Overrun)
     );
     drop(ctl);

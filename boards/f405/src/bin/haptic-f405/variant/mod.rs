@@ -97,6 +97,10 @@ pub trait BoardVariant {
     /// (read only by that build).
     #[allow(dead_code)]
     const QEMU_FAULT_TICK: Option<u32>;
+    /// Ticks of a QEMU run (`board_run_ends`, read only by that build): the board's
+    /// second, or what the plant needs to show its work.
+    #[allow(dead_code)]
+    const QEMU_TICKS: u32 = haptic_f405::config::BOARD.qemu_ticks;
 
     /// Takes its pins and peripherals and builds the device in its safe state; returns
     /// it, the PWM's full scale and the link's pins.

@@ -10,7 +10,10 @@ use haptic_f405::config::{BoardConfig, BoardConfigError, BOARD};
 use haptic_f405::device::{BoardRoaming, StartFault};
 use haptic_f405::telemetry::BoardTelemetry;
 use haptic_f405::tissue::TissueTable;
-use mccs_firmware::arm::plant::{Plant, PlantEnable, PlantHome, PlantJoint, PLANT_MAX_DUTY};
+use mccs_firmware::arm::plant::{
+    Plant, PlantEnable, PlantHome, PlantJoint, APPROACH_TICKS, HOME_TICKS, NUDGE_TICKS,
+    PALPATION_TICKS, PLANT_MAX_DUTY,
+};
 use mccs_firmware::Slot;
 use mccs_link::{ContactKind, DeviceKind};
 use stm32f4xx_hal::rcc::Clocks;
@@ -28,6 +31,10 @@ impl BoardVariant for SimArm {
     const CONTACT: ContactKind = ContactKind::Roaming;
     const SIMULATED: bool = true;
     const QEMU_FAULT_TICK: Option<u32> = None;
+    /// Homed, the direction checked, the approach and one whole palpation (about 1.5 s
+    /// in contact, sliding 30 mm each way): the trainer's tick at its worst
+    /// (`BENCH … case=trainer_tick`).
+    const QEMU_TICKS: u32 = HOME_TICKS + NUDGE_TICKS + APPROACH_TICKS + PALPATION_TICKS;
 
     fn build(
         parts: BoardParts,
