@@ -98,31 +98,42 @@ fn torques_are_the_virtual_work_of_the_forward_kinematics() {
             .drive(&arm.pose(c), f.map(Force::from_num))
             .torque_q8
             .map(|t| t as f64 / 256.0);
-        // Central differences of F · p(θ), in the twin, at the counts' angles.
-        let t = twin.angles(c.map(f64::from));
-        let h = 1e-6;
-        let fd: [f64; 3] = std::array::from_fn(|k| {
-            let mut a = t;
-            let mut b = t;
-            a[k] += h;
-            b[k] -= h;
-            let (pa, pb) = (twin.fk(a), twin.fk(b));
-            (0..3).map(|n| f[n] * (pa[n] - pb[n])).sum::<f64>() / (2.0 * h)
-        });
-        let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        for k in 0..3 {
-            // 0.5 % and a few of the torque's LSBs (1/256 N·mm): its products' truncations.
-            let err = (fixed[k] - fd[k]).abs();
-            assert!(
-                err <= 0.005 * scale + 4.0 / 256.0,
-                "joint {k}: {} against {} N·mm",
-                fixed[k],
-                fd[k]
-            );
-            worst = worst.max(err / scale.max(1e-9));
-        }
+        let fd = virtual_work(&twin, twin.angles(c.map(f64::from)), f);
+        worst = worst.max(assert_torques(fixed, fd, &format!("{f:?}")));
     }
     println!("ARM case=jt max_rel_err={worst:.2e}");
+}
+
+/// The torques `F · ∂p/∂θ` that render `f` at angles `t`: central differences of the
+/// twin's forward kinematics.
+fn virtual_work(twin: &ArmTwin, t: [f64; 3], f: [f64; 3]) -> [f64; 3] {
+    let h = 1e-6;
+    std::array::from_fn(|k| {
+        let (mut a, mut b) = (t, t);
+        a[k] += h;
+        b[k] -= h;
+        let (pa, pb) = (twin.fk(a), twin.fk(b));
+        (0..3).map(|n| f[n] * (pa[n] - pb[n])).sum::<f64>() / (2.0 * h)
+    })
+}
+
+/// Holds the fixed torques to the virtual work `fd` within 0.5 % of its largest and 4 of
+/// the torque's LSBs (1/256 N·mm: its products' truncations); the worst error relative
+/// to the largest.
+fn assert_torques(fixed: [f64; 3], fd: [f64; 3], at: &str) -> f64 {
+    let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut worst = 0.0f64;
+    for k in 0..3 {
+        let err = (fixed[k] - fd[k]).abs();
+        assert!(
+            err <= 0.005 * scale + 4.0 / 256.0,
+            "joint {k} at {at}: {} against {} N·mm",
+            fixed[k],
+            fd[k]
+        );
+        worst = worst.max(err / scale.max(1e-9));
+    }
+    worst
 }
 
 /// `drive` takes all of `Force`'s range (±2,048 N): at every corner of it, the torques
@@ -152,26 +163,8 @@ fn the_drive_takes_the_whole_force_range() {
                 .drive(&arm.pose(c), f)
                 .torque_q8
                 .map(|t| t as f64 / 256.0);
-            let h = 1e-6;
-            let fd: [f64; 3] = std::array::from_fn(|k| {
-                let (mut a, mut b) = (t, t);
-                a[k] += h;
-                b[k] -= h;
-                let (pa, pb) = (twin.fk(a), twin.fk(b));
-                (0..3)
-                    .map(|n| f[n].to_num::<f64>() * (pa[n] - pb[n]))
-                    .sum::<f64>()
-                    / (2.0 * h)
-            });
-            let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            for k in 0..3 {
-                assert!(
-                    (fixed[k] - fd[k]).abs() <= 0.005 * scale + 4.0 / 256.0,
-                    "joint {k} at {f:?}: {} against {} N·mm",
-                    fixed[k],
-                    fd[k]
-                );
-            }
+            let f = f.map(|x| x.to_num::<f64>());
+            assert_torques(fixed, virtual_work(&twin, t, f), &format!("{f:?}"));
         }
     }
 }

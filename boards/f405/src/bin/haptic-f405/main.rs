@@ -397,7 +397,7 @@ mod firmware {
                 substeps,
                 t.run.ticks,
                 worst,
-                168_000_000 / BOARD.tick_hz / 2
+                BOARD.tick_budget
             );
         }
         defmt::println!(
