@@ -239,6 +239,10 @@ fn symplectic_dynamics_track_the_twin() {
     let default = sd(1.0, 0.05, 0.005);
     dynamics::<Wide>("wide, symplectic", default);
     dynamics::<Narrow>("narrow, symplectic", default);
+    // The board's patch (`haptic_f405::BOARD`: N = 10, this option, 2 substeps).
+    let board = haptic_f405::BOARD.solver();
+    assert_eq!(board.integrator, Integrator::SymplecticDamped);
+    dynamics_at::<65, 366, Wide>("wide, symplectic, the board's", 10, board);
     for (c, m) in [(0.05, 0.005), (0.0, 0.005), (30.0, 0.1)] {
         dynamics::<Wide>(&format!("wide, symplectic, C = {c} N·s/m"), sd(c, 5.0, m));
         dynamics::<Narrow>(&format!("narrow, symplectic, C = {c} N·s/m"), sd(c, 5.0, m));
@@ -269,8 +273,14 @@ fn narrow_dynamics_with_little_no_or_most_spring_damping() {
 }
 
 fn dynamics<A: Arith>(name: &str, cfg: SolverConfig) {
-    let mut f = fixed::<10, 61, A>(5, 2.5, &cfg);
-    let mut t = twin(5, 2.5, &cfg, f.substeps());
+    dynamics_at::<10, 61, A>(name, 5, cfg);
+}
+
+/// The indentation path on the N = `n` patch (capacity `N`, `E`) against its twin: the
+/// force's RMS error within 0.2 % of its peak, the largest within 1 %.
+fn dynamics_at<const N: usize, const E: usize, A: Arith>(name: &str, n: usize, cfg: SolverConfig) {
+    let mut f = fixed::<N, E, A>(n, 2.5, &cfg);
+    let mut t = twin(n, 2.5, &cfg, f.substeps());
     let path = indentation_path(1000).unwrap();
     let (mut peak, mut sum_sq, mut max_err, mut count) = (0.0f64, 0.0, 0.0f64, 0.0);
     for tick in 0..2000 {
@@ -287,7 +297,7 @@ fn dynamics<A: Arith>(name: &str, cfg: SolverConfig) {
     }
     let rms = (sum_sq / count).sqrt();
     println!(
-        "{name}: indentation path, N=5: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
+        "{name}: indentation path, N={n}: peak {peak:.4} N, RMS error {:.2e}, max error {:.2e} of peak",
         rms / peak,
         max_err / peak
     );

@@ -1,6 +1,6 @@
-//! The board's black box ([`mccs_firmware::black_box`]): two boxes in the last 32 KiB
-//! of SRAM ([`BLACK_BOX_ADDR`]), which `memory/stm32f405.x` leaves out of the linker's
-//! RAM, so that no section covers them: neither the start-up code (which zeroes `.bss`
+//! The board's black box ([`mccs_firmware::black_box`]): two boxes outside the SRAM that
+//! `memory/stm32f405.x` gives the linker ([`BLACK_BOX_ADDR`]: the chip's CCM; in QEMU
+//! past its 128 KiB), so that no section covers them: neither the start-up code (which zeroes `.bss`
 //! and copies `.data`) nor a loader writes them, and a reset leaves them as the run
 //! before left them.
 //!
@@ -21,12 +21,32 @@ use mccs_link::black_box::{box_flags, BoxTick, StopCause};
 /// The board's box.
 pub type BoardBox = BlackBox<BLACK_BOX_TICKS>;
 
-/// Where the two boxes lie: the last 32 KiB of the STM32F405's 128 KiB SRAM (the live
-/// box, then the last run's); `memory/stm32f405.x` links RAM up to here. The statics
-/// (under 32 KiB) and the main loop's stack (some 43 KB at its deepest, a replay's or a
-/// tissue check's start) share the 96 KiB below; the test command's `link-qemu` stage
-/// holds 4 KiB of them free (docs/safety.md).
-pub const BLACK_BOX_ADDR: usize = 0x2001_8000;
+/// Where the two boxes lie (the live box, then the last run's): outside the 128 KiB of
+/// SRAM that `memory/stm32f405.x` links, so that no section covers them. On the chip
+/// they lie in its 64 KiB of core-coupled RAM ([`CCM_BOX_ADDR`], clocked from reset:
+/// RCC_AHB1ENR's reset value sets CCMDATARAMEN; only the core writes the boxes, and the
+/// CCM needs no more); in QEMU, which models no CCM, past the 128 KiB in the 192 KiB of
+/// SRAM its netduinoplus2 has ([`QEMU_BOX_ADDR`]). The statics (some 50 KB at N = 10)
+/// and the stack (some 73 KB at its deepest: the start-up's controller, a replay's or a
+/// tissue check's start) share the 128 KiB; the test command's `link-qemu` stage holds
+/// 4 KiB of them free (docs/safety.md).
+#[cfg(not(board_qemu))]
+pub const BLACK_BOX_ADDR: usize = CCM_BOX_ADDR;
+/// See the chip's.
+#[cfg(board_qemu)]
+pub const BLACK_BOX_ADDR: usize = QEMU_BOX_ADDR;
+/// The STM32F405's core-coupled RAM: 64 KiB at `0x1000_0000` (RM0090, "Memory map").
+pub const CCM_BOX_ADDR: usize = 0x1000_0000;
+/// In QEMU: the end of the chip's 128 KiB of SRAM, within the 192 KiB QEMU models.
+pub const QEMU_BOX_ADDR: usize = 0x2002_0000;
+const _: () = assert!(
+    CCM_BOX_ADDR + BLACK_BOX_BYTES <= 0x1001_0000,
+    "within the CCM"
+);
+const _: () = assert!(
+    QEMU_BOX_ADDR + BLACK_BOX_BYTES <= 0x2003_0000,
+    "within QEMU's SRAM"
+);
 /// Their room.
 pub const BLACK_BOX_BYTES: usize = 0x8000;
 const _: () = assert!(2 * core::mem::size_of::<BoardBox>() <= BLACK_BOX_BYTES);
@@ -89,7 +109,7 @@ fn boxes() -> (&'static mut BoardBox, &'static mut BoardBox) {
     // returns, so that the tick's is not used again (at worst it interrupts a record half
     // written: one tick's fields mixed). Every field is an integer: whatever bits a
     // power-on leaves are a box, which `kept` rejects unless marked.
-    // SAFETY: the boxes lie in SRAM no section covers (memory/stm32f405.x), aligned and
+    // SAFETY: the boxes lie in RAM no section covers (memory/stm32f405.x), aligned and
     // apart (the assertion above); their callers are the two above.
     unsafe {
         (
@@ -126,9 +146,10 @@ pub fn stop_in_handler(cause: StopCause, pc: u32) {
 mod tests {
     use super::*;
 
-    /// The memory map links RAM up to the boxes and no further, and the boxes end where
-    /// the STM32F405's 128 KiB of SRAM does: a map that covered them would let the
-    /// start-up code zero the last run's record.
+    /// The memory map links the chip's 128 KiB of SRAM and no further, and the boxes lie
+    /// outside it: in the CCM's 64 KiB on the chip, in QEMU's SRAM past the 128 KiB and
+    /// within its 192. A map that covered them would let the start-up code zero the last
+    /// run's record.
     #[test]
     fn the_memory_map_leaves_the_boxes_out_of_the_linked_ram() {
         let map = include_str!("../../../memory/stm32f405.x");
@@ -148,8 +169,16 @@ mod tests {
                 None => usize::from_str_radix(v.trim_start_matches("0x"), 16).unwrap(),
             }
         };
-        assert_eq!(field("ORIGIN") + field("LENGTH"), BLACK_BOX_ADDR, "{ram}");
-        assert_eq!(BLACK_BOX_ADDR + BLACK_BOX_BYTES, 0x2002_0000);
+        let (start, end) = (field("ORIGIN"), field("ORIGIN") + field("LENGTH"));
+        assert_eq!((start, end), (0x2000_0000, 0x2002_0000), "{ram}");
+        assert_eq!(
+            QEMU_BOX_ADDR, end,
+            "QEMU's boxes start where the linked RAM ends"
+        );
+        assert!(
+            CCM_BOX_ADDR + BLACK_BOX_BYTES <= start,
+            "the CCM lies below the SRAM"
+        );
     }
 
     #[test]

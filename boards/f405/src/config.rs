@@ -5,6 +5,7 @@
 //! parts' limits. The pin map is type-level (the HAL's pins are types): `src/pins.rs`,
 //! one table with this one in docs/firmware.md.
 
+use mccs::arith::Integrator;
 use mccs::{Coupling, SolverConfig};
 use mccs_firmware::drivers::as5047p::EncoderConfig;
 use mccs_firmware::drivers::pwm_motor::{MotorConfig, MotorConfigError};
@@ -60,8 +61,13 @@ pub struct BoardConfig {
     /// for a current-mode driver (duty ∝ current ∝ torque; a plain H-bridge's torque
     /// also falls with the motor's speed: docs/firmware.md, "The motor driver").
     pub force_at_full_duty: f64,
-    /// The patch: N × N surface nodes (the standard patch, 2.5 mm spacing): 3 … 8.
+    /// The patch: N × N surface nodes (the standard patch, 2.5 mm spacing): 3 …
+    /// [`MAX_GRID`] (10).
     pub grid: usize,
+    /// The integrator (`--integrator`): the symplectic option, whose 2 substeps a 1 kHz
+    /// tick at N = 10 takes where the paper's improved Euler takes 3 (docs/arm.md, "The
+    /// trainer tick").
+    pub integrator: Integrator,
     /// Haptic mass of each free node, g (> 0; `mccs patch`/`replay`'s `--node-mass`).
     pub node_mass_g: f64,
     /// Relative damping of each spring, N·s/m (`--spring-damping`).
@@ -105,23 +111,30 @@ pub struct BoardConfig {
     /// See `mu_s`.
     pub mu_k: f64,
     /// Instructions a tick may spend (half a tick at the core's clock: 84,000 at
-    /// 168 MHz), what it costs besides its substeps, and what a substep costs: the
-    /// bench's measured figures for this device's tick (a test holds them to
-    /// `bench/baseline.txt`). A tissue whose tick would pass the budget is refused.
+    /// 168 MHz), what it costs besides its substeps, and what a substep costs: measured
+    /// on the arm board's own run at N = 10 (docs/arm.md, "The trainer tick"), whose
+    /// worst tick the test command holds within `tick_base_cost + substeps ×
+    /// substep_cost`. A tissue whose tick would pass the budget is refused.
     pub tick_budget: u32,
     /// See `tick_budget`.
     pub tick_base_cost: u32,
     /// See `tick_budget`.
     pub substep_cost: u32,
     /// Steps of a tissue's stability check run between two polls of the link: at most
-    /// 5 ms of the M4F at 168 MHz at N = 8 (`link::device::a_slice_of_a_tissue_check_
+    /// 5 ms of the M4F at 168 MHz at N = 10 (`link::device::a_slice_of_a_tissue_check_
     /// holds_the_main_loop_under_5_ms` holds them to the bench's cost of a step).
     pub check_steps_per_poll: u32,
 }
 
+/// The largest patch the board's controller holds: N = 10 (the trainer's patch, issue 60:
+/// its tick fits half of a 1 kHz tick with the symplectic option's 2 substeps;
+/// docs/arm.md, "The trainer tick").
+pub const MAX_GRID: usize = 10;
+
 /// The STM32F405 board: 8 MHz crystal, 168 MHz, a 1 kHz tick, the AS5047P at 5.25 MHz,
 /// 20 kHz PWM, a 50 ms watchdog; a 75 mm lever on a 10:1 capstan, a 3 N motor, the
-/// force held to it; the N = 8 patch of the M4F demo, the solver's default coupling.
+/// force held to it; the N = 10 patch (the symplectic option's 2 substeps), the solver's
+/// default coupling.
 pub const BOARD: BoardConfig = BoardConfig {
     hse_hz: 8_000_000,
     sysclk_hz: 168_000_000,
@@ -136,7 +149,8 @@ pub const BOARD: BoardConfig = BoardConfig {
     diag_every: 100,
     max_bad_frames: 8,
     force_at_full_duty: 3.0,
-    grid: 8,
+    grid: 10,
+    integrator: Integrator::SymplecticDamped,
     node_mass_g: 5.0,
     spring_damping: 1.0,
     coupling_stiffness: 1.0,
@@ -154,9 +168,9 @@ pub const BOARD: BoardConfig = BoardConfig {
     mu_s: 0.6,
     mu_k: 0.4,
     tick_budget: 84_000,
-    tick_base_cost: 27_000,
-    substep_cost: 18_000,
-    check_steps_per_poll: 20,
+    tick_base_cost: 13_000,
+    substep_cost: 31_200,
+    check_steps_per_poll: 16,
 };
 
 /// A board constant out of its range: which one, in words.
@@ -181,7 +195,7 @@ pub enum BoardConfigError {
     Speed,
     /// The motor constant.
     Motor(MotorConfigError),
-    /// `grid` is not 3 … 8 (the controller's capacity), or the mass or damping is not
+    /// `grid` is not 3 … 10 (the controller's capacity), or the mass or damping is not
     /// a finite positive number.
     Patch,
     /// The coupling's stiffness, damping or force clamp is out of the solver's range.
@@ -217,7 +231,7 @@ impl BoardConfigError {
             }
             Self::Speed => "max_speed_mm_s: must be finite and positive",
             Self::Motor(_) => "force_at_full_duty: must be 0.001 … 1024 N",
-            Self::Patch => "grid 3 … 8, node_mass_g and spring_damping finite and positive",
+            Self::Patch => "grid 3 … 10, node_mass_g and spring_damping finite and positive",
             Self::Coupling => "coupling_stiffness > 0 and ≤ 1000 N/mm, coupling_damping 0 … 1000 N·s/m, max_force > 0 N",
             Self::ForceClamp => "max_force: must be at most force_at_full_duty (the motor saturates there)",
             Self::Baud => "baud: must be 9600 … 2625000 and within 1 % of what USART2 makes at APB1's clock",
@@ -366,7 +380,7 @@ impl BoardConfig {
         }
         MotorConfig::check(self.force_at_full_duty).map_err(E::Motor)?;
         let positive = |x: f64| x.is_finite() && x > 0.0;
-        if !(3..=8).contains(&self.grid)
+        if !(3..=MAX_GRID).contains(&self.grid)
             || !positive(self.node_mass_g)
             || !positive(self.spring_damping)
         {
@@ -507,6 +521,7 @@ impl BoardConfig {
                 damping: self.coupling_damping,
                 max_force: self.max_force,
             },
+            integrator: self.integrator,
             ..SolverConfig::default()
         }
     }

@@ -25,11 +25,10 @@ pub use crate::device_part::DevicePart;
 /// edge). The board's SPI1 is set to it.
 pub const SPI_MODE: Mode = MODE_1;
 
-/// The largest patch the board's controller holds: N = 8.
-pub const MAX_GRID: usize = 8;
-/// Node slots (the ground included) of the N = 8 patch.
+pub use crate::config::MAX_GRID;
+/// Node slots (the ground included) of the N = 10 patch.
 pub const NODES: usize = mccs::topology::standard_capacity(MAX_GRID).0;
-/// Springs of the N = 8 patch.
+/// Springs of the N = 10 patch.
 pub const EDGES: usize = mccs::topology::standard_capacity(MAX_GRID).1;
 pub use crate::config::SPACING_MM;
 

@@ -100,6 +100,46 @@ pub(super) struct Args {
     table: TableArgs,
 }
 
+/// Which of a spring's costlier paths a table has (the bench's `spring_path_*` cases):
+/// every table has its segments, its two lines and the held edge vector and `l0/l`; some
+/// have a graded corner (a stiff series spring's), some a lower corner (a steep kink's).
+struct TablePaths {
+    corner: bool,
+    lower_corner: bool,
+}
+
+impl TablePaths {
+    /// The most a spring of this table takes on any of its paths less the least, on
+    /// `core`: the bench's `spring_path_spread` where a path's figure is missing.
+    fn spread(&self, core: &str) -> u64 {
+        let mut paths = vec!["uniform", "below", "above", "stretched", "crushed"];
+        if self.corner {
+            paths.push("corner");
+        }
+        if self.lower_corner {
+            paths.push("lower_corner");
+        }
+        let costs: Option<Vec<u64>> = paths
+            .iter()
+            .map(|p| figure(core, &format!("spring_path_{p}"), "instructions"))
+            .collect();
+        match costs {
+            Some(c) => c.iter().max().unwrap_or(&0) - c.iter().min().unwrap_or(&0),
+            None => figure(core, "spring_path_spread", "instructions").unwrap_or(0),
+        }
+    }
+
+    /// What the message names: the corners it counts.
+    fn named(&self) -> &'static str {
+        match (self.corner, self.lower_corner) {
+            (false, false) => ", no corner",
+            (true, false) => ", its graded corner among them",
+            (false, true) => ", its lower corner among them",
+            (true, true) => ", both its corners among them",
+        }
+    }
+}
+
 /// One core's figures from the baseline, by case: `instructions`, or another field.
 fn figure(core: &str, case: &str, field: &str) -> Option<u64> {
     BASELINE.lines().find_map(|l| {
@@ -134,25 +174,32 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         ..a.tuning.config(rate)?
     };
     let p = paramfile::read(&a.params)?;
-    let substeps = with_knots!(a.table.knots(), |S| {
+    let (substeps, paths) = with_knots!(a.table.knots(), |S| {
         let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
-        match core {
+        let paths = TablePaths {
+            corner: t.corner().is_some(),
+            lower_corner: t.lower_corner(),
+        };
+        let substeps = match core {
             CoreArg::M0 => substeps_of(t, n, a.spacing, &cfg, mccs::Narrow)?,
             _ => substeps_of(t, n, a.spacing, &cfg, mccs::Wide)?,
-        }
+        };
+        (substeps, paths)
     });
     // The bench's bound over every state of the patch's substeps, as its
-    // `largest_patch_1khz` takes it: each spring at the spread of its paths more.
+    // `largest_patch_1khz` takes it: each spring at the spread of its paths more, over
+    // the paths this table has (a graded or a lower corner only where it has one).
     let springs = mccs::topology::standard_capacity(n).1 as u64;
-    let spread = figure(core.name(), "spring_path_spread", "instructions").unwrap_or(0);
+    let spread = paths.spread(core.name());
     let patch_tick = substeps as u64 * (substep + springs * spread);
     let budget = core.mhz() * 1_000_000 / (2 * rate as u64);
     let (tick, how) = device_share(core, a.device, patch_tick);
     let fits = tick <= budget;
 
     eprintln!(
-        "mccs check: tick_instructions estimated from the bench's measured costs on the {} (bench/baseline.txt): {substeps} substeps × ({substep} per substep + {springs} springs × {spread}, their spread over every state); {how}; budget: half a {} Hz tick at {} MHz, one instruction per cycle",
+        "mccs check: tick_instructions estimated from the bench's measured costs on the {} (bench/baseline.txt): {substeps} substeps × ({substep} per substep + {springs} springs × {spread}, their spread over every state of this table's paths{}); {how}; budget: half a {} Hz tick at {} MHz, one instruction per cycle",
         core.name(),
+        paths.named(),
         rate as u64,
         core.mhz()
     );

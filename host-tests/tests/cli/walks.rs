@@ -41,8 +41,15 @@ fn fitted(dir: &str) -> (PathBuf, PathBuf) {
 fn the_walk_from_a_fit_to_the_board() {
     let (_, toml) = fitted("board");
     let p = toml.to_str().unwrap();
-    let check = String::from_utf8(mccs_ok(&["check", "--params", p]).stdout).unwrap();
-    assert_eq!(field(&check, "fits"), "yes", "{check}");
+    // As the board runs it: its patch (N = 10) with the symplectic option.
+    let grid = haptic_f405::BOARD.grid.to_string();
+    let board = ["--grid", &grid, "--integrator", "symplectic-damped"];
+    let check = |params: &str| {
+        let args = [&["check", "--params", params][..], &board[..]].concat();
+        String::from_utf8(mccs_ok(&args).stdout).unwrap()
+    };
+    let fit = check(p);
+    assert_eq!(field(&fit, "fits"), "yes", "{fit}");
     let tissue = toml.with_file_name("tissue.rs");
     mccs_ok(&["table", "--params", p, "--out", tissue.to_str().unwrap()]);
     let text = std::fs::read_to_string(&tissue).unwrap();
@@ -54,13 +61,12 @@ fn the_walk_from_a_fit_to_the_board() {
         text.lines().next().unwrap_or("")
     );
     assert!(text.contains("mccs::ForceTable::<64>::from_raw("));
-    let table2 =
-        String::from_utf8(mccs_ok(&["check", "--params", "params/table2.toml"]).stdout).unwrap();
+    let table2 = check("params/table2.toml");
     println!(
         "WALK walk=board substeps={} tick_instructions={} budget={} table2_substeps={}",
-        field(&check, "substeps"),
-        field(&check, "tick_instructions"),
-        field(&check, "budget"),
+        field(&fit, "substeps"),
+        field(&fit, "tick_instructions"),
+        field(&fit, "budget"),
         field(&table2, "substeps"),
     );
 }

@@ -37,7 +37,10 @@ fn hello_status_arm_pose_and_load() {
     let t2 = hash_of("params/table2.toml");
     for field in [
         format!("protocol={} schema={:08x}", mccs_link::PROTOCOL, mccs_link::SCHEMA),
-        "device=arm simulated=1 core=m4f tick_hz=1000 contact=roaming grid=8 tissue=64x64".into(),
+        format!(
+            "device=arm simulated=1 core=m4f tick_hz=1000 contact=roaming grid={} tissue=64x64",
+            haptic_f405::BOARD.grid
+        ),
         format!("knots=65 tissue_hash={t2:08x} friction=0.6,0.4"),
         "force_clamp_n=3 workspace_mm=-50,-50,-40..50,50,40 pose_limits=200mm/s,180deg/s baud=1000000".into(),
     ] {
@@ -106,7 +109,8 @@ fn hello_status_arm_pose_and_load() {
     let text = std::fs::read_to_string(crate::cli::root().join("params/table2.toml")).unwrap();
     std::fs::write(
         &stiff,
-        text.replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e6"),
+        text.replace("shear_modulus = 1.8472e5", "shear_modulus = 1.8472e6")
+            .replace("shear_modulus = 4.9151e5", "shear_modulus = 4.9151e6"),
     )
     .unwrap();
     let out = mccs(&[
@@ -203,8 +207,8 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
     }
     for (extra, needle) in [
         (
-            &["--grid", "9"][..],
-            "--grid: the device holds a patch of at most 8 nodes a side",
+            &["--grid", "11"][..],
+            "--grid: the device holds a patch of at most 10 nodes a side",
         ),
         (
             &["--arith", "narrow", "--backend", "fixed"][..],
@@ -280,8 +284,10 @@ fn dev_hello() -> mccs_link::HelloInfo {
 #[test]
 fn mesh_streams_every_free_node_of_the_patch() {
     let dev = device("mesh");
-    let least = mccs_link::rates::mesh_least_every(1000, 1_000_000, 36) as u32;
-    let (meshes, _, _) = super::mesh_run(dev.addr(), "0.5", 8, least);
+    let grid = haptic_f405::BOARD.grid;
+    let free = (grid - 2).pow(2);
+    let least = mccs_link::rates::mesh_least_every(1000, 1_000_000, free) as u32;
+    let (meshes, _, _) = super::mesh_run(dev.addr(), "0.5", grid, least);
     assert!(meshes.len() >= 10, "{} meshes in 0.5 s", meshes.len());
     let bad = mccs(&["link", "--connect", dev.addr(), "mesh", "--every", "0"]);
     assert_eq!(bad.status.code(), Some(2));

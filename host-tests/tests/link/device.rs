@@ -208,7 +208,7 @@ fn hello_says_what_the_device_is_its_limits_and_its_rates() {
     );
     assert_eq!(
         h.mesh_least_every,
-        rates::mesh_least_every(1000, 1_000_000, 36)
+        rates::mesh_least_every(1000, 1_000_000, free_nodes())
     );
     assert_eq!(h.tick_budget, BOARD.tick_budget);
     let mut glued = Rig::glued(table2());
@@ -219,7 +219,8 @@ fn hello_says_what_the_device_is_its_limits_and_its_rates() {
         (h.device, h.contact),
         (DeviceKind::OneDof, ContactKind::Glued)
     );
-    assert_eq!((h.tissue_w, h.tissue_h), (8, 8), "glued: the patch alone");
+    let n = BOARD.grid as u8;
+    assert_eq!((h.tissue_w, h.tissue_h), (n, n), "glued: the patch alone");
 }
 
 #[test]
@@ -283,8 +284,9 @@ fn a_tissue_is_checked_in_slices_and_acknowledged_once_the_tick_runs_it() {
             tissue: stiffer.hash()
         }
     );
-    // Ten runs of 1,536 steps, a slice of check_steps_per_poll a poll; a status each.
-    let slices = (10 * 1536u32).div_ceil(BOARD.check_steps_per_poll);
+    // The search's runs of 1,536 steps (12 for the board's symplectic option), a slice of
+    // check_steps_per_poll a poll; a status each.
+    let slices = mccs::solver::stability::MAX_CHECK_STEPS.div_ceil(BOARD.check_steps_per_poll);
     assert!(
         polls as u32 >= slices / 2 && polls as u32 <= slices + 10,
         "{polls} polls, {slices} slices"
@@ -361,9 +363,10 @@ fn the_device_refuses_what_it_cannot_run_with_its_reason() {
         load(&mut rig, &over, 0, over.hash()),
         ToHost::Nak(NakReason::Bound)
     );
-    // A spring ten times stiffer: its tick would pass the budget, with the figures.
+    // A tissue ten times stiffer: its tick would pass the budget, with the figures.
     let mut stiff = Params::TABLE2;
     stiff.cone.shear_modulus *= 10.0;
+    stiff.linear.shear_modulus *= 10.0;
     let stiff = Tissue::from_params(&stiff).unwrap();
     match load(&mut rig, &stiff, 0, stiff.hash()) {
         ToHost::Nak(NakReason::Budget {
@@ -612,7 +615,7 @@ fn telemetry_is_held_to_the_byte_budget_and_its_gaps_are_the_drops() {
 fn the_mesh_has_every_free_node_in_its_grid_place_within_the_byte_budget() {
     let mut rig = Rig::roaming(table2());
     rig.send(&ToDevice::WatchMesh { every: 1 });
-    let least = rates::mesh_least_every(1000, BOARD.baud, 36) as u32;
+    let least = rates::mesh_least_every(1000, BOARD.baud, free_nodes()) as u32;
     for _ in 0..300 {
         rig.step();
     }
@@ -636,15 +639,20 @@ fn the_mesh_has_every_free_node_in_its_grid_place_within_the_byte_budget() {
         "{} meshes",
         starts.len()
     );
-    // Each mesh: 36 free nodes in parts of 12, each node in its place of the 8 × 8 grid
-    // at its rest position (the probe is above the tissue) plus the window's origin.
-    let topo = mccs::Topology::<NODES, EDGES>::standard_patch(8, 2.5).unwrap();
+    // Each mesh: the free nodes in parts of 12, each node in its place of the board's
+    // N × N grid at its rest position (the probe is above the tissue) plus the window's
+    // origin.
+    let (free, inner) = (free_nodes(), BOARD.grid - 2);
+    let topo = mccs::Topology::<NODES, EDGES>::standard_patch(BOARD.grid, 2.5).unwrap();
     for p in parts.iter().filter(|p| p.seq == starts[1].seq) {
-        assert_eq!(p.nodes, 36);
-        for k in 0..MESH_PART.min(36 - p.first as usize) {
+        assert_eq!(p.nodes as usize, free);
+        for k in 0..MESH_PART.min(free - p.first as usize) {
             let node = p.first as usize + k;
             let [i, j] = p.grid[k];
-            assert_eq!((i as usize, j as usize), (1 + node / 6, 1 + node % 6));
+            assert_eq!(
+                (i as usize, j as usize),
+                (1 + node / inner, 1 + node % inner)
+            );
             let rest = topo.rest_q24(node + 1).unwrap();
             for c in 0..3 {
                 assert!((p.positions[k][c] - rest[c]).abs() < 1 << 12, "node {node}");
@@ -666,6 +674,11 @@ fn the_mesh_has_every_free_node_in_its_grid_place_within_the_byte_budget() {
         encode(&worst, &mut buf).unwrap().len() as u32,
         rates::MESH_PART_FRAME_MAX
     );
+}
+
+/// The board's patch's free nodes, `(N − 2)²`: what its mesh streams.
+fn free_nodes() -> usize {
+    (BOARD.grid - 2).pow(2)
 }
 
 #[test]
@@ -857,11 +870,11 @@ fn a_replay_beyond_the_device_is_refused_naming_the_option() {
     let cases = [
         (
             ReplaySpec {
-                grid: 9,
+                grid: haptic_f405::device::MAX_GRID as u8 + 1,
                 ..spec(10, [0.0; 3], None)
             },
             SpecOption::Grid,
-            8,
+            haptic_f405::device::MAX_GRID as i32,
         ),
         (
             ReplaySpec {
@@ -974,7 +987,12 @@ fn a_slice_of_a_tissue_check_holds_the_main_loop_under_5_ms() {
         .trim()
         .parse()
         .unwrap();
-    let slice_ms = ms / (2.0 * 1536.0) * BOARD.check_steps_per_poll as f64;
+    // A step's cost is a sum over the springs and the free nodes: from N = 8's (214
+    // springs, 36 free nodes) to the board's it grows by at most the larger ratio.
+    let inner = (BOARD.grid - 2) as f64;
+    let springs = mccs::topology::standard_capacity(BOARD.grid).1 as f64;
+    let growth = (springs / 214.0).max(inner * inner / 36.0);
+    let slice_ms = ms / (2.0 * 1536.0) * growth * BOARD.check_steps_per_poll as f64;
     println!(
         "LINK check_slice ms_at_clock={slice_ms:.2} steps={}",
         BOARD.check_steps_per_poll

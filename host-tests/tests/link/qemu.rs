@@ -268,6 +268,7 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
     step(s, "a tissue over the tick budget refused", || {
         let mut stiff = mccs::Params::TABLE2;
         stiff.cone.shear_modulus *= 10.0;
+        stiff.linear.shear_modulus *= 10.0;
         let e = device
             .load_tissue(&Tissue::from_params(&stiff).unwrap())
             .unwrap_err();
@@ -401,8 +402,10 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
         let end = Instant::now() + Duration::from_secs(2);
         while Instant::now() < end {
             if let Some(m) = device.mesh().filter(|m| seqs.last() != Some(&m.seq)) {
-                assert_eq!(m.nodes.len(), 36);
-                assert_eq!(m.triangles().len(), 2 * 5 * 5);
+                // The board's N × N patch: (N − 2)² free nodes, 2 (N − 3)² triangles.
+                let inner = haptic_f405::BOARD.grid - 2;
+                assert_eq!(m.nodes.len(), inner * inner);
+                assert_eq!(m.triangles().len(), 2 * (inner - 1) * (inner - 1));
                 seqs.push(m.seq);
             }
             std::thread::sleep(Duration::from_millis(2));
@@ -542,7 +545,10 @@ fn worst_tick(name: &str) {
         .max()
         .expect("the board logs its worst tick once a second");
     let instructions = cycles * 1_000_000_000 / (168_000_000 * 8);
-    println!("LINK case=trainer_tick n=8 worst_instructions={instructions} budget=84000");
+    println!(
+        "LINK case=trainer_tick n={} worst_instructions={instructions} budget=84000",
+        haptic_f405::BOARD.grid
+    );
     assert!(
         instructions <= 84_000,
         "the worst tick took {instructions} instructions"

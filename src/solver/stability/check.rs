@@ -1,7 +1,8 @@
 //! [`StabilityCheck`]: the estimated bound of [`super::bounds`] run in pieces, so that a
 //! device can check a new tissue between other work (its link, its replays) without
 //! holding its main loop for the whole estimate; and the check of a proposed substep
-//! count, which takes two runs of the linearised step instead of the search's ten.
+//! count, which takes two runs of the linearised step instead of the search's ten (twelve
+//! for the symplectic option).
 //!
 //! Searching, it makes the same decisions on the same runs as [`super::bounds`] and
 //! ends with the same substeps (tested). Verifying `n` substeps (a host's, computed by
@@ -19,8 +20,10 @@ use crate::solver::{SolverConfig, SolverError};
 use crate::table::ForceTable;
 use crate::topology::Topology;
 
-/// Steps of the linearised patch a whole check runs at most: the search's ten runs.
-pub const MAX_CHECK_STEPS: u32 = 10 * STEPS_PER_RUN;
+/// Steps of the linearised patch a whole check runs at most: the search's runs (its top,
+/// its bottom, its bisections — 7 for the paper's integrator, 9 for the symplectic
+/// option — and the trust test: 10 or 12).
+pub const MAX_CHECK_STEPS: u32 = 12 * STEPS_PER_RUN;
 
 /// What the check runs next.
 #[derive(Clone, Copy, Debug, PartialEq)]

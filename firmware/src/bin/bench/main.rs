@@ -124,7 +124,8 @@ mod firmware {
 
         /// One substep of each patch, each integrator (the symplectic option's names end
         /// in `_symplectic`), and one spring where the solver runs it, per spring. Not
-        /// on the M0 above N = 5: its 16 KiB hold neither these patches nor their figures.
+        /// on the M0 above N = 5: its 16 KiB hold neither these patches nor their figures;
+        /// N = 9 and 10 (the board's) on the M4F alone, whose flash holds their cases.
         fn substeps(&mut self) {
             let (h, table, empty) = (&self.h, self.table, self.empty);
             let sub = |n, i| match n {
@@ -133,9 +134,17 @@ mod firmware {
                 5 => cases::substep::<10, 61>(h, 5, table, PROBE, i),
                 6 => cases::substep::<17, 102>(h, 6, table, PROBE, i),
                 7 => cases::substep::<26, 153>(h, 7, table, PROBE, i),
+                // (Guarded by the core, a constant, so that the M3's flash is not given
+                // cases it never runs.)
+                9 if CORE == Core::M4F => cases::substep::<50, 285>(h, 9, table, PROBE, i),
+                10 if CORE == Core::M4F => cases::substep::<65, 366>(h, 10, table, PROBE, i),
                 _ => cases::substep::<37, 214>(h, 8, table, PROBE, i),
             };
-            let largest = if CORE == Core::M0 { 5 } else { 8 };
+            let largest = match CORE {
+                Core::M0 => 5,
+                Core::M3 => 8,
+                Core::M4F => 10,
+            };
             for integrator in [Integrator::ImprovedEuler, Integrator::SymplecticDamped] {
                 for n in 3..=largest {
                     let name = substep_case(n, integrator).unwrap_or("substep");

@@ -41,25 +41,29 @@ impl Figures {
     }
 }
 
-const SUBSTEP: [&str; 6] = [
+const SUBSTEP: [&str; 8] = [
     "substep_n3",
     "substep_n4",
     "substep_n5",
     "substep_n6",
     "substep_n7",
     "substep_n8",
+    "substep_n9",
+    "substep_n10",
 ];
 
-const SUBSTEP_SYMPLECTIC: [&str; 6] = [
+const SUBSTEP_SYMPLECTIC: [&str; 8] = [
     "substep_n3_symplectic",
     "substep_n4_symplectic",
     "substep_n5_symplectic",
     "substep_n6_symplectic",
     "substep_n7_symplectic",
     "substep_n8_symplectic",
+    "substep_n9_symplectic",
+    "substep_n10_symplectic",
 ];
 
-/// The case name of one substep of the N × N patch (N = 3 … 8) with `integrator`.
+/// The case name of one substep of the N × N patch (N = 3 … 10) with `integrator`.
 pub fn substep_case(n: u32, integrator: Integrator) -> Option<&'static str> {
     let names = match integrator {
         Integrator::ImprovedEuler => &SUBSTEP,
@@ -129,7 +133,7 @@ fn largest(
     tick_hz: u32,
     half_tick: u32,
 ) -> Option<(u32, u32, u32, u32)> {
-    (3..=8u32)
+    (3..=10u32)
         .filter_map(|n| {
             let (substeps, tick, worst) = tick_of(figs, steps, n, tick_hz)?;
             (worst <= half_tick).then_some((n, substeps, tick, worst))
@@ -211,12 +215,17 @@ fn next_patch(figs: &Figures, steps: &Steps, n: u32, half_tick: u32) {
     );
 }
 
+/// Patches [`Steps`] holds, N = 3 onward: up to N = 10 on the M4F, 8 elsewhere (the M0's
+/// bench has no room on its stack for two more: 32 bytes more in `main`'s frame ran its
+/// `f64` substep into a lockup).
+const STEP_SLOTS: usize = if matches!(CORE, Core::M4F) { 8 } else { 6 };
+
 /// The substep (s) the default configuration's stability bound takes on the standard
-/// N × N patch, for N = 3 … 8 (`None` where the core cannot hold the patch): computed
+/// N × N patch, for N = 3 … 10 (`None` where the core cannot hold the patch): computed
 /// once, since it does not depend on the tick rate (the estimate is the start-up's
 /// longest job).
 pub struct Steps {
-    steps: [Option<f64>; 6],
+    steps: [Option<f64>; STEP_SLOTS],
     integrator: Integrator,
 }
 
@@ -262,6 +271,9 @@ fn chosen_step(n: u32, table: &ForceTable64, cfg: &SolverConfig) -> Option<f64> 
         6 if CORE != Core::M0 => of::<17, 102>(n, table, cfg),
         7 if CORE != Core::M0 => of::<26, 153>(n, table, cfg),
         8 if CORE != Core::M0 => of::<37, 214>(n, table, cfg),
+        // The M4F's alone: the board's patch (N = 10) and the one between.
+        9 if CORE == Core::M4F => of::<50, 285>(n, table, cfg),
+        10 if CORE == Core::M4F => of::<65, 366>(n, table, cfg),
         _ => None,
     }
 }

@@ -389,14 +389,17 @@ mod firmware {
         // The simulated arm's run is the trainer's whole tick (issue 60): the counts, the
         // arm's chain, the roaming patch with friction, Jᵀ F and gravity, the duties and
         // the link's share, at its worst over a palpation; held to half a tick at 168 MHz
-        // by the test command (bench/budgets.txt).
+        // by the test command (bench/budgets.txt), and to what the board's budget model
+        // says it costs (`tick_base_cost + substeps × substep_cost`, which a tissue's
+        // check is held to).
         if Variant::SIMULATED && matches!(Variant::KIND, mccs_link::DeviceKind::Arm) {
             defmt::println!(
-                "BENCH core=m4f case=trainer_tick n={=usize} substeps={=u32} ticks={=u32} worst_instructions={=u32} half_tick_instructions={=u32}",
+                "BENCH core=m4f case=trainer_tick n={=usize} substeps={=u32} ticks={=u32} worst_instructions={=u32} model_instructions={=u32} half_tick_instructions={=u32}",
                 BOARD.grid,
                 substeps,
                 t.run.ticks,
                 worst,
+                BOARD.budget().cost(substeps),
                 BOARD.tick_budget
             );
         }
