@@ -67,6 +67,7 @@ impl StartError<ArmFault> {
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
             Self::Coupling(c) => StartFault::Coupling(*c),
+            Self::Budget(b) => StartFault::Budget(*b),
         }
     }
 }

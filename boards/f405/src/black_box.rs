@@ -1,8 +1,8 @@
 //! The board's black box ([`mccs_firmware::black_box`]): two boxes outside the SRAM that
 //! `memory/stm32f405.x` gives the linker ([`BLACK_BOX_ADDR`]: the chip's CCM; in QEMU
-//! past its 128 KiB), so that no section covers them: neither the start-up code (which zeroes `.bss`
-//! and copies `.data`) nor a loader writes them, and a reset leaves them as the run
-//! before left them.
+//! past its 128 KiB), so that no section covers them: neither the start-up code (which
+//! zeroes `.bss` and copies `.data`) nor a loader writes them, and a reset leaves them as
+//! the run before left them.
 //!
 //! - At boot ([`take_at_boot`]): the live box kept as the last run's with the reset's
 //!   cause (RCC_CSR, which the board's `main` reads and clears), the live box started

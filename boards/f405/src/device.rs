@@ -112,6 +112,20 @@ pub enum StartError<E> {
     Contact(ProxyError),
     /// The coupling over half the arm's stable region at its damping.
     Coupling(UnstableCoupling),
+    /// The tissue's tick would pass the board's budget ([`BoardConfig::budget`]).
+    Budget(OverBudget),
+}
+
+/// A tissue whose tick would pass the board's instruction budget: its substeps, what
+/// they would cost (`tick_base_cost + substeps × substep_cost`) and the budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OverBudget {
+    /// Substeps per tick the stability bound asks for.
+    pub substeps: u32,
+    /// Instructions the tick would take.
+    pub instructions: u32,
+    /// Instructions it may take.
+    pub budget: u32,
 }
 
 impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
@@ -126,6 +140,7 @@ impl<S, P, D, E> StartError<OneDofError<S, P, D, E>> {
             Self::Solver(e) => StartFault::Solver(*e),
             Self::Contact(e) => StartFault::Contact(*e),
             Self::Coupling(c) => StartFault::Coupling(*c),
+            Self::Budget(b) => StartFault::Budget(*b),
         }
     }
 }
@@ -198,6 +213,8 @@ pub enum StartFault {
     Contact(ProxyError),
     /// The coupling over half the arm's stable region at its damping.
     Coupling(UnstableCoupling),
+    /// The tissue's tick would pass the board's budget.
+    Budget(OverBudget),
 }
 
 impl core::fmt::Display for StartFault {
@@ -213,6 +230,11 @@ impl core::fmt::Display for StartFault {
             Self::Solver(e) => write!(f, "solver: {e}"),
             Self::Contact(e) => write!(f, "{e}"),
             Self::Coupling(c) => write!(f, "{c}"),
+            Self::Budget(b) => write!(
+                f,
+                "budget: the tissue needs {} substeps per tick, {} instructions, over the board's {} (tick_base_cost + substeps × substep_cost; docs/arm.md)",
+                b.substeps, b.instructions, b.budget
+            ),
         }
     }
 }
@@ -249,6 +271,13 @@ impl defmt::Format for StartFault {
                     c.damping_mn_s_m
                 ),
             },
+            Self::Budget(b) => defmt::write!(
+                f,
+                "budget: the tissue needs {=u32} substeps per tick, {=u32} instructions, over the board's {=u32} (tick_base_cost + substeps × substep_cost; docs/arm.md)",
+                b.substeps,
+                b.instructions,
+                b.budget
+            ),
         }
     }
 }
@@ -316,13 +345,23 @@ where
     })
 }
 
-/// The board's solver on `config` and `table`.
+/// The board's solver on `config` and `table`, its substeps within the tick's budget.
 fn solver<const S: usize>(
     config: &BoardConfig,
     table: ForceTable<S>,
 ) -> Result<Solver<NODES, EDGES, S, Wide>, StartError<core::convert::Infallible>> {
     let topo = Topology::standard_patch(config.grid, SPACING_MM).map_err(StartError::Topology)?;
-    Solver::new(topo, table, &config.solver()).map_err(StartError::Solver)
+    let solver = Solver::new(topo, table, &config.solver()).map_err(StartError::Solver)?;
+    // Within the tick's budget, as a tissue over the link is held to it (`Budget`).
+    let (budget, substeps) = (config.budget(), solver.substeps());
+    if substeps > budget.most_substeps() {
+        return Err(StartError::Budget(OverBudget {
+            substeps,
+            instructions: budget.cost(substeps),
+            budget: budget.tick,
+        }));
+    }
+    Ok(solver)
 }
 
 /// A start-up error of no device's (the patch, the solver, the contact) as one of `E`.
@@ -334,6 +373,7 @@ fn widen<E>(e: StartError<core::convert::Infallible>) -> StartError<E> {
         StartError::Solver(s) => StartError::Solver(s),
         StartError::Contact(c) => StartError::Contact(c),
         StartError::Coupling(c) => StartError::Coupling(c),
+        StartError::Budget(b) => StartError::Budget(b),
         StartError::SafeState(never) => match never {},
     }
 }

@@ -501,14 +501,17 @@ fn a_start_up_failure_says_what_failed_with_its_values() {
     stiff.linear.shear_modulus *= 40.0;
     let table = ForceTable64::new(&stiff).unwrap();
     let log = Log::default();
-    let dev = device::device(
-        &BOARD,
-        Sensor::new(|_| 0),
-        Pwm(log.clone()),
-        Pin(log.clone(), "dir"),
-        Pin(log.clone(), "enable"),
-    )
-    .unwrap();
+    let new_device = || {
+        device::device(
+            &BOARD,
+            Sensor::new(|_| 0),
+            Pwm(log.clone()),
+            Pin(log.clone(), "dir"),
+            Pin(log.clone(), "enable"),
+        )
+        .unwrap()
+    };
+    let dev = new_device();
     let mut slot: Option<BoardController<_>> = None;
     // The paper's integrator, whose bound this tissue puts past `max_substeps` (64).
     let config = BoardConfig {
@@ -528,6 +531,26 @@ fn a_start_up_failure_says_what_failed_with_its_values() {
             "solver: max_substeps: stability needs {needed} substeps per tick"
         )),
         "{line}"
+    );
+    assert!(slot.is_none());
+    // With the board's own integrator it stays within `max_substeps` but not within the
+    // tick's budget: refused with its figures, as a tissue over the link is.
+    let Err((e, _)) = device::controller_into(&BOARD, table, new_device(), &mut slot) else {
+        panic!("a tissue 40 times Table 2's started within the budget")
+    };
+    let device::StartFault::Budget(b) = e.fault() else {
+        panic!("{:?}", e.fault())
+    };
+    assert!(b.substeps > BOARD.budget().most_substeps(), "{b:?}");
+    assert_eq!(b.instructions, BOARD.budget().cost(b.substeps));
+    assert_eq!(b.budget, BOARD.tick_budget);
+    assert!(
+        e.fault().to_string().starts_with(&format!(
+            "budget: the tissue needs {} substeps per tick, {} instructions, over the board's 84000",
+            b.substeps, b.instructions
+        )),
+        "{}",
+        e.fault()
     );
     assert!(slot.is_none());
     use mccs_firmware::drivers::pwm_motor::MotorError;

@@ -134,7 +134,12 @@ fn stability(
             "must be 1 to 16 dampings, rising, each 0 … 1000 N·s/m",
         ));
     }
-    let config = haptic_f405::BOARD;
+    // The arm's stability, not the tick's: any substeps the bound asks for (the board
+    // also refuses a coupling whose substeps pass its tick's budget, at start-up).
+    let config = haptic_f405::BoardConfig {
+        tick_budget: u32::MAX,
+        ..haptic_f405::BOARD
+    };
     let mut points = Vec::new();
     for &b in dampings {
         eprintln!(
