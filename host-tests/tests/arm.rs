@@ -16,6 +16,16 @@ fn woodenhaptics() -> ArmSpec {
         .unwrap()
 }
 
+/// The shipped arm with no gravity term (so that its torques are `Jᵀ F` alone), its
+/// fixed-point chain and its `f64` twin.
+fn without_gravity() -> (ArmSpec, Arm, ArmTwin) {
+    let spec = ArmSpec {
+        gravity: None,
+        ..woodenhaptics()
+    };
+    (spec, Arm::new(&spec).unwrap(), ArmTwin { spec })
+}
+
 /// Random counts within the joints' ranges.
 fn counts_in(spec: &ArmSpec, twin: &ArmTwin, rng: &mut ChaCha8Rng) -> [i32; 3] {
     let angles: [f64; 3] = std::array::from_fn(|k| {
@@ -83,12 +93,7 @@ fn the_fixed_forward_kinematics_is_the_twins_within_10_um() {
 
 #[test]
 fn torques_are_the_virtual_work_of_the_forward_kinematics() {
-    let spec = ArmSpec {
-        gravity: None,
-        ..woodenhaptics()
-    };
-    let arm = Arm::new(&spec).unwrap();
-    let twin = ArmTwin { spec };
+    let (spec, arm, twin) = without_gravity();
     let mut rng = ChaCha8Rng::seed_from_u64(54);
     let mut worst = 0.0f64;
     for _ in 0..20_000 {
@@ -141,12 +146,7 @@ fn assert_torques(fixed: [f64; 3], fd: [f64; 3], at: &str) -> f64 {
 /// ±1,024 N until its sums were taken in Q18 N, 2026-11-30).
 #[test]
 fn the_drive_takes_the_whole_force_range() {
-    let spec = ArmSpec {
-        gravity: None,
-        ..woodenhaptics()
-    };
-    let arm = Arm::new(&spec).unwrap();
-    let twin = ArmTwin { spec };
+    let (spec, arm, twin) = without_gravity();
     let mut rng = ChaCha8Rng::seed_from_u64(59);
     for _ in 0..2_000 {
         let c = counts_in(&spec, &twin, &mut rng);
@@ -224,12 +224,7 @@ fn counts_survive_the_fixed_forward_and_the_f64_inverse_kinematics() {
 
 #[test]
 fn saturated_duties_keep_the_force_s_direction() {
-    let spec = ArmSpec {
-        gravity: None,
-        ..woodenhaptics()
-    };
-    let arm = Arm::new(&spec).unwrap();
-    let twin = ArmTwin { spec };
+    let (spec, arm, twin) = without_gravity();
     let mut rng = ChaCha8Rng::seed_from_u64(57);
     let mut worst_deg = 0.0f64;
     let mut scaled = 0;

@@ -354,10 +354,10 @@ fn solver<const S: usize>(
     let solver = Solver::new(topo, table, &config.solver()).map_err(StartError::Solver)?;
     // Within the tick's budget, as a tissue over the link is held to it (`Budget`).
     let (budget, substeps) = (config.budget(), solver.substeps());
-    if substeps > budget.most_substeps() {
+    if let Some(instructions) = budget.over(substeps) {
         return Err(StartError::Budget(OverBudget {
             substeps,
-            instructions: budget.cost(substeps),
+            instructions,
             budget: budget.tick,
         }));
     }

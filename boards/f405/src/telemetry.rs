@@ -127,10 +127,10 @@ impl QemuMismatch {
 }
 
 /// Holds a QEMU run to its length, `ticks` (the variant's: `BoardConfig::qemu_ticks`, or
-/// the simulated arm's palpation), and to the fault rules: the safe state entered through a failed read on
-/// `fault_tick` (the 1-DOF board: its SPI reads zeros, [`zeros_fault_tick`]) or never
-/// (`None`: the arm, whose counters read and whose home input stays low), and no duty on
-/// an arm that was never homed.
+/// the simulated arm's palpation), and to the fault rules: the safe state entered through
+/// a failed read on `fault_tick` (the 1-DOF board: its SPI reads zeros,
+/// [`zeros_fault_tick`]) or never (`None`: the arm, whose counters read and whose home
+/// input stays low), and no duty on an arm that was never homed.
 pub fn qemu_verdict(
     ticks: u32,
     t: &BoardTelemetry,

@@ -27,6 +27,18 @@ impl TickBudget {
             .saturating_add(self.per_substep.saturating_mul(substeps))
     }
 
+    /// What a tick of `substeps` would take where that passes the budget: the one rule
+    /// a tissue is refused by, over the link (`NakReason::Budget`) and at a board's
+    /// start-up.
+    pub const fn over(&self, substeps: u32) -> Option<u32> {
+        let cost = self.cost(substeps);
+        if cost > self.tick {
+            Some(cost)
+        } else {
+            None
+        }
+    }
+
     /// The most substeps within the budget.
     pub const fn most_substeps(&self) -> u32 {
         match self
@@ -113,8 +125,7 @@ impl<const N: usize, const E: usize, const S: usize> TissueCheck<N, E, S> {
         outcome: Result<u32, SolverError>,
     ) -> Result<CheckedTissue<S, A>, NakReason> {
         let substeps = outcome.map_err(|e| nak(e, self.budget))?;
-        let cost = self.budget.cost(substeps);
-        if cost > self.budget.tick {
+        if let Some(cost) = self.budget.over(substeps) {
             return Err(NakReason::Budget {
                 substeps: substeps.min(u16::MAX as u32) as u16,
                 instructions: cost,
