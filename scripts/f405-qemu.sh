@@ -19,12 +19,13 @@ case "${1:-}" in
   --arm-sim) features=arm,sim,qemu ;;
   *) echo "usage: scripts/f405-qemu.sh [--arm | --arm-sim] (not '$1')" >&2; exit 2 ;;
 esac
-source scripts/lib.sh  # build_decoder, $DECODER
+source scripts/lib.sh  # build_decoder, $DECODER, board_build, board_elf, qemu_runner
 echo "f405-qemu: building the board firmware (--features $features) and the log decoder" >&2
 build_decoder --quiet
-cargo build --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 --features "$features"
-elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405
+board_build "$features" --quiet
+elf=$(board_elf "$features")
+runner=$(qemu_runner thumbv7em-none-eabihf)
 echo "f405-qemu: running it in QEMU (netduinoplus2, a second of ticks; the simulated arm 5.5 s)" >&2
-timeout --foreground 300 cargo run --quiet --release -p haptic-f405 --target thumbv7em-none-eabihf \
-    --bin haptic-f405 --features "$features" < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
+# shellcheck disable=SC2086  # the runner is a command line, split into its words
+timeout --foreground 300 $runner "$elf" < /dev/null 2> >(grep -v "Timer with period zero" >&2) \
   | "$DECODER" "$elf"

@@ -13,7 +13,19 @@
 #                               profile, `tool`: unoptimised, it builds in half the time),
 #                               linted as it builds (clippy's driver as the workspace's
 #                               rustc wrapper, warnings denied): the test command's
-#                               clippy-host stage leaves it out.
+#                               clippy-host stage leaves it out. Nothing when
+#                               DECODER_BUILT=1 (the test command, once it built it: a
+#                               build relinks the file, which a run beside it may be
+#                               starting).
+#   run_lanes LANE...           runs each LANE, a function that runs its stages one after
+#                               another with run_stage, side by side; their rows join
+#                               STAGES in the order of the lanes.
+#   board_build FEATURES [ARGS] builds the board firmware (boards/f405) with FEATURES
+#                               ("" for none) and copies it to `board_elf FEATURES`.
+#   board_elf FEATURES          that copy's path: one per feature set, as cargo writes
+#                               every variant to one path (see board_build).
+#   qemu_runner TARGET          the QEMU command line of TARGET's runner in
+#                               .cargo/config.toml, without the ELF.
 
 LOG_DIR=${LOG_DIR:-target/logs}
 mkdir -p "$LOG_DIR"
@@ -23,6 +35,7 @@ STAGES=()
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 DECODER=$TARGET_DIR/tool/defmt-log
 build_decoder() {
+  [ "${DECODER_BUILT:-}" = 1 ] && [ -x "$DECODER" ] && return 0
   RUSTFLAGS=-Dwarnings RUSTC_WORKSPACE_WRAPPER="$(rustup which clippy-driver)" \
     cargo build -p defmt-log --profile tool "$@"
 }
@@ -86,4 +99,60 @@ core_target() {
     m0) echo thumbv6m-none-eabi ;;
     *) say "core must be m4f, m3 or m0, not '$1'"; return 2 ;;
   esac
+}
+
+# Stages side by side: each lane in a subshell, which writes its rows to a file as it
+# ends; a lane that ends without it (killed, or its shell failed) is a failed row.
+run_lanes() {
+  local lane pids=()
+  for lane in "$@"; do
+    rm -f "$LOG_DIR/.lane.$lane"
+    (
+      STAGES=()
+      "$lane"
+      printf '%s\n' "${STAGES[@]}" > "$LOG_DIR/.lane.$lane.tmp" \
+        && mv "$LOG_DIR/.lane.$lane.tmp" "$LOG_DIR/.lane.$lane"
+    ) &
+    pids+=("$!")
+  done
+  wait "${pids[@]}"
+  for lane in "$@"; do
+    if [ -s "$LOG_DIR/.lane.$lane" ]; then
+      mapfile -t -O "${#STAGES[@]}" STAGES < "$LOG_DIR/.lane.$lane"
+    else
+      say "FAIL lane $lane: it ended without its stages' results"
+      STAGES+=("FAIL|lane-$lane|0|0")
+    fi
+    rm -f "$LOG_DIR/.lane.$lane"
+  done
+}
+
+# The board firmware's variants. Cargo writes each to one path
+# (…/release/haptic-f405), and a build that has nothing to do writes it again; so each
+# is copied to its own path, the build and the copy under one lock, and a script reads
+# its copy: scripts that run side by side (the test command's lanes) then each run the
+# variant they built. (`haptic-f405-default` without features.)
+board_elf() {
+  local features=${1:-default}
+  echo "$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405-${features//,/-}"
+}
+
+board_build() {
+  local features=$1 elf
+  shift
+  elf=$(board_elf "$features")
+  (
+    flock 9
+    cargo build --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 \
+      --features "$features" "$@" \
+      && cp "$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405" "$elf.tmp" \
+      && mv "$elf.tmp" "$elf"
+  ) 9> "$TARGET_DIR/.board-build.lock"
+}
+
+qemu_runner() {
+  local runner
+  runner=$(sed -n "/^\[target\.$1\]/,/^runner/s/^runner = \"\(.*\)\"$/\1/p" .cargo/config.toml)
+  [ -n "$runner" ] || { say "no runner for $1 in .cargo/config.toml"; return 1; }
+  echo "$runner"
 }

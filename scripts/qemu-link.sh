@@ -54,11 +54,9 @@ fi
 LOG_DIR=target/logs/qemu-link
 source scripts/lib.sh  # run_stage, build_decoder, $DECODER, $TARGET_DIR
 run_stage build-decoder build_decoder
-run_stage "build-firmware-${features//,/-}" cargo build --release -p haptic-f405 \
-  --target thumbv7em-none-eabihf --bin haptic-f405 --features "$features"
-# One ELF per feature set, so that parallel runs of several variants do not race.
-elf=$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405-${features//,/-}
-cp "$TARGET_DIR/thumbv7em-none-eabihf/release/haptic-f405" "$elf.tmp" && mv "$elf.tmp" "$elf"
+# (One ELF per feature set, so that runs of several variants side by side do not race.)
+run_stage "build-firmware-${features//,/-}" board_build "$features"
+elf=$(board_elf "$features")
 rm -f "$socket"
 echo "qemu-link: running it in QEMU (netduinoplus2, --features $features), its link on unix:$socket" >&2
 qemu-system-arm -machine netduinoplus2 -display none -monitor none \

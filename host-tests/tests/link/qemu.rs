@@ -170,7 +170,9 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
         let armed = device.arm_held().unwrap();
         assert!(armed.raw.armed);
         // The ramp: full gain once the probe has left the tissue and 500 ticks passed.
-        let up = collect(&telemetry, Duration::from_secs(20), |g| {
+        // (Limits on the host's clock are generous where the wait ends on the device's
+        // state: QEMU runs slower with other work beside it.)
+        let up = collect(&telemetry, Duration::from_secs(60), |g| {
             g.last().unwrap().gain >= 1.0
         });
         assert!(
@@ -196,7 +198,7 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
         "a tissue loaded mid-press without a telemetry gap over 50 ticks",
         || {
             // Wait for a press (contact), then load the stiffer tissue while the stream runs.
-            collect(&telemetry, Duration::from_secs(10), |g| {
+            collect(&telemetry, Duration::from_secs(30), |g| {
                 g.last().unwrap().flags.contains(Flags::CONTACT)
             });
             let stiffer = Tissue::from_param_file(&params("table2-stiffer.toml")).unwrap();
@@ -290,7 +292,8 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
     });
     step(s, "friction reaches the hand", || {
         // Over the palpation's slides (at depth), slipping: lateral over normal is mu_k.
-        let round = collect(&telemetry, Duration::from_secs(8), |g| g.len() > 500);
+        // 2,000 of the device's ticks (a sample every 10), however fast QEMU runs.
+        let round = collect(&telemetry, Duration::from_secs(40), |g| g.len() >= 200);
         let (mu_s, mu_k) = device.info().friction();
         let slipping: Vec<&TelemetrySample> = round
             .iter()
@@ -317,7 +320,7 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
                 .set_pose(Pose::from_mm_deg([5.0, 0.0, 0.0], [tilt, 0.0, 0.0]))
                 .unwrap();
             // 20° at 180°/s: settled within 200 ticks; then a round of the palpation.
-            let round = collect(&telemetry, Duration::from_secs(8), |g| g.len() > 500);
+            let round = collect(&telemetry, Duration::from_secs(40), |g| g.len() >= 200);
             let n = [0.0, -tilt.to_radians().sin(), tilt.to_radians().cos()];
             let (mu_s, _) = device.info().friction();
             let pressed: Vec<&TelemetrySample> = round[60..]
@@ -399,8 +402,9 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
     step(s, "the mesh in its grid, within the byte budget", || {
         device.watch_mesh(1).unwrap();
         let mut seqs = Vec::new();
-        let end = Instant::now() + Duration::from_secs(2);
-        while Instant::now() < end {
+        // Ten meshes, or 20 s of the host's clock (at full speed QEMU sends 16 in 2 s).
+        let end = Instant::now() + Duration::from_secs(20);
+        while Instant::now() < end && seqs.len() < 10 {
             if let Some(m) = device.mesh().filter(|m| seqs.last() != Some(&m.seq)) {
                 // The board's N × N patch: (N − 2)² free nodes, 2 (N − 3)² triangles.
                 let inner = haptic_f405::BOARD.grid - 2;
@@ -411,7 +415,7 @@ fn the_simulated_arm_board_in_qemu_runs_the_trainers_loop() {
             std::thread::sleep(Duration::from_millis(2));
         }
         device.watch_mesh(0).unwrap();
-        assert!(seqs.len() >= 5, "{} meshes in 2 s", seqs.len());
+        assert_eq!(seqs.len(), 10, "{} meshes in 20 s", seqs.len());
         println!(
             "LINK case=mesh meshes={} least_every={}",
             seqs.len(),
@@ -646,7 +650,9 @@ fn the_simulated_lever_board_in_qemu_presses_the_tissue() {
         let rx = device.telemetry_stream();
         device.watch(10).unwrap();
         let armed = device.arm().unwrap();
-        let got = collect(&rx, Duration::from_secs(8), |g| g.len() > 600);
+        // 2,500 of the device's ticks (a sample every 10): its time, not the host's, so
+        // that a QEMU slowed by other work beside it sees the same presses.
+        let got = collect(&rx, Duration::from_secs(60), |g| g.len() >= 250);
         drop(armed);
         let pressed: Vec<&TelemetrySample> = got
             .iter()
