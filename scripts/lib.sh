@@ -141,6 +141,7 @@ board_build() {
   local features=$1 elf
   shift
   elf=$(board_elf "$features")
+  mkdir -p "$TARGET_DIR"
   (
     flock 9
     cargo build --release -p haptic-f405 --target thumbv7em-none-eabihf --bin haptic-f405 \
