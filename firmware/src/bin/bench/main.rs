@@ -281,6 +281,12 @@ mod firmware {
             f.report("tick_proxy", ticks::tick_proxy(h, table) - empty);
             // What the host link adds to a tick (the board's TIM2).
             f.report("tick_link", ticks::tick_link(h, table));
+            // Its rarer work at the board's patch, N = 10 (the M4F's: the board's core).
+            if CORE == Core::M4F {
+                let (swap, mesh) = ticks::link_extras(h, table);
+                f.report("link_swap_n10", swap.saturating_sub(empty));
+                f.report("link_mesh_n10", mesh.saturating_sub(empty));
+            }
             // The arm's counts to duties without the solver, fixed point and its f32 peer.
             f.report("arm_kinematics", arm::arm_kinematics(h) - empty);
             f.report("arm_kinematics_f32", arm::arm_kinematics_f32(h) - empty);

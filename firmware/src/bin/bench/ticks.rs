@@ -330,3 +330,50 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
     });
     with_link.saturating_sub(plain)
 }
+
+/// What the link's rarer work adds to the board's tick at the board's patch (N = 10, its
+/// arithmetic, Table 2): a checked tissue swapped in (its parameter set copied out of
+/// the mailbox and applied: [`Solver::apply`]) and a mesh captured and posted for the
+/// main loop (`Mesh::of`, the mailbox's post, which copies an untaken one out), as
+/// `LinkState::run_tick` does them; each averaged over 4, the call's cost included
+/// (`(swap, mesh)`). The board's budget model adds both to its tick's base
+/// (boards/f405's `tick_base_cost`), as the same tick may do both.
+#[inline(never)]
+pub fn link_extras(h: &Harness, table: &ForceTable64) -> (u32, u32) {
+    use mccs_firmware::link::Mesh;
+    use mccs_firmware::Mailbox;
+    const N: usize = mccs::topology::standard_capacity(10).0;
+    const E: usize = mccs::topology::standard_capacity(10).1;
+    let Ok(topo) = Topology::<N, E>::standard_patch(10, 2.5) else {
+        exit(false)
+    };
+    // (The conservative bound spares the bench the estimate: `apply` does not run it.)
+    let cfg = mccs::SolverConfig {
+        bound: mccs::Bound::Conservative,
+        integrator: mccs::Integrator::SymplecticDamped,
+        ..mccs::SolverConfig::default()
+    };
+    let Ok(mut s) = Solver::<N, E, 64, mccs::Wide>::with_arith(topo, *table, &cfg, mccs::Wide)
+    else {
+        exit(false)
+    };
+    let Ok(set) = s.prepare(*table, &cfg) else {
+        exit(false)
+    };
+    let probe = [Length::ZERO, Length::ZERO, Length::from_bits(-(1 << 23))];
+    for _ in 0..200 {
+        black_box(s.step(probe));
+    }
+    let swaps: Mailbox<mccs::ParamSet<64, mccs::Wide>> = Mailbox::new();
+    let swap = h.measure(4, || {
+        let _ = swaps.post(black_box(set));
+        if let Some(taken) = swaps.take() {
+            let _ = black_box(s.apply(taken));
+        }
+    });
+    let meshes: Mailbox<Mesh<N>> = Mailbox::new();
+    let mesh = h.measure(4, || {
+        black_box(meshes.post(Mesh::of(&s, black_box(7), [0; 2])));
+    });
+    (swap, mesh)
+}
