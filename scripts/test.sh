@@ -425,10 +425,11 @@ run_stage firmware-builds firmware_builds && export DECODER_BUILT=1
 
 # Then three lanes side by side (run_lanes, scripts/lib.sh), each its stages in order:
 # the stages before them are CPU-bound on both cores, but these are mostly one thread
-# each (a QEMU run, an LTO link, a browser) and the host tests, in the background, end
-# before them. The lanes share no file: the demo firmware and the bench are the first
-# lane's alone; the board's variants each run from their own copy (board_build); each
-# QEMU run with a link has its own socket. The link's lane keeps its priority and the
+# each (a QEMU run, an LTO link, a browser), and one after another they left a core
+# idle once the host tests had ended (from a fresh clone, before these stages end). The
+# lanes share no file: the demo firmware and the bench are the first lane's alone; the
+# board's variants each run from their own copy (board_build); each QEMU run with a
+# link has its own socket. The link's lane keeps its priority and the
 # others run at `nice` 5: a host on the link takes the link as lost after 400 ms without
 # a frame (on its own clock), and a QEMU starved beside the bench's three QEMU runs sent
 # none for 406 ms (tried). The QEMU runs of the other lanes count instructions, not time.
