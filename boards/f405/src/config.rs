@@ -114,10 +114,9 @@ pub struct BoardConfig {
     /// 168 MHz), what it costs besides its substeps, and what a substep costs: measured
     /// on the arm board's own run at N = 10 (docs/arm.md, "The trainer tick"), whose
     /// worst tick the test command holds within `tick_base_cost + substeps ×
-    /// substep_cost`, with a host on the link too. The base is that run's rest (12,900)
-    /// and the link's work at most (bench/budgets.txt: its share of every tick, 800; a
-    /// tissue's swap, 3,200; a mesh's capture, 3,600; all three may fall on one tick).
-    /// A tissue whose tick would pass the budget is refused.
+    /// substep_cost`, with a host on the link too. The base is that run's rest
+    /// ([`TICK_REST_COST`]) and the link's work at most ([`LINK_WORK_COST`]). A tissue
+    /// whose tick would pass the budget is refused.
     pub tick_budget: u32,
     /// See `tick_budget`.
     pub tick_base_cost: u32,
@@ -128,6 +127,17 @@ pub struct BoardConfig {
     /// holds_the_main_loop_under_5_ms` holds them to the bench's cost of a step).
     pub check_steps_per_poll: u32,
 }
+
+/// The arm board's tick besides its substeps and the link's work, instructions: its
+/// simulated arm's palpation in QEMU less its 2 substeps (docs/arm.md, "The trainer
+/// tick").
+pub const TICK_REST_COST: u32 = 12_900;
+
+/// The link's work in one tick at most, instructions: its share of every tick, a
+/// tissue's swap and a mesh's capture, which may fall on one tick, each at its budget in
+/// bench/budgets.txt (`tick_link`, `link_swap_n10`, `link_mesh_n10`; a test holds the
+/// sum to that file).
+pub const LINK_WORK_COST: u32 = 800 + 3_200 + 3_600;
 
 /// The largest patch the board's controller holds: N = 10 (the trainer's patch, issue 60:
 /// its tick fits half of a 1 kHz tick with the symplectic option's 2 substeps;
@@ -171,7 +181,7 @@ pub const BOARD: BoardConfig = BoardConfig {
     mu_s: 0.6,
     mu_k: 0.4,
     tick_budget: 84_000,
-    tick_base_cost: 20_500,
+    tick_base_cost: TICK_REST_COST + LINK_WORK_COST,
     substep_cost: 31_200,
     check_steps_per_poll: 16,
 };

@@ -1004,6 +1004,35 @@ fn a_slice_of_a_tissue_check_holds_the_main_loop_under_5_ms() {
     );
 }
 
+/// The board's budget model charges the link's work at the budgets the bench holds it
+/// to: `LINK_WORK_COST` is the sum of bench/budgets.txt's M4F `tick_link`,
+/// `link_swap_n10` and `link_mesh_n10`, and the tick's base is the rest and that.
+#[test]
+fn the_budget_model_charges_the_link_s_work_at_its_budgets() {
+    let budgets =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../bench/budgets.txt"))
+            .unwrap();
+    let max = |case: &str| -> u32 {
+        let head = format!("BUDGET core=m4f case={case} max=");
+        let line = budgets
+            .lines()
+            .find(|l| l.starts_with(&head))
+            .unwrap_or_else(|| panic!("no M4F budget for {case} in bench/budgets.txt"));
+        line[head.len()..]
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let link = max("tick_link") + max("link_swap_n10") + max("link_mesh_n10");
+    assert_eq!(haptic_f405::config::LINK_WORK_COST, link);
+    assert_eq!(
+        BOARD.tick_base_cost,
+        haptic_f405::config::TICK_REST_COST + link
+    );
+}
+
 /// A device whose homing the test decides, held out of contact (far above the tissue).
 struct Homing(std::rc::Rc<std::cell::Cell<bool>>);
 

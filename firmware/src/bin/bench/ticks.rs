@@ -335,9 +335,10 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
 /// arithmetic, Table 2): a checked tissue swapped in (its parameter set copied out of
 /// the mailbox and applied: [`Solver::apply`]) and a mesh captured and posted for the
 /// main loop (`Mesh::of`, the mailbox's post, which copies an untaken one out), as
-/// `LinkState::run_tick` does them; each averaged over 4, the call's cost included
-/// (`(swap, mesh)`). The board's budget model adds both to its tick's base
-/// (boards/f405's `tick_base_cost`), as the same tick may do both.
+/// `LinkState::run_tick` does them; each averaged over 4, `(swap, mesh)`, the empty
+/// call's cost included (the caller takes it off). The swap's counts the main loop's
+/// post of the set too, one copy more than the tick makes. The board's budget model
+/// adds both at their budgets (boards/f405's `LINK_WORK_COST`): one tick may do both.
 #[inline(never)]
 pub fn link_extras(h: &Harness, table: &ForceTable64) -> (u32, u32) {
     use mccs_firmware::link::Mesh;
