@@ -158,15 +158,11 @@ impl<const NODES: usize, const EDGES: usize> StabilityCheck<NODES, EDGES> {
             let growth = match run {
                 Err(g) => Some(*g),
                 Ok(r) => {
-                    let before = self.steps;
+                    let before = r.steps();
                     let out = lin.advance(r, left);
-                    let ran = if out.is_some() {
-                        // (A run that overflowed ends early: count what it took.)
-                        left.min(STEPS_PER_RUN)
-                    } else {
-                        left
-                    };
-                    self.steps = before.saturating_add(ran);
+                    // (A run ends early where it overflowed or its energy fell away.)
+                    let ran = r.steps() - before;
+                    self.steps = self.steps.saturating_add(ran);
                     left -= ran.min(left);
                     out
                 }

@@ -21,6 +21,26 @@ const RUN_STEPS: usize = 1536;
 /// The last steps of a run, over which its growth is measured.
 const RUN_WINDOW: usize = RUN_STEPS / 3;
 
+/// A run whose energy has fallen to this fraction of its start's (2⁻⁶⁴) ends there,
+/// its growth that fall: the step is stable and its motion visibly dies out, as the
+/// whole run would say. A mode that does not decay over the run (growth above
+/// [`super::TRUSTED_DECAY`] over its last third, or any growth) keeps its share of the
+/// start's energy times at least 2⁻³ (its left eigenvector `w` holds `|w·s_k| ≥
+/// |λ|^k |w·s_0|`), so the state's energy can fall this far only where the start held
+/// less than 2⁻⁶¹ of such a mode; the fixed pseudo-random start holds every mode (the
+/// tests hold the decisions to the whole runs').
+const DECAYED: f32 = 1.0 / 18_446_744_073_709_551_616.0;
+
+/// Steps between two looks at a run's fall ([`DECAYED`]); and the state's exponent must
+/// first have fallen [`DECAY_GATE_BITS`] below the start's, so that a run that does not
+/// fall that fast pays nothing for the look (its energy is a loop over the springs in
+/// `f32`, and `f64` for each spring's stiffness).
+const DECAY_LOOK_STEPS: usize = 64;
+const DECAY_GATE_BITS: i32 = 16;
+
+/// The state's exponent at a run's start (its components in Q20 mm).
+const START_EXP: i32 = -20;
+
 /// The fraction bits of the fixed-point step's coefficients ([`Linearised::growth`]).
 const COEFF_FRAC: u32 = 24;
 
@@ -65,6 +85,9 @@ pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     integrator: Integrator,
     /// [`most_damping`], 1/s.
     most_damping: f32,
+    /// Whether a run ends where its energy has fallen to [`DECAYED`] (always, but in
+    /// the tests that hold the decisions to the whole runs').
+    decay_exit: bool,
 }
 
 /// A run of the linearised step in progress ([`Linearised::start`],
@@ -85,9 +108,18 @@ pub(super) struct Run<const NODES: usize, const EDGES: usize> {
     step: usize,
     exp: i32,
     at_window: (f32, i32),
+    /// The energy at the start (exponent [`START_EXP`]).
+    at_start: f32,
 }
 
-/// Steps of one run ([`RUN_STEPS`]).
+impl<const NODES: usize, const EDGES: usize> Run<NODES, EDGES> {
+    /// Steps run so far.
+    pub(super) fn steps(&self) -> u32 {
+        self.step as u32
+    }
+}
+
+/// Steps of one run at most ([`RUN_STEPS`]).
 pub const STEPS_PER_RUN: u32 = RUN_STEPS as u32;
 
 /// [`q::mulhi_round`] (`a b / 2³²` rounded to nearest, exact: a floor's bias acts as
@@ -149,6 +181,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             per_mass: (1000.0 / config.node_mass) as f32,
             integrator: config.integrator,
             most_damping: most_damping(topo, config) as f32,
+            decay_exit: true,
         }
     }
 
@@ -160,13 +193,19 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     /// in one call: [`Self::start`] and [`Self::advance`] run it in pieces.
     #[cfg(test)]
     pub(super) fn growth(&self, h: f64) -> f32 {
+        self.growth_in(h).0
+    }
+
+    /// [`Self::growth`] and the steps the run took.
+    #[cfg(test)]
+    pub(super) fn growth_in(&self, h: f64) -> (f32, u32) {
         match self.start(h) {
             Ok(mut run) => loop {
                 if let Some(g) = self.advance(&mut run, RUN_STEPS as u32) {
-                    return g;
+                    return (g, run.steps());
                 }
             },
-            Err(g) => g,
+            Err(g) => (g, 0),
         }
     }
 
@@ -238,6 +277,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 *c = ((seed >> 8) as i32 - (1 << 23)) >> 4;
             }
         }
+        let at_start = self.energy(&nodes, hf, g);
         Ok(Run {
             nodes,
             kappa,
@@ -249,13 +289,16 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             h: hf,
             symplectic,
             step: 0,
-            exp: -20,
+            exp: START_EXP,
             at_window: (0.0, 0),
+            at_start,
         })
     }
 
     /// Runs up to `steps` more steps of `run`; its growth once it has run all
-    /// [`RUN_STEPS`] (infinite where a step overflowed), `None` before.
+    /// [`RUN_STEPS`] (infinite where a step overflowed; its fall where its energy fell
+    /// to [`DECAYED`] of the start's first), `None` before. A run that has given its
+    /// growth is over ([`Run::steps`] says how many steps it took).
     pub(super) fn advance(&self, run: &mut Run<NODES, EDGES>, steps: u32) -> Option<f32> {
         let k = StepCoeffs {
             chi: run.chi,
@@ -273,6 +316,15 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             if run.step == RUN_STEPS - RUN_WINDOW {
                 run.at_window = (self.energy(&run.nodes, run.h, run.g), run.exp);
             }
+            if self.decay_exit
+                && run.step.is_multiple_of(DECAY_LOOK_STEPS)
+                && run.exp <= START_EXP - DECAY_GATE_BITS
+            {
+                let fall = self.fall(run);
+                if fall <= DECAYED {
+                    return Some(fall);
+                }
+            }
             run.step += 1;
             let edges = self.topo.edges();
             if !step_once(
@@ -283,8 +335,6 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 &k,
                 &mut run.exp,
             ) {
-                run.step = RUN_STEPS;
-                run.at_window = (0.0, 0);
                 return Some(f32::INFINITY);
             }
         }
@@ -298,6 +348,16 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
         } else {
             f32::INFINITY
         })
+    }
+
+    /// The run's energy now over its start's.
+    fn fall(&self, run: &Run<NODES, EDGES>) -> f32 {
+        let e = self.energy(&run.nodes, run.h, run.g);
+        if run.at_start > 0.0 {
+            libm::ldexpf(e / run.at_start, 2 * (run.exp - START_EXP))
+        } else {
+            f32::INFINITY
+        }
     }
 
     /// The energy at displacements `x` and velocities per step `v` (substep `h`), over

@@ -109,19 +109,22 @@ pub fn startup(figs: &mut Figures, n: u32, instructions: u64) {
 }
 
 /// A device's check of a new tissue, the host's substeps proposed
-/// ([`crate::ticks::tissue_check`]): `case=tissue_check n= instructions= ms_at_clock=`.
-pub fn tissue_check(figs: &mut Figures, n: u32, instructions: u64) {
+/// ([`crate::ticks::tissue_check`]): `case=tissue_check n= instructions= ms_at_clock=
+/// steps=` (the steps of the linearised patch it ran).
+pub fn tissue_check(figs: &mut Figures, n: u32, (instructions, steps): (u64, u32)) {
     let ms = CORE.ms_at_clock(instructions);
     figs.record(
         "tissue_check",
         u32::try_from(instructions).unwrap_or(u32::MAX),
     );
     defmt::println!(
-        "BENCH core={=str} case=tissue_check n={=u32} instructions={=u64} ms_at_clock={=u64}",
+        "BENCH core={=str} case=tissue_check n={=u32} instructions={=u64} ms_at_clock={=u64} \
+         steps={=u32}",
         CORE.name(),
         n,
         instructions,
-        ms
+        ms,
+        steps
     );
 }
 

@@ -60,10 +60,11 @@ fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64)
 
 /// A device's check of a new tissue as the link runs it: the host's proposed substeps
 /// (the count the search finds) verified by the device's own runs
-/// ([`StabilityCheck`] with a proposal, advanced to its end), once, in instructions. Exits
-/// with failure if the check does not take the search's count.
+/// ([`StabilityCheck`] with a proposal, advanced to its end), once: its instructions and
+/// the steps of the linearised patch it ran. Exits with failure if the check does not
+/// take the search's count.
 #[inline(never)]
-pub fn tissue_check(h: &Harness, table: &ForceTable64) -> u64 {
+pub fn tissue_check(h: &Harness, table: &ForceTable64) -> (u64, u32) {
     match demo::spec_for(CORE).grid {
         8 => tissue_check_in::<37, 214>(h, table),
         5 => tissue_check_in::<10, 61>(h, table),
@@ -72,22 +73,26 @@ pub fn tissue_check(h: &Harness, table: &ForceTable64) -> u64 {
 }
 
 #[inline(never)]
-fn tissue_check_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64) -> u64 {
+fn tissue_check_in<const N: usize, const E: usize>(
+    h: &Harness,
+    table: &ForceTable64,
+) -> (u64, u32) {
     let spec = demo::spec_for(CORE);
     let topo = demo_topology::<N, E>(&spec);
     let config = spec.config();
     let proposal = demo_solver::<N, E>(&spec, table).substeps();
-    let mut outcome = None;
+    let (mut outcome, mut steps) = (None, 0);
     let n = h.measure_long(|| {
         let check = StabilityCheck::new(black_box(&topo), table, &config, Some(proposal));
         if let Ok(mut check) = check {
             outcome = check.advance(&topo, u32::MAX);
+            steps = check.steps_run();
         }
     });
     if outcome != Some(Ok(proposal)) {
         exit(false)
     }
-    n
+    (n, steps)
 }
 
 /// One tick of this core's demo configuration, pressed in, averaged over 4.

@@ -6,10 +6,13 @@ use super::*;
 use crate::{ForceTable64, Params};
 
 /// The linearised step of [`Linearised::growth`] in plain `f64` from the same start:
-/// the energy ratio over the last [`RUN_WINDOW`] of [`RUN_STEPS`] steps.
+/// the energy ratio over the last [`RUN_WINDOW`] of [`RUN_STEPS`] steps, or where the
+/// run ends at `steps` before that (its energy fallen away), the energy then over the
+/// start's.
 fn growth_f64<const NODES: usize, const EDGES: usize>(
     lin: &Linearised<'_, NODES, EDGES>,
     h: f64,
+    steps: usize,
 ) -> f64 {
     let n = lin.topo.node_count();
     let symplectic = lin.integrator == Integrator::SymplecticDamped;
@@ -50,9 +53,9 @@ fn growth_f64<const NODES: usize, const EDGES: usize>(
             .map(|w| 0.5 * mass * w * w)
             .sum::<f64>()
     };
-    let (mut at_window, mut scale) = (0.0, 0.0);
-    for step in 0..RUN_STEPS {
-        if step == RUN_STEPS - RUN_WINDOW {
+    let (mut at_window, mut scale) = (energy(&x, &v), 0.0);
+    for step in 0..steps.min(RUN_STEPS) {
+        if step == RUN_STEPS - RUN_WINDOW && steps >= RUN_STEPS {
             at_window = energy(&x, &v);
             scale = 0.0;
         }
@@ -148,14 +151,16 @@ fn the_fixed_point_growth_is_the_f64_steps() {
             let lin4 = Linearised::new(&topo4, k_max, &config);
             for f in [0.0625, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0] {
                 let what = format!("{integrator:?} C={spring_damping} c={node_damping} {f}×closed");
+                let (g3, steps3) = lin3.growth_in(f * closed3);
+                let (g4, steps4) = lin4.growth_in(f * closed4);
                 check(
-                    lin3.growth(f * closed3),
-                    growth_f64(&lin3, f * closed3),
+                    g3,
+                    growth_f64(&lin3, f * closed3, steps3 as usize),
                     &format!("N=3 {what}"),
                 );
                 check(
-                    lin4.growth(f * closed4),
-                    growth_f64(&lin4, f * closed4),
+                    g4,
+                    growth_f64(&lin4, f * closed4, steps4 as usize),
                     &format!("N=4 {what}"),
                 );
                 compared += 2;
@@ -189,4 +194,110 @@ fn the_limits_call_a_step_unstable() {
     );
     let g = lin.growth(0.01 * closed);
     assert!(g.is_finite() && g < 1.0, "{g}");
+}
+
+/// Runs, runs ended early, their steps and the whole runs' ([`compare_with_whole`]).
+#[derive(Default)]
+struct Ended {
+    runs: u32,
+    early: u32,
+    steps: u64,
+    whole_steps: u64,
+}
+
+/// Each run of `lin` from a sixteenth of `closed` to four times it (geometric steps of
+/// 2^¼) decides as the whole run does (see below).
+fn compare_with_whole<const N: usize, const E: usize>(
+    topo: &Topology<N, E>,
+    k_max: f64,
+    config: &SolverConfig,
+    tally: &mut Ended,
+) {
+    let closed = closed_form(topo, k_max, config).unwrap();
+    let mut lin = Linearised::new(topo, k_max, config);
+    let trusted = super::super::TRUSTED_DECAY;
+    let what = format!("N={N} {config:?}");
+    for k in -16..=8 {
+        let h = closed * libm::exp2(k as f64 / 4.0);
+        lin.decay_exit = true;
+        let (g, ran) = lin.growth_in(h);
+        lin.decay_exit = false;
+        let (whole, whole_ran) = lin.growth_in(h);
+        assert_eq!(
+            g <= 1.0,
+            whole <= 1.0,
+            "{what} h={h:e}: {g} against {whole}"
+        );
+        assert_eq!(
+            g <= trusted,
+            whole <= trusted,
+            "{what} h={h:e}: {g} against {whole}"
+        );
+        if ran < whole_ran {
+            assert!(g <= DECAYED, "{what} h={h:e}: ended at {ran} with {g}");
+            tally.early += 1;
+        }
+        tally.runs += 1;
+        tally.steps += ran as u64;
+        tally.whole_steps += whole_ran as u64;
+    }
+}
+
+/// A run that ends where its energy has fallen to [`DECAYED`] decides as the whole run
+/// does: stable (growth at most 1) and trusted (at most [`super::super::TRUSTED_DECAY`])
+/// alike, on the standard N = 3, 4, 5 and 8 patches, both integrators, a light, the
+/// default and a heavy damping, from a sixteenth of the closed form to four times it.
+/// How many runs end early and the steps they take is printed (`LINEARISED
+/// case=decay_exit`).
+#[test]
+fn a_run_ended_by_its_fall_decides_as_the_whole_run() {
+    let table = ForceTable64::new(&Params::TABLE2).unwrap();
+    let k_max = table.max_stiffness().to_num::<f64>();
+    let mut tally = Ended::default();
+    for integrator in [Integrator::ImprovedEuler, Integrator::SymplecticDamped] {
+        for (spring_damping, node_damping) in [(0.05, 0.05), (1.0, 0.05), (10.0, 0.5)] {
+            let config = SolverConfig {
+                integrator,
+                spring_damping,
+                node_damping,
+                ..SolverConfig::default()
+            };
+            let t = &mut tally;
+            compare_with_whole(
+                &Topology::<2, 9>::standard_patch(3, 2.5).unwrap(),
+                k_max,
+                &config,
+                t,
+            );
+            compare_with_whole(
+                &Topology::<5, 30>::standard_patch(4, 2.5).unwrap(),
+                k_max,
+                &config,
+                t,
+            );
+            compare_with_whole(
+                &Topology::<10, 61>::standard_patch(5, 2.5).unwrap(),
+                k_max,
+                &config,
+                t,
+            );
+            compare_with_whole(
+                &Topology::<37, 214>::standard_patch(8, 2.5).unwrap(),
+                k_max,
+                &config,
+                t,
+            );
+        }
+    }
+    let Ended {
+        runs,
+        early,
+        steps,
+        whole_steps,
+    } = tally;
+    assert!(early > runs / 4, "{early} of {runs} runs ended early");
+    std::println!(
+        "LINEARISED case=decay_exit runs={runs} ended_early={early} steps_of_whole_pct={}",
+        100 * steps / whole_steps
+    );
 }
