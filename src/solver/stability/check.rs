@@ -160,7 +160,7 @@ impl<const NODES: usize, const EDGES: usize> StabilityCheck<NODES, EDGES> {
                 Ok(r) => {
                     let before = r.steps();
                     let out = lin.advance(r, left);
-                    // (A run ends early where it overflowed or its energy fell away.)
+                    // (A run ends early where it overflowed or its energy moved past `DECIDED`.)
                     let ran = r.steps() - before;
                     self.steps = self.steps.saturating_add(ran);
                     left -= ran.min(left);

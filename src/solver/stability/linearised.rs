@@ -21,22 +21,26 @@ const RUN_STEPS: usize = 1536;
 /// The last steps of a run, over which its growth is measured.
 const RUN_WINDOW: usize = RUN_STEPS / 3;
 
-/// A run whose energy has fallen to this fraction of its start's (2⁻⁶⁴) ends there,
-/// its growth that fall: the step is stable and its motion visibly dies out, as the
-/// whole run would say. A mode that does not decay over the run (growth above
-/// [`super::TRUSTED_DECAY`] over its last third, or any growth) keeps its share of the
-/// start's energy times at least 2⁻³ (its left eigenvector `w` holds `|w·s_k| ≥
-/// |λ|^k |w·s_0|`), so the state's energy can fall this far only where the start held
-/// less than 2⁻⁶¹ of such a mode; the fixed pseudo-random start holds every mode (the
-/// tests hold the decisions to the whole runs').
-const DECAYED: f32 = 1.0 / 18_446_744_073_709_551_616.0;
+/// A run whose energy has fallen to this fraction of its start's (2⁻⁶⁴), or grown to
+/// its inverse times it, ends there, its growth that ratio: the whole run would decide
+/// the same (`test_growth` holds every decision to the whole run's).
+/// - Fallen: the step is stable and its motion visibly dies out. A mode that does not
+///   decay over the run (growth above [`super::TRUSTED_DECAY`] over its last third, or
+///   any growth) keeps at least 2⁻³ of its share of the start's energy (its left
+///   eigenvector `w` holds `|w·s_k| ≥ |λ|^k |w·s_0|`; `w` vanishes where the energy
+///   does, on the springs' mechanisms), so the energy falls this far only where the
+///   fixed pseudo-random start held less than 2⁻⁶¹ of such a mode.
+/// - Grown: the step is unstable. A stable step's energy grows only by its
+///   eigenvectors' conditioning, a Jordan pair's (critical damping) by at most `k²`
+///   over `k` steps: 2²² in a run, far below 2⁶⁴.
+const DECIDED: f32 = 1.0 / 18_446_744_073_709_551_616.0;
 
-/// Steps between two looks at a run's fall ([`DECAYED`]); and the state's exponent must
-/// first have fallen [`DECAY_GATE_BITS`] below the start's, so that a run that does not
-/// fall that fast pays nothing for the look (its energy is a loop over the springs in
-/// `f32`, and `f64` for each spring's stiffness).
-const DECAY_LOOK_STEPS: usize = 64;
-const DECAY_GATE_BITS: i32 = 16;
+/// Steps between two looks at a run's energy ([`DECIDED`]); and the state's exponent must
+/// first have moved [`LOOK_GATE_BITS`] from the start's, so that a run whose energy moves
+/// slowly pays nothing for the look (its energy is a loop over the springs in `f32`, and
+/// `f64` for each spring's stiffness).
+const LOOK_STEPS: usize = 64;
+const LOOK_GATE_BITS: i32 = 16;
 
 /// The state's exponent at a run's start (its components in Q20 mm).
 const START_EXP: i32 = -20;
@@ -85,9 +89,9 @@ pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     integrator: Integrator,
     /// [`most_damping`], 1/s.
     most_damping: f32,
-    /// Whether a run ends where its energy has fallen to [`DECAYED`] (always, but in
+    /// Whether a run ends where its energy has moved past [`DECIDED`] (always, but in
     /// the tests that hold the decisions to the whole runs').
-    decay_exit: bool,
+    decided_early: bool,
 }
 
 /// A run of the linearised step in progress ([`Linearised::start`],
@@ -181,7 +185,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             per_mass: (1000.0 / config.node_mass) as f32,
             integrator: config.integrator,
             most_damping: most_damping(topo, config) as f32,
-            decay_exit: true,
+            decided_early: true,
         }
     }
 
@@ -296,8 +300,8 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     }
 
     /// Runs up to `steps` more steps of `run`; its growth once it has run all
-    /// [`RUN_STEPS`] (infinite where a step overflowed; its fall where its energy fell
-    /// to [`DECAYED`] of the start's first), `None` before. A run that has given its
+    /// [`RUN_STEPS`] (infinite where a step overflowed; its energy over the start's
+    /// where that passed [`DECIDED`] first), `None` before. A run that has given its
     /// growth is over ([`Run::steps`] says how many steps it took).
     pub(super) fn advance(&self, run: &mut Run<NODES, EDGES>, steps: u32) -> Option<f32> {
         let k = StepCoeffs {
@@ -316,13 +320,13 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
             if run.step == RUN_STEPS - RUN_WINDOW {
                 run.at_window = (self.energy(&run.nodes, run.h, run.g), run.exp);
             }
-            if self.decay_exit
-                && run.step.is_multiple_of(DECAY_LOOK_STEPS)
-                && run.exp <= START_EXP - DECAY_GATE_BITS
+            if self.decided_early
+                && run.step.is_multiple_of(LOOK_STEPS)
+                && (run.exp - START_EXP).abs() >= LOOK_GATE_BITS
             {
-                let fall = self.fall(run);
-                if fall <= DECAYED {
-                    return Some(fall);
+                let ratio = self.since_start(run);
+                if !(DECIDED..1.0 / DECIDED).contains(&ratio) {
+                    return Some(ratio);
                 }
             }
             run.step += 1;
@@ -351,7 +355,7 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     }
 
     /// The run's energy now over its start's.
-    fn fall(&self, run: &Run<NODES, EDGES>) -> f32 {
+    fn since_start(&self, run: &Run<NODES, EDGES>) -> f32 {
         let e = self.energy(&run.nodes, run.h, run.g);
         if run.at_start > 0.0 {
             libm::ldexpf(e / run.at_start, 2 * (run.exp - START_EXP))

@@ -34,7 +34,7 @@ fn demo_solver<const N: usize, const E: usize>(
 
 /// The solver's start-up for this core's demo configuration (`Solver::new`: the patch's
 /// coefficients and its stability bound, whose estimate runs the linearised step about
-/// ten times 1,536 steps, in block fixed point), once, in instructions.
+/// ten times up to 1,536 steps, in block fixed point), once, in instructions.
 #[inline(never)]
 pub fn startup(h: &Harness, table: &ForceTable64) -> u64 {
     match demo::spec_for(CORE).grid {
