@@ -48,6 +48,7 @@ mutants=(
   "graded corner's octave not in the index|add r8, r8, r5, lsl #2|add r8, r8, r5, lsl #3"
   "graded corner's strain difference reversed|sub r3, r3, r9\\n|sub r3, r9, r3\\n"
   "graded corner's line above never taken|blt 54b|b 54b"
+  "b's velocity read one word off|ldrd r11, lr, [r4], #8|ldrd r11, lr, [r4, #4]!"
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)

@@ -10,9 +10,9 @@ use crate::topology::{Edge, Topology};
 use super::serves;
 
 /// What the loop reads at entry (`repr(C)`: one `ldm`). The first six words become its
-/// frame: `velocities` and `stride` one `ldrd` (node `i`'s velocity is at
-/// `velocities + stride · i`; its displacement just before, one `ldmdb`, its
-/// accumulator just after).
+/// frame: `velocities`, `stride` and `end` one `ldm` at each spring's end (node `i`'s
+/// velocity is at `velocities + stride · i`; its displacement just before, one `ldmdb`,
+/// its accumulator just after).
 #[repr(C)]
 struct LoopArgs {
     /// The first node's velocity: the nodes' address plus 12.
@@ -200,17 +200,6 @@ macro_rules! spring_body {
             "ubfx r3, r3, #14, #15\n",
             "lsl r3, r3, #16\n",
             "b 55b\n",
-            // Below: force_lo + the slope's product with e ⊖ anchor_lo (or first, in
-            // the loop of a table with a lower corner, that corner above corner_hi).
-            "51:\n",
-            $below!(),
-            "ldr r3, [r11, #{anchor_lo}]\n",
-            "qsub r3, r9, r3\n",
-            "ldr r5, [r11, #{slope_lo}]\n",
-            $lower!(),
-            "ldr r5, [r11, #{force_lo}]\n",
-            "qadd r5, r5, r3\n",
-            "b 53f\n",
             // At or above strain_hi: the graded corner below corner_hi; above it
             // force_hi + hi(slope_hi · (e ⊖ corner_hi)) where stiffness_hi is within
             // ±2¹⁹ (slope_hi is then Q28: `fine_line`), else
@@ -235,6 +224,18 @@ macro_rules! spring_body {
             "57:\n",
             "ldr r5, [r11, #{force_hi}]\n",
             "qadd r5, r5, r3\n",
+            "b 53f\n",
+            // Below: force_lo + the slope's product with e ⊖ anchor_lo (or first, in
+            // the loop of a table with a lower corner, that corner above corner_hi).
+            // Last, falling through: the pressed patch's springs mostly take it.
+            "51:\n",
+            $below!(),
+            "ldr r3, [r11, #{anchor_lo}]\n",
+            "qsub r3, r9, r3\n",
+            "ldr r5, [r11, #{slope_lo}]\n",
+            $lower!(),
+            "ldr r5, [r11, #{force_lo}]\n",
+            "qadd r5, r5, r3\n",
             // f within ±64 N; f r' >> 25 (Q22; the law's product subtracts it); the
             // damping.
             "53:\n",
@@ -249,36 +250,13 @@ macro_rules! spring_body {
 
 /// One axis of a spring between two nodes: `p = round(C dv) + round(w (−f r))` (one
 /// `smmlsr`: `t − w (f r)` rounded is `t + round(w (−f r))`), held within ±64 N, into
-/// the axis' `w` register. `$w`: w's register; `$vb`: the offset of
-/// b's velocity component; `$va`: the register holding a's.
+/// the axis' `w` register. `$w`: w's register; `$dv`: the register holding the axis'
+/// `v_b − v_a`.
 macro_rules! axis_two {
-    ($w:literal, $vb:literal, $va:literal) => {
+    ($w:literal, $dv:literal) => {
         concat!(
-            "ldr lr, [r4, #",
-            $vb,
-            "]\n",
-            "sub ",
-            $va,
-            ", lr, ",
-            $va,
-            "\n",
-            "smmulr ",
-            $va,
-            ", ",
-            $va,
-            ", r3\n",
-            "smmlsr ",
-            $w,
-            ", ",
-            $w,
-            ", r8, ",
-            $va,
-            "\n",
-            "ssat ",
-            $w,
-            ", #27, ",
-            $w,
-            "\n",
+            "smmulr ", $dv, ", ", $dv, ", r3\n", "smmlsr ", $w, ", ", $w, ", r8, ", $dv, "\n",
+            "ssat ", $w, ", #27, ", $w, "\n",
         )
     };
 }
@@ -295,19 +273,19 @@ macro_rules! axis_ground {
     };
 }
 
-/// Node a's accumulator (after its velocity, r6) takes `p` (r0–r2); the next spring,
-/// until the end.
+/// Node a's accumulator (r6, moved past its velocity) takes `p` (r0–r2); the next
+/// spring, until the end (which the frame's first words, the velocities' base and
+/// stride, come with: the next spring's addresses take them in r5 and r11).
 macro_rules! a_takes_p_and_loops {
     () => {
         concat!(
-            "add r6, r6, #12\n",
             "ldm r6, {{r5, r9, r10}}\n",
             "add r5, r5, r0\n",
             "add r9, r9, r1\n",
             "add r10, r10, r2\n",
             "stm r6, {{r5, r9, r10}}\n",
-            "ldr r5, [sp, #8]\n",
-            "cmp r12, r5\n",
+            "ldm sp, {{r5, r11, lr}}\n",
+            "cmp r12, lr\n",
             "bne 20b\n",
         )
     };
@@ -325,16 +303,18 @@ macro_rules! spring_loop {
             "push {{r1, r2, r3, r4, r5, r6}}",
             "mov r12, r7",
             "mov r7, r8",
+            "mov r5, r1",
+            "mov r11, r2",
             "cmp r12, r3",
             "beq 90f",
             // One spring: the edge (dir, 1/l0, a | b << 16) and its nodes' velocity
             // addresses.
             "20:",
             "ldm r12!, {{r0, r1, r2, r3, r4}}",
-            // a's: base + 36 a, one multiply-accumulate of the low half (a node index
-            // below 2¹⁵, so the signed half is the index); then b's of the high half,
-            // unless b is the ground. Their displacements: the three words before.
-            "ldrd r5, r11, [sp]",
+            // a's: base + 36 a (r5 + r11 r4, the base and the stride from the loop's
+            // end), one multiply-accumulate of the low half (a node index below 2¹⁵,
+            // so the signed half is the index); then b's of the high half, unless b is
+            // the ground. Their displacements: the three words before.
             "smlabb r6, r4, r11, r5",
             "lsrs lr, r4, #16",
             "beq 30f",
@@ -349,12 +329,18 @@ macro_rules! spring_loop {
             "smmla r1, r8, r3, r1",
             "smmla r2, r9, r3, r2",
             spring_body!($lower, $below),
-            "ldm r6, {{r5, r9, r10}}",
-            axis_two!("r0", "0", "r5"),
-            axis_two!("r1", "4", "r9"),
-            axis_two!("r2", "8", "r10"),
+            // dv = v_b − v_a: a's velocity (r6 on to its accumulator), b's by two
+            // post-indexed loads (r4 on to its accumulator).
+            "ldm r6!, {{r5, r9, r10}}",
+            "ldrd r11, lr, [r4], #8",
+            "sub r5, r11, r5",
+            "sub r9, lr, r9",
+            "ldr r11, [r4], #4",
+            "sub r10, r11, r10",
+            axis_two!("r0", "r5"),
+            axis_two!("r1", "r9"),
+            axis_two!("r2", "r10"),
             // b's accumulator takes −p, a's p.
-            "add r4, r4, #12",
             "ldm r4, {{r5, r9, r10}}",
             "sub r5, r5, r0",
             "sub r9, r9, r1",
@@ -372,7 +358,7 @@ macro_rules! spring_loop {
             spring_body!($lower, $below),
             // −f r' for the ground's axes.
             "rsb r8, r8, #0",
-            "ldm r6, {{r5, r9, r10}}",
+            "ldm r6!, {{r5, r9, r10}}",
             axis_ground!("r0", "r5"),
             axis_ground!("r1", "r9"),
             axis_ground!("r2", "r10"),
