@@ -183,7 +183,7 @@ pub const BOARD: BoardConfig = BoardConfig {
     tick_budget: 84_000,
     tick_base_cost: TICK_REST_COST + LINK_WORK_COST,
     substep_cost: 31_200,
-    check_steps_per_poll: 16,
+    check_steps_per_poll: 12,
 };
 
 /// A board constant out of its range: which one, in words.

@@ -72,7 +72,7 @@ pub(super) struct Linearised<'a, const NODES: usize, const EDGES: usize> {
     /// The table's largest tangent stiffness, N (each spring's `k_max / l0`:
     /// [`spring_of`], computed where it is needed rather than held, for the M0's start-up
     /// stack).
-    k_max: f64,
+    k_max: f32,
     /// The stiffest spring's `k_max / l0` and the largest sum of them on one free node,
     /// N/mm; the most springs on one free node.
     k_spring: f32,
@@ -170,11 +170,15 @@ fn along(xa: &[i32; 3], xb: &[i32; 3], d: &[i32; 3]) -> i32 {
 impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
     pub(super) fn new(topo: &'a Topology<NODES, EDGES>, k_max: f64, config: &SolverConfig) -> Self {
         let mut row = [(0.0f32, 0u32); NODES];
-        let (k_spring, k_row, degree) =
-            spring_rows(topo.edges(), topo.node_count().min(NODES), k_max, &mut row);
+        let (k_spring, k_row, degree) = spring_rows(
+            topo.edges(),
+            topo.node_count().min(NODES),
+            k_max as f32,
+            &mut row,
+        );
         Self {
             topo,
-            k_max,
+            k_max: k_max as f32,
             k_spring,
             k_row,
             degree,
@@ -324,8 +328,10 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
                 && run.step.is_multiple_of(LOOK_STEPS)
                 && (run.exp - START_EXP).abs() >= LOOK_GATE_BITS
             {
+                // (Not on an energy of 0, which the springs' mechanisms alone hold: the
+                // whole run calls that unstable.)
                 let ratio = self.since_start(run);
-                if !(DECIDED..1.0 / DECIDED).contains(&ratio) {
+                if (ratio > 0.0 && ratio < DECIDED) || ratio >= 1.0 / DECIDED {
                     return Some(ratio);
                 }
             }
@@ -383,8 +389,12 @@ impl<'a, const NODES: usize, const EDGES: usize> Linearised<'a, NODES, EDGES> {
 }
 
 /// A spring's `k_max / l0` (N/mm) for the table's largest tangent stiffness `k_max` (N).
-fn spring_of(k_max: f64, e: &Edge) -> f32 {
-    (k_max / crate::topology::rest_length(e)) as f32
+fn spring_of(k_max: f32, e: &Edge) -> f32 {
+    // `k_max / l0` as `k_max · (1/l0)` in `f32`: two products, where the rest length's
+    // quotient and this one took two divisions in software `f64` (each run's start and
+    // each look at its energy take one a spring, and a slice of a check on the link may
+    // hold both: `case=tissue_check`'s `worst_slice_instructions`).
+    k_max * e.inv_len as f32 * (1.0 / (1u64 << crate::units::INV_LEN_FRAC) as f32)
 }
 
 /// Each node's sum of its springs' `k_max / l0` and their count into `row`; the
@@ -394,7 +404,7 @@ fn spring_of(k_max: f64, e: &Edge) -> f32 {
 fn spring_rows(
     edges: &[Edge],
     nodes: usize,
-    k_max: f64,
+    k_max: f32,
     row: &mut [(f32, u32)],
 ) -> (f32, f32, u32) {
     // (Compares, not `f32::max`: a library call on the M4F.)
@@ -562,7 +572,7 @@ fn step_once(
 #[allow(clippy::too_many_arguments)]
 fn energy_of(
     edges: &[Edge],
-    k_max: f64,
+    k_max: f32,
     nodes: &[NodeState],
     n: usize,
     c: usize,

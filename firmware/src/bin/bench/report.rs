@@ -110,8 +110,9 @@ pub fn startup(figs: &mut Figures, n: u32, instructions: u64) {
 
 /// A device's check of a new tissue, the host's substeps proposed
 /// ([`crate::ticks::tissue_check`]): `case=tissue_check n= instructions= ms_at_clock=
-/// steps=` (the steps of the linearised patch it ran).
-pub fn tissue_check(figs: &mut Figures, n: u32, (instructions, steps): (u64, u32)) {
+/// steps= slice_steps= worst_slice_instructions=` (the steps of the linearised patch it
+/// ran; run again in slices of `slice_steps`, the most one took).
+pub fn tissue_check(figs: &mut Figures, n: u32, (instructions, steps, slice): (u64, u32, u64)) {
     let ms = CORE.ms_at_clock(instructions);
     figs.record(
         "tissue_check",
@@ -119,12 +120,14 @@ pub fn tissue_check(figs: &mut Figures, n: u32, (instructions, steps): (u64, u32
     );
     defmt::println!(
         "BENCH core={=str} case=tissue_check n={=u32} instructions={=u64} ms_at_clock={=u64} \
-         steps={=u32}",
+         steps={=u32} slice_steps={=u32} worst_slice_instructions={=u64}",
         CORE.name(),
         n,
         instructions,
         ms,
-        steps
+        steps,
+        crate::ticks::CHECK_SLICE_STEPS,
+        slice
     );
 }
 

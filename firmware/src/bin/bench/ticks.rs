@@ -58,13 +58,19 @@ fn startup_in<const N: usize, const E: usize>(h: &Harness, table: &ForceTable64)
     n
 }
 
+/// Steps of the linearised patch in one slice of [`tissue_check`]'s second run (the arm
+/// board's `check_steps_per_poll`).
+pub const CHECK_SLICE_STEPS: u32 = 12;
+
 /// A device's check of a new tissue as the link runs it: the host's proposed substeps
 /// (the count the search finds) verified by the device's own runs
-/// ([`StabilityCheck`] with a proposal, advanced to its end), once: its instructions and
-/// the steps of the linearised patch it ran. Exits with failure if the check does not
-/// take the search's count.
+/// ([`StabilityCheck`] with a proposal, advanced to its end), once: its instructions, the
+/// steps of the linearised patch it ran, and the most instructions one slice of
+/// [`CHECK_SLICE_STEPS`] took when the check runs again in slices (a run's start and a
+/// look at its energy fall in some). Exits with failure if the check does not take the
+/// search's count.
 #[inline(never)]
-pub fn tissue_check(h: &Harness, table: &ForceTable64) -> (u64, u32) {
+pub fn tissue_check(h: &Harness, table: &ForceTable64) -> (u64, u32, u64) {
     match demo::spec_for(CORE).grid {
         8 => tissue_check_in::<37, 214>(h, table),
         5 => tissue_check_in::<10, 61>(h, table),
@@ -76,7 +82,7 @@ pub fn tissue_check(h: &Harness, table: &ForceTable64) -> (u64, u32) {
 fn tissue_check_in<const N: usize, const E: usize>(
     h: &Harness,
     table: &ForceTable64,
-) -> (u64, u32) {
+) -> (u64, u32, u64) {
     let spec = demo::spec_for(CORE);
     let topo = demo_topology::<N, E>(&spec);
     let config = spec.config();
@@ -92,7 +98,19 @@ fn tissue_check_in<const N: usize, const E: usize>(
     if outcome != Some(Ok(proposal)) {
         exit(false)
     }
-    (n, steps)
+    let Ok(mut check) = StabilityCheck::new(&topo, table, &config, Some(proposal)) else {
+        exit(false)
+    };
+    let mut worst_slice = 0;
+    while check.outcome().is_none() {
+        worst_slice = worst_slice.max(h.measure_long(|| {
+            black_box(check.advance(&topo, CHECK_SLICE_STEPS));
+        }));
+    }
+    if check.outcome() != Some(Ok(proposal)) {
+        exit(false)
+    }
+    (n, steps, worst_slice)
 }
 
 /// One tick of this core's demo configuration, pressed in, averaged over 4.
