@@ -2,6 +2,7 @@
 //! the same state and the same verdict, on random states, coefficients and shifts up to
 //! their limits, and its position step over the whole range of its input.
 
+use super::position::PositionStep;
 use super::*;
 
 /// `a b / 2^frac` rounded to nearest, in `i64` (exact for the step's operands).
