@@ -121,11 +121,11 @@ impl TablePaths {
         }
         let costs: Option<Vec<u64>> = paths
             .iter()
-            .map(|p| figure(core, &format!("spring_path_{p}"), "instructions"))
+            .map(|p| bench_figure(core, &format!("spring_path_{p}"), "instructions"))
             .collect();
         match costs {
             Some(c) => c.iter().max().unwrap_or(&0) - c.iter().min().unwrap_or(&0),
-            None => figure(core, "spring_path_spread", "instructions").unwrap_or(0),
+            None => bench_figure(core, "spring_path_spread", "instructions").unwrap_or(0),
         }
     }
 
@@ -140,8 +140,9 @@ impl TablePaths {
     }
 }
 
-/// One core's figures from the baseline, by case: `instructions`, or another field.
-fn figure(core: &str, case: &str, field: &str) -> Option<u64> {
+/// One core's figure from the bench's baseline (`bench/baseline.txt`, compiled in): the
+/// `field` of its `case` line, `None` where there is none.
+pub fn bench_figure(core: &str, case: &str, field: &str) -> Option<u64> {
     BASELINE.lines().find_map(|l| {
         let mut f = l.split_whitespace();
         if f.next() != Some("BENCH") {
@@ -268,7 +269,7 @@ fn coupling_within_region(
 fn substep_figure(core: CoreArg, n: usize, integrator: IntegratorArg) -> Result<u64, CliError> {
     let symplectic = integrator == IntegratorArg::SymplecticDamped;
     let suffix = if symplectic { "_symplectic" } else { "" };
-    if let Some(substep) = figure(
+    if let Some(substep) = bench_figure(
         core.name(),
         &format!("substep_n{n}{suffix}"),
         "instructions",
@@ -277,7 +278,7 @@ fn substep_figure(core: CoreArg, n: usize, integrator: IntegratorArg) -> Result<
     }
     let measured: Vec<String> = (3..=12)
         .filter(|k| {
-            figure(
+            bench_figure(
                 core.name(),
                 &format!("substep_n{k}{suffix}"),
                 "instructions",
@@ -303,7 +304,7 @@ fn substep_figure(core: CoreArg, n: usize, integrator: IntegratorArg) -> Result<
 
 /// The tick's cost beyond the patch's for `device`, and how it was reckoned.
 fn device_share(core: CoreArg, device: DeviceArg, patch_tick: u64) -> (u64, String) {
-    let roaming = figure(core.name(), "tick_roaming_bound", "instructions").unwrap_or(0);
+    let roaming = bench_figure(core.name(), "tick_roaming_bound", "instructions").unwrap_or(0);
     match device {
         DeviceArg::Patch => (
             patch_tick,
@@ -315,12 +316,12 @@ fn device_share(core: CoreArg, device: DeviceArg, patch_tick: u64) -> (u64, Stri
         DeviceArg::Arm => {
             // The roaming contact's own cost: the demo's roaming tick (window shift
             // included) less its glued tick, on the same patch and substeps.
-            let glued = figure(core.name(), "tick", "instructions").unwrap_or(0);
+            let glued = bench_figure(core.name(), "tick", "instructions").unwrap_or(0);
             let contact = roaming.saturating_sub(glued);
-            let chain = figure(core.name(), "arm_kinematics", "instructions").unwrap_or(0);
-            let link = figure(core.name(), "tick_link", "instructions").unwrap_or(0);
-            let observer = figure(core.name(), "passivity_observer", "instructions").unwrap_or(0);
-            let tracker = figure(core.name(), "velocity_tracker", "instructions").unwrap_or(0);
+            let chain = bench_figure(core.name(), "arm_kinematics", "instructions").unwrap_or(0);
+            let link = bench_figure(core.name(), "tick_link", "instructions").unwrap_or(0);
+            let observer = bench_figure(core.name(), "passivity_observer", "instructions").unwrap_or(0);
+            let tracker = bench_figure(core.name(), "velocity_tracker", "instructions").unwrap_or(0);
             (
                 patch_tick + contact + chain + link + observer + tracker,
                 format!(

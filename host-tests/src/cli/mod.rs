@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 mod arm;
 mod check;
+pub use check::bench_figure;
 mod curve;
 mod demo;
 mod fit;

@@ -979,21 +979,13 @@ fn a_flood_of_garbage_is_counted_and_never_stalls_the_tick_or_the_link() {
 /// energy fall in some), at the bench's estimate of the M4F's cycles per instruction.
 #[test]
 fn a_slice_of_a_tissue_check_holds_the_main_loop_under_5_ms() {
-    let base = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../bench/baseline.txt"
-    ))
-    .unwrap();
-    let line = base
-        .lines()
-        .find(|l| l.starts_with("BENCH core=m4f case=tissue_check n=8 "))
-        .expect("the M4F's tissue_check in bench/baseline.txt");
-    let field = |name: &str| -> f64 {
-        let at = line.split_whitespace().find_map(|kv| kv.strip_prefix(name));
-        at.and_then(|v| v.parse().ok())
-            .unwrap_or_else(|| panic!("no {name} in {line}"))
+    let field = |name: &str| {
+        mccs_host::cli::bench_figure("m4f", "tissue_check", name)
+            .unwrap_or_else(|| panic!("no M4F tissue_check {name} in bench/baseline.txt"))
+            as f64
     };
-    let (worst, slice_steps) = (field("worst_slice_instructions="), field("slice_steps="));
+    let (worst, slice_steps) = (field("worst_slice_instructions"), field("slice_steps"));
+    assert_eq!(field("n"), 8.0, "the M4F's check at N = 8");
     assert_eq!(
         slice_steps, BOARD.check_steps_per_poll as f64,
         "the bench's slices are the board's"
