@@ -19,17 +19,16 @@ pub struct Drive {
 /// 100 % duty, Q16.
 const FULL_DUTY_Q16: i32 = 1 << 16;
 
-/// `m · 2^up`, saturated at the ends of `i32` (`up` < 32): a compare each way and a
-/// shift on every core (a saturating multiply is a 64-bit product on the M0).
+/// `m · up` (`up` a power of two, `limit` = `i32::MAX / up`), saturated at the ends of
+/// `i32`: a compare each way and a product (a saturating product is a long one).
 #[inline(always)]
-fn shl_saturating(m: i32, up: u32) -> i32 {
-    let limit = i32::MAX >> up;
+fn mul_saturating(m: i32, up: i32, limit: i32) -> i32 {
     if m > limit {
         i32::MAX
     } else if m < !limit {
         i32::MIN
     } else {
-        m << up
+        m.wrapping_mul(up)
     }
 }
 
@@ -59,31 +58,40 @@ impl Arm {
         ];
         let mut torque_q8 = [0i32; 3];
         let mut duty = [0i32; 3];
-        let mut most = 0u32;
+        let mut over = false;
         for k in 0..3 {
             torque_q8[k] = jt[k].saturating_add(gravity[k]);
             let j = &self.joints[k];
             // In `i32`: the duty's high word, then its shift (`Arm::new`'s `duty_gain`).
-            duty[k] = shl_saturating(hi(torque_q8[k], j.duty_gain), j.duty_up) >> j.duty_down;
-            most = most.max(duty[k].unsigned_abs());
+            let high = hi(torque_q8[k], j.duty_gain);
+            duty[k] = mul_saturating(high, j.duty_up, j.duty_limit) >> j.duty_down;
+            // |duty| > 100 %, as one unsigned compare.
+            over |= duty[k].wrapping_add(FULL_DUTY_Q16) as u32 > 2 * FULL_DUTY_Q16 as u32;
         }
-        let scaled = most > FULL_DUTY_Q16 as u32;
-        if scaled {
-            // d / most for each, through one reciprocal: `most` and the duties shifted
-            // alike so that `most` lies in [2³⁰, 2³¹) (`most` ≤ 2³¹, over 2¹⁶ here).
-            let shift = 1 - most.leading_zeros() as i32;
-            let (m, d) = if shift >= 0 {
-                ((most >> shift) as i64, duty.map(|d| (d >> shift) as i64))
-            } else {
-                ((most << -shift) as i64, duty.map(|d| (d as i64) << -shift))
-            };
-            let y = recip(m);
-            duty = d.map(|d| ((d * y) >> 46) as i32);
+        if over {
+            duty = scale_to_full(duty);
         }
         Drive {
             torque_q8,
-            duty_q16: duty.map(|d| d.clamp(-FULL_DUTY_Q16, FULL_DUTY_Q16)),
-            scaled,
+            duty_q16: duty,
+            scaled: over,
         }
     }
+}
+
+/// The duties scaled by one factor so that the largest is ±100 % (at least one is
+/// past it): `d / most` for each, through one reciprocal, `most` and the duties shifted
+/// alike so that `most` lies in [2³⁰, 2³¹) (`most` ≤ 2³¹, over 2¹⁶ here). Out of line:
+/// the rare path.
+#[inline(never)]
+fn scale_to_full(duty: [i32; 3]) -> [i32; 3] {
+    let most = duty.iter().fold(0u32, |most, d| most.max(d.unsigned_abs()));
+    let shift = 1 - most.leading_zeros() as i32;
+    let (m, d) = if shift >= 0 {
+        ((most >> shift) as i64, duty.map(|d| (d >> shift) as i64))
+    } else {
+        ((most << -shift) as i64, duty.map(|d| (d as i64) << -shift))
+    };
+    let y = recip(m);
+    d.map(|d| (((d * y) >> 46) as i32).clamp(-FULL_DUTY_Q16, FULL_DUTY_Q16))
 }

@@ -70,17 +70,22 @@ struct Joint {
     home_phase: u32,
     /// The home count.
     home_count: i32,
-    /// Phase per count, Q16 (sign included).
-    phase_per_count: i64,
+    /// Phase per count (sign included) as `whole + fraction / 2¹⁶`: `whole` its floor
+    /// (wrapping: a count's phase is taken modulo a turn), `fraction` in `[0, 2¹⁶)`.
+    phase_per_count_whole: i32,
+    phase_per_count_fraction: i32,
     /// The joint's range, phases relative to home (signed): from `min_phase`, `phase_span`
     /// more.
     min_phase: i32,
     phase_span: u32,
-    /// Duty (Q16) per torque (Q8 N·mm): `⌊τ · gain / 2³²⌋`, saturated times `2^duty_up`,
-    /// then shifted down `duty_down` (one of the two is 0): `|gain|` in `[2³⁰, 2³¹)` but
-    /// where the shifts reach their ends ([`duty_gain`]).
+    /// Duty (Q16) per torque (Q8 N·mm): `⌊τ · gain / 2³²⌋`, saturated times `2^up`,
+    /// then shifted down `duty_down` (one of `up` and `duty_down` is 0): `|gain|` in
+    /// `[2³⁰, 2³¹)` but where the shifts reach their ends ([`duty_gain`]). `2^up` is
+    /// held as `duty_up`, a factor, and `i32::MAX >> up` as `duty_limit`, the high word's
+    /// largest that the factor keeps in `i32`.
     duty_gain: i32,
-    duty_up: u32,
+    duty_up: i32,
+    duty_limit: i32,
     duty_down: u32,
 }
 
@@ -119,16 +124,19 @@ impl Arm {
             // raised to 2²⁰ … 2²¹ with a shift, for the product's precision.
             let k = j.sign / (j.ratio * j.torque_constant_nm_per_a * j.max_current_a * 1000.0);
             let (duty_gain, duty_up, duty_down) = duty_gain(k * 256.0);
+            let phase_per_count = libm::round(j.sign * TURN * 65_536.0 / per_turn) as i64;
             Joint {
                 home_phase: phase(j.home_angle_deg) as i64 as u32,
                 home_count: j.home_count,
-                phase_per_count: libm::round(j.sign * TURN * 65_536.0 / per_turn) as i64,
+                phase_per_count_whole: (phase_per_count >> 16) as i32,
+                phase_per_count_fraction: (phase_per_count & 0xFFFF) as i32,
                 min_phase: phase(j.min_angle_deg - j.home_angle_deg) as i32,
                 phase_span: (phase(j.max_angle_deg - j.home_angle_deg) as i32)
                     .wrapping_sub(phase(j.min_angle_deg - j.home_angle_deg) as i32)
                     as u32,
                 duty_gain,
-                duty_up,
+                duty_up: 1 << duty_up,
+                duty_limit: i32::MAX >> duty_up,
                 duty_down,
             }
         };

@@ -48,10 +48,7 @@ impl Joint {
     /// side spilled (on the M4F).
     #[inline(never)]
     fn cos_sin(&self, count: i32) -> ((i32, i32), bool) {
-        // The phase from home, wrapping with the angle (a turn is 2³²).
-        let from_home = ((count.wrapping_sub(self.home_count) as i64)
-            .wrapping_mul(self.phase_per_count)
-            >> 16) as i32;
+        let from_home = from_home(count.wrapping_sub(self.home_count), self);
         // Outside `min_phase ..= max_phase`, as one unsigned compare.
         let outside = from_home.wrapping_sub(self.min_phase) as u32 > self.phase_span;
         let phase = self.home_phase.wrapping_add(from_home as u32);
@@ -60,8 +57,21 @@ impl Joint {
     }
 }
 
-/// 128 mm in Q16, the tissue frame's end.
-const HOLD_Q16: i32 = (1 << 23) - 1;
+/// The phase from home of a count `delta` from it, wrapping with the angle (a turn is
+/// 2³²): `delta` times the phase per count (Q16), shifted down 16. As the phase per
+/// count's whole part (a wrapping product) and its fraction's (one long product): the
+/// same bits as the 64-bit product gives, which takes three (`test_from_home`).
+#[inline(always)]
+fn from_home(delta: i32, joint: &Joint) -> i32 {
+    let fraction = ((delta as i64 * joint.phase_per_count_fraction as i64) >> 16) as i32;
+    delta
+        .wrapping_mul(joint.phase_per_count_whole)
+        .wrapping_add(fraction)
+}
+
+/// 128 mm in Q16, the tissue frame's end: the probe is held within `[−HOLD_Q16,
+/// HOLD_Q16 − 1]`, `Length`'s own range (one `ssat` on the M3/M4F).
+const HOLD_Q16: i32 = 1 << 23;
 
 impl Arm {
     /// The arm at joint counts `counts` (A, B, C).
@@ -84,7 +94,7 @@ impl Arm {
         let mut probe = [Length::ZERO; 3];
         for k in 0..3 {
             let p = device_q16[k] - self.origin_q16[k];
-            let held = p.clamp(-HOLD_Q16, HOLD_Q16);
+            let held = p.clamp(-HOLD_Q16, HOLD_Q16 - 1);
             if held != p {
                 flags |= OUTSIDE;
             }
@@ -96,6 +106,44 @@ impl Arm {
             device_q16,
             probe,
             flags,
+        }
+    }
+}
+
+#[cfg(test)]
+mod test_from_home {
+    use super::{from_home, Joint};
+
+    /// [`from_home`] is the 64-bit product's bits 16 … 47, for phases per count of every
+    /// magnitude and sign and counts over all of `i32`.
+    #[test]
+    fn the_split_product_is_the_64_bit_one() {
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..200_000 {
+            let bits = next() % 49;
+            let per_count =
+                (next() >> (64 - bits.max(1))) as i64 * if next() & 1 == 0 { 1 } else { -1 };
+            let delta = next() as i32 >> (next() % 32);
+            let joint = Joint {
+                phase_per_count_whole: (per_count >> 16) as i32,
+                phase_per_count_fraction: (per_count & 0xFFFF) as i32,
+                home_phase: 0,
+                home_count: 0,
+                min_phase: 0,
+                phase_span: 0,
+                duty_gain: 0,
+                duty_up: 1,
+                duty_limit: i32::MAX,
+                duty_down: 0,
+            };
+            let wide = ((delta as i64).wrapping_mul(per_count) >> 16) as i32;
+            assert_eq!(from_home(delta, &joint), wide, "{delta} × {per_count}");
         }
     }
 }
