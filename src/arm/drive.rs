@@ -56,26 +56,28 @@ impl Arm {
             -(hi(self.gravity_b_q16, sb) >> 7),
             hi(self.gravity_c_q16, sc) >> 7,
         ];
-        let mut torque_q8 = [0i32; 3];
-        let mut duty = [0i32; 3];
-        let mut over = false;
+        let mut drive = Drive {
+            torque_q8: [0; 3],
+            duty_q16: [0; 3],
+            scaled: false,
+        };
+        // Each duty plus 100 %, unsigned: the largest over 200 % is a duty past ±100 %.
+        let mut offset_most = 0u32;
         for k in 0..3 {
-            torque_q8[k] = jt[k].saturating_add(gravity[k]);
+            let torque = jt[k].saturating_add(gravity[k]);
             let j = &self.joints[k];
             // In `i32`: the duty's high word, then its shift (`Arm::new`'s `duty_gain`).
-            let high = hi(torque_q8[k], j.duty_gain);
-            duty[k] = mul_saturating(high, j.duty_up, j.duty_limit) >> j.duty_down;
-            // |duty| > 100 %, as one unsigned compare.
-            over |= duty[k].wrapping_add(FULL_DUTY_Q16) as u32 > 2 * FULL_DUTY_Q16 as u32;
+            let high = hi(torque, j.duty_gain);
+            let duty = mul_saturating(high, j.duty_up, j.duty_limit) >> j.duty_down;
+            offset_most = offset_most.max(duty.wrapping_add(FULL_DUTY_Q16) as u32);
+            drive.torque_q8[k] = torque;
+            drive.duty_q16[k] = duty;
         }
-        if over {
-            duty = scale_to_full(duty);
+        if offset_most > 2 * FULL_DUTY_Q16 as u32 {
+            drive.duty_q16 = scale_to_full(drive.duty_q16);
+            drive.scaled = true;
         }
-        Drive {
-            torque_q8,
-            duty_q16: duty,
-            scaled: over,
-        }
+        drive
     }
 }
 

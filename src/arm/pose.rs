@@ -43,18 +43,22 @@ impl ArmPose {
 pub(super) use crate::q::mulhi as hi;
 
 impl Joint {
-    /// The joint's `(cos, sin)` at `count` (Q31), and whether it is outside its range.
-    /// Out of line: one joint's values fit the registers, where three inlined side by
-    /// side spilled (on the M4F).
-    #[inline(never)]
-    fn cos_sin(&self, count: i32) -> ((i32, i32), bool) {
+    /// The joint's phase at `count` (full turn), and whether it is outside its range.
+    #[inline(always)]
+    fn phase(&self, count: i32) -> (u32, bool) {
         let from_home = from_home(count.wrapping_sub(self.home_count), self);
         // Outside `min_phase ..= max_phase`, as one unsigned compare.
         let outside = from_home.wrapping_sub(self.min_phase) as u32 > self.phase_span;
-        let phase = self.home_phase.wrapping_add(from_home as u32);
-        // (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the lengths.)
-        (idsp::cossin(phase as i32), outside)
+        (self.home_phase.wrapping_add(from_home as u32), outside)
     }
+}
+
+/// `(cos, sin)` of `phase`, Q31 (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the
+/// lengths). Out of line, returned in two registers: one joint's values fit the
+/// registers, where three inlined side by side spilled (on the M4F).
+#[inline(never)]
+fn cos_sin(phase: u32) -> (i32, i32) {
+    idsp::cossin(phase as i32)
 }
 
 /// The phase from home of a count `delta` from it, wrapping with the angle (a turn is
@@ -79,8 +83,8 @@ impl Arm {
         let mut cos_sin = [(0i32, 0i32); 3];
         let mut flags = 0u8;
         for k in 0..3 {
-            let (cs, outside) = self.joints[k].cos_sin(counts[k]);
-            cos_sin[k] = cs;
+            let (phase, outside) = self.joints[k].phase(counts[k]);
+            cos_sin[k] = self::cos_sin(phase);
             flags |= (outside as u8) << k;
         }
         let [(ca, sa), (cb, sb), (cc, sc)] = cos_sin;
