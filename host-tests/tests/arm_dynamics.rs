@@ -175,10 +175,12 @@ fn a_held_press_is_still_and_the_released_arm_comes_to_rest() {
     assert!(spread.iter().all(|&s| s <= 1), "not at rest: {spread:?}");
 }
 
-/// The region in devices/woodenhaptics.toml is what the simulated arm measures at the
-/// board's damping: its stiffness is stable with every hand, the grid's next is not.
+/// The edge of the region in devices/woodenhaptics.toml at the board's damping: its
+/// stiffness is stable with every hand, the grid's next is not. Not the stiffnesses below
+/// it: at 16 N/mm one hand's count-level limit cycle puts out 0.2 mJ (docs/safety.md,
+/// "Not reproduced today").
 #[test]
-fn the_device_file_s_stable_region_is_what_the_simulated_arm_measures() {
+fn the_device_file_s_edge_is_stable_and_the_next_stiffness_is_not() {
     let b = BOARD.coupling_damping;
     let edge = region().max_coupling(b).unwrap();
     let on_grid = stiffness_grid().any(|k| (k - edge).abs() < 1e-3);
