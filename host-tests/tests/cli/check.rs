@@ -140,6 +140,21 @@ fn what_does_not_fit_or_cannot_run_says_why() {
     assert_eq!(out.stderr, table.stderr);
 }
 
+/// `mccs check --params params/table2.toml --device arm --core <core>`, then `more`.
+fn check_arm_table2(core: &str, more: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "check",
+        "--params",
+        "params/table2.toml",
+        "--device",
+        "arm",
+        "--core",
+        core,
+    ];
+    args.extend_from_slice(more);
+    mccs(&args)
+}
+
 /// `--device arm`: the arm board's whole tick on the M4F's N = 8 patch is the bare
 /// patch's bound plus the contact's own cost (the demo's roaming tick less its glued
 /// tick), the arm's chain, the link's share with a tissue's swap and a mesh's capture
@@ -169,15 +184,7 @@ fn the_arm_boards_trainer_tick_adds_the_contact_the_chain_the_link_and_the_watch
         c("link_mesh_n10")
     );
     assert!(err.contains(&swap), "{err}");
-    let m0 = mccs(&[
-        "check",
-        "--params",
-        "params/table2.toml",
-        "--device",
-        "arm",
-        "--core",
-        "m0",
-    ]);
+    let m0 = check_arm_table2("m0", &[]);
     let err = String::from_utf8(m0.stderr).unwrap();
     assert!(
         err.contains("not in it: a tissue's swap and a mesh's capture"),
@@ -200,19 +207,7 @@ fn each_cores_largest_trainer_tick() {
     ] {
         let run = |n: u32| {
             let grid = n.to_string();
-            mccs(&[
-                "check",
-                "--params",
-                "params/table2.toml",
-                "--device",
-                "arm",
-                "--core",
-                core,
-                "--grid",
-                &grid,
-                "--integrator",
-                integrator,
-            ])
+            check_arm_table2(core, &["--grid", &grid, "--integrator", integrator])
         };
         let at = run(n);
         assert_eq!(at.status.code(), Some(0), "{core} N = {n}, {integrator}");
@@ -248,19 +243,9 @@ fn the_arm_s_coupling_is_held_to_half_its_stable_region() {
     let edge = region.max_coupling(0.5).unwrap();
     let run = |k: f64, b: f64, extra: &[&str]| {
         let (k, b) = (k.to_string(), b.to_string());
-        let mut args = vec![
-            "check",
-            "--params",
-            "params/table2.toml",
-            "--device",
-            "arm",
-            "--coupling-stiffness",
-            &k,
-            "--coupling-damping",
-            &b,
-        ];
+        let mut args = vec!["--coupling-stiffness", &k, "--coupling-damping", &b];
         args.extend_from_slice(extra);
-        let out = mccs(&args);
+        let out = check_arm_table2("m4f", &args);
         (
             out.status.code(),
             String::from_utf8_lossy(&out.stderr).to_string(),
