@@ -6,13 +6,14 @@
 #   2. the roaming probe over random caps and paths at CASES / 10 cases
 #      (host-tests/tests/cap.rs), the stability bound against the exact one on CASES / 2
 #      random configurations (host-tests/tests/stability.rs), and the force-table bound
-#      over 10⁵ random springs (host-tests/tests/table_bound/);
+#      over 10⁵ random springs (host-tests/tests/table_bound/), and the arm's stable
+#      region against its device file's (`mccs arm stability`);
 #   3. every fuzz target for FUZZ_SECONDS (default 300) each (scripts/fuzz.sh).
 # First, the whole host test suite in a release build (link-time optimisation, as
 # docs/cli.md builds the CLI), and that build's stack probes
 # (scripts/check_stack_probes.py: an LLVM defect once cost the window its position).
 # Each step says what it runs and ticks every 10 s (scripts/lib.sh, `run_stage`), its log
-# in target/logs/long/. Prints the STACKPROBE, PROPERTY, STABILITY, TABLEBOUND and FUZZ
+# in target/logs/long/. Prints the STACKPROBE, PROPERTY, STABILITY, TABLEBOUND, STABLE and FUZZ
 # lines; exits with failure at the first run that fails.
 #   scripts/long.sh [CASES] [FUZZ_SECONDS]
 set -euo pipefail
@@ -70,6 +71,19 @@ table_bound() {
 say "long.sh: the force-table bound over 10^5 random springs (about 22 minutes on two cores; docs/reliability.md)"
 run_stage table-bound table_bound
 grep -E "^TABLEBOUND " "$LOG_DIR/table-bound.log"
+
+# The arm's stable region re-measured (`mccs arm stability`, in the release build) and
+# the device file it writes held to the shipped one, byte for byte: the test command
+# holds only the region's edge at the board's damping.
+arm_region() {
+  cargo run --release -q -p mccs-host --bin mccs -- arm stability \
+    --device devices/woodenhaptics.toml --out "$LOG_DIR/woodenhaptics.toml" || return 1
+  cmp devices/woodenhaptics.toml "$LOG_DIR/woodenhaptics.toml" \
+    || { diff devices/woodenhaptics.toml "$LOG_DIR/woodenhaptics.toml"; return 1; }
+}
+say "long.sh: the arm's stable region re-measured against devices/woodenhaptics.toml (10 to 20 minutes)"
+run_stage arm-region arm_region
+grep -E "^STABLE " "$LOG_DIR/arm-region.log"
 
 say "long.sh: properties done in $((SECONDS - start)) s; fuzzing $fuzz_seconds s per target"
 bash scripts/fuzz.sh "$fuzz_seconds"

@@ -286,6 +286,32 @@ fn the_reciprocal_holds_over_its_domain() {
     assert!(worst < 1e-8, "{worst}");
 }
 
+/// The table's `cos` and `sin` at every 2⁻²⁰ of a turn, and at each table point's
+/// neighbours, against `f64`'s of the same amplitude: within 5e-6 (the chord's sag,
+/// 4.7e-6, and the truncations).
+#[test]
+fn cos_sin_is_within_5e_6() {
+    use mccs::arm::cos_sin::{cos_sin, AMPLITUDE};
+    let scale = AMPLITUDE * 2_147_483_648.0;
+    let mut worst = 0.0f64;
+    let mut check = |phase: u32| {
+        let (c, s) = cos_sin(phase);
+        let x = phase as f64 / 4_294_967_296.0 * std::f64::consts::TAU;
+        let err = ((c as f64 / scale - x.cos()).abs()).max((s as f64 / scale - x.sin()).abs());
+        worst = worst.max(err);
+    };
+    for k in 0..1u32 << 20 {
+        check(k << 12);
+    }
+    for k in 0..1024u32 {
+        for d in [1u32, 2, u32::MAX, u32::MAX - 1] {
+            check((k << 22).wrapping_add(d));
+        }
+    }
+    println!("ARM case=cos_sin max_err={worst:.2e} points=1024");
+    assert!(worst <= 5e-6, "{worst}");
+}
+
 /// The firmware's WoodenHaptics constant is the shipped device file.
 #[test]
 fn the_firmware_s_arm_is_the_device_file() {

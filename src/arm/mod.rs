@@ -22,8 +22,8 @@
 //! # Fixed point
 //! Every product is of two 32-bit operands, most kept as their high word (one long
 //! multiply, `smmul` on the M4F). Angles are full-turn phases (`u32`, 2³² a turn);
-//! `cos`/`sin` come from quartiq's
-//! `idsp::cossin` (Q31 less 2⁻¹⁶, which the lengths make up; 9e-6 at most from the true
+//! `cos`/`sin` come from a table of 1,024 points and linear interpolation
+//! ([`cos_sin`]: Q31 less 2.4e-7, which the lengths make up; 5e-6 at most from the true
 //! values); lengths are Q17/Q18 mm, the device-frame position Q16 mm, the
 //! tissue-frame probe the core's `Length`
 //! (Q24 mm, ±128 mm, saturated), torques Q8 N·mm, duties Q16 (65,536 = 100 %). Every
@@ -31,6 +31,7 @@
 //! tick ([`Arm::pose`], [`Arm::drive`]) multiplies and shifts, and scales the duties by a
 //! reciprocal found by Newton's iteration ([`recip`]).
 
+pub mod cos_sin;
 mod drive;
 pub mod inverse;
 mod pose;
@@ -141,11 +142,11 @@ impl Arm {
             }
         };
         let q = |mm: f64, bits: u32| libm::round(mm * (1u64 << bits) as f64) as i64;
-        // idsp's cos and sin have the amplitude 65,535 · 2¹⁵ = 2³¹ (1 − 2⁻¹⁶), not 2³¹: a
-        // length that multiplies one of them is raised by 1/(1 − 2⁻¹⁶), the reach's (x
-        // and y multiply two) by its square (a bias of 1.5e-5 otherwise: 7 µm on a
-        // 450 mm arm). The torques' 1.5e-5 is left (their bound is 0.5 %).
-        let amp = 1.0 / (1.0 - 1.0 / 65_536.0);
+        // The table's cos and sin have the amplitude 2³¹ − 512 (`cos_sin::AMPLITUDE`), not
+        // 2³¹: a length that multiplies one of them is raised by its inverse, the reach's
+        // (x and y multiply two) by its square. The torques' 2.4e-7 is left (their bound
+        // is 0.5 %).
+        let amp = 1.0 / cos_sin::AMPLITUDE;
         let g = spec.gravity.unwrap_or(GravitySpec::NONE);
         Ok(Arm {
             joints: [

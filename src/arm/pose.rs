@@ -53,12 +53,12 @@ impl Joint {
     }
 }
 
-/// `(cos, sin)` of `phase`, Q31 (idsp's amplitude, 2³¹ (1 − 2⁻¹⁶), is folded into the
+/// `(cos, sin)` of `phase`, Q31 ([`super::cos_sin`]'s amplitude is folded into the
 /// lengths). Out of line, returned in two registers: one joint's values fit the
 /// registers, where three inlined side by side spilled (on the M4F).
 #[inline(never)]
 fn cos_sin(phase: u32) -> (i32, i32) {
-    idsp::cossin(phase as i32)
+    super::cos_sin::cos_sin(phase)
 }
 
 /// The phase from home of a count `delta` from it, wrapping with the angle (a turn is

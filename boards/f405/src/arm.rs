@@ -26,11 +26,11 @@ pub const ARM: ArmSpec = mccs_firmware::arm::device::WOODENHAPTICS;
 /// device file's `[stability]` (`mccs arm stability` measured it on the simulated arm;
 /// a host test holds the two equal). A port to another arm measures its own.
 pub const STABLE_REGION: [(f64, f64); 5] = [
-    (0.0, 16.0),
-    (0.5, 64.0),
-    (1.0, 64.0),
-    (2.0, 64.0),
-    (5.0, 64.0),
+    (0.0, 64.0),
+    (0.5, 90.51),
+    (1.0, 90.51),
+    (2.0, 128.0),
+    (5.0, 181.019),
 ];
 
 /// Whether `config`'s coupling is within half of [`STABLE_REGION`] at its damping, as

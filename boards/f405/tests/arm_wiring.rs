@@ -518,16 +518,17 @@ fn a_coupling_beyond_half_the_stable_region_is_refused_at_start_up() {
         coupling_damping: b,
         ..BOARD
     };
-    // Half of 64 N/mm at 0.5 N·s/m: 32 passes, 33 does not.
-    assert_eq!(check_coupling(&at(32.0, 0.5)), Ok(()));
+    // Half of 90.51 N/mm at 0.5 N·s/m: 45.25 passes, 45.26 does not; between 0 and 0.5
+    // N·s/m, half the lower, 64 N/mm.
+    assert_eq!(check_coupling(&at(45.25, 0.5)), Ok(()));
     for (config, said) in [
         (
-            at(33.0, 0.5),
-            "coupling: 33.000 N/mm at 0.500 N·s/m is over half the arm's stable region there, 32.000 N/mm (docs/safety.md)",
+            at(45.26, 0.5),
+            "coupling: 45.260 N/mm at 0.500 N·s/m is over half the arm's stable region there, 45.255 N/mm (docs/safety.md)",
         ),
         (
-            at(9.0, 0.25),
-            "coupling: 9.000 N/mm at 0.250 N·s/m is over half the arm's stable region there, 8.000 N/mm (docs/safety.md)",
+            at(33.0, 0.25),
+            "coupling: 33.000 N/mm at 0.250 N·s/m is over half the arm's stable region there, 32.000 N/mm (docs/safety.md)",
         ),
         (
             at(1.0, 7.0),

@@ -269,6 +269,9 @@ pub struct Held {
     pub window_mj: f64,
     /// Over the whole run.
     pub run_mj: f64,
+    /// The energy of one count ([`COUNT_AT_PROBE_MM`]) in the coupling's spring, mJ:
+    /// `½ k c²`, what where the run ends within a count leaves `run_mj` unknown by.
+    pub count_mj: f64,
     /// The largest force over the window, N.
     pub most_n: f64,
     /// The board's fault, and its tick.
@@ -287,6 +290,7 @@ pub fn hold(
     settle: u32,
     window: u32,
 ) -> Result<Held, Refused> {
+    let count_mj = 0.5 * config.coupling_stiffness * COUNT_AT_PROBE_MM * COUNT_AT_PROBE_MM;
     let mut lp = ClosedLoop::new(config, spec, body, hand)?;
     let start = lp.lead.at(LEAD_TICKS);
     lp.lead.hold = Some(HoldAt {
@@ -311,6 +315,7 @@ pub fn hold(
                 cycle_counts: [f64::INFINITY; 3],
                 window_mj: f64::NAN,
                 run_mj: lp.rendered_mj(),
+                count_mj,
                 most_n: most,
                 fault: Some((t, fault)),
             });
@@ -324,6 +329,7 @@ pub fn hold(
         cycle_counts: std::array::from_fn(|k| cycle_range(seen.iter().map(|c| c[k] as f64))),
         window_mj: (lp.body.rendered_j - before) * 1e3,
         run_mj: lp.rendered_mj(),
+        count_mj,
         most_n: most,
         fault: None,
     })
@@ -380,7 +386,10 @@ fn cycle_range(xs: impl Iterator<Item = f64>) -> f64 {
 }
 
 /// Whether a held press is stable: no fault, no joint's counts spread over
-/// [`STILL_COUNTS`], no net energy out of the device over the run; or why not.
+/// [`STILL_COUNTS`], no net energy out of the device over the run beyond one count's in
+/// the coupling ([`Held::count_mj`]: the force is a whole count's, so the energy a run
+/// ends with is known to no better; a loop that pumps energy gains more with every
+/// cycle); or why not.
 pub fn verdict(h: &Held) -> Result<(), String> {
     if let Some((t, f)) = &h.fault {
         return Err(format!("the board faulted at tick {t}: {f}"));
@@ -392,8 +401,11 @@ pub fn verdict(h: &Held) -> Result<(), String> {
             h.cycle_counts[k]
         ));
     }
-    if h.run_mj > 0.0 {
-        return Err(format!("the device put out {:.3} mJ net", h.run_mj));
+    if h.run_mj > h.count_mj {
+        return Err(format!(
+            "the device put out {:.3} mJ net, over a count's {:.3} mJ in the coupling",
+            h.run_mj, h.count_mj
+        ));
     }
     Ok(())
 }
@@ -406,15 +418,62 @@ pub fn held_press(
     body: BodySpec,
     hand: Hand,
 ) -> Result<Held, Refused> {
-    hold(
-        config,
-        spec,
-        body,
-        hand,
-        HOLD_DEPTH_MM,
-        HOLD_SETTLE,
-        HOLD_WINDOW,
-    )
+    held_press_at(config, spec, body, hand, 0)
+}
+
+/// One encoder count at the probe, mm (a count of joint B or C near the middle of the
+/// workspace; docs/safety.md, "The probe's velocity").
+pub const COUNT_AT_PROBE_MM: f64 = 0.064;
+
+/// The holds a hand's verdict takes: [`HOLD_DEPTH_MM`] and deeper by fifths of
+/// [`COUNT_AT_PROBE_MM`], so that where the press rests within a count, which decides a
+/// count's limit cycle, is sampled, not fixed.
+pub const HOLDS_PER_HAND: usize = 5;
+
+/// The `i`th of a hand's holds ([`HOLDS_PER_HAND`]).
+fn held_press_at(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hand: Hand,
+    i: usize,
+) -> Result<Held, Refused> {
+    let depth = HOLD_DEPTH_MM + COUNT_AT_PROBE_MM * i as f64 / HOLDS_PER_HAND as f64;
+    hold(config, spec, body, hand, depth, HOLD_SETTLE, HOLD_WINDOW)
+}
+
+/// Whether a hand's press is stable, as the stable region judges it: held at each of
+/// [`HOLDS_PER_HAND`] depths across one count, it is not stable when most of them are not
+/// ([`verdict`]); the first such hold's reason, and how many were not stable. A count's
+/// limit cycle can put a press out a fraction of a mJ at one depth in a count and not
+/// at the next (docs/safety.md, "The stable region"); a loop past its edge does so at
+/// most depths. It stops once most holds agree.
+pub fn hand_verdict(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hand: Hand,
+) -> Result<Result<(), String>, Refused> {
+    let most = HOLDS_PER_HAND / 2 + 1;
+    let (mut stable, mut not, mut first_why) = (0, 0, String::new());
+    for i in 0..HOLDS_PER_HAND {
+        if stable >= most || not >= most {
+            break;
+        }
+        if let Err(why) = verdict(&held_press_at(config, spec, body, hand, i)?) {
+            if not == 0 {
+                first_why = why;
+            }
+            not += 1;
+        } else {
+            stable += 1;
+        }
+    }
+    Ok(if not >= most {
+        Err(format!("{first_why} ({not} of {} holds)", stable + not))
+    } else {
+        Ok(())
+    })
 }
 
 /// The coupling stiffnesses tried, N/mm: 0.25 to 1024 by factors of √2.
@@ -423,9 +482,10 @@ pub fn stiffness_grid() -> impl Iterator<Item = f64> {
 }
 
 /// The stable region's edge at one damping: the largest coupling stiffness on
-/// [`stiffness_grid`] below the first that is not stable with every hand of `hands`,
-/// and why that one is not (`None`: the board refused it, or the grid ran out).
-/// `progress` is called with each stiffness tried.
+/// [`stiffness_grid`] below the first that is not stable with every hand of `hands`
+/// ([`hand_verdict`]), and why that one is not (the first such hand's reason; the board
+/// refusing it; or the grid's end). `progress` is called with each stiffness tried. The
+/// hands are judged side by side, one thread each.
 pub fn largest_stable(
     config: &BoardConfig,
     spec: &ArmSpec,
@@ -442,16 +502,22 @@ pub fn largest_stable(
             coupling_damping: damping,
             ..*config
         };
-        for hand in hands {
-            let why = match held_press(&cfg, spec, body, *hand) {
-                Err(Refused(e)) => format!("the board refuses it: {e}"),
-                Ok(h) => match verdict(&h) {
-                    Ok(()) => continue,
-                    Err(e) => format!(
-                        "{e} (hand {} kg, {} N·s/m, {} N/m)",
-                        hand.mass_kg, hand.damping_n_s_m, hand.stiffness_n_m
-                    ),
-                },
+        let verdicts: Vec<_> = std::thread::scope(|s| {
+            let runs: Vec<_> = hands
+                .iter()
+                .map(|hand| s.spawn(|| hand_verdict(&cfg, spec, body, *hand)))
+                .collect();
+            runs.into_iter().map(|r| r.join()).collect()
+        });
+        for (hand, v) in hands.iter().zip(verdicts) {
+            let why = match v {
+                Err(panic) => std::panic::resume_unwind(panic),
+                Ok(Err(Refused(e))) => format!("the board refuses it: {e}"),
+                Ok(Ok(Ok(()))) => continue,
+                Ok(Ok(Err(e))) => format!(
+                    "{e} (hand {} kg, {} N·s/m, {} N/m)",
+                    hand.mass_kg, hand.damping_n_s_m, hand.stiffness_n_m
+                ),
             };
             return (best, format!("{k:.3} N/mm: {why}"));
         }

@@ -59,9 +59,10 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// The arm's stable region on its simulated body (docs/safety.md): the board's loop
-    /// closed through the arm's dynamics, a held press with each hand of the range; at
-    /// each coupling damping, prints `STABLE damping_n_s_m=… max_coupling_n_mm=…
-    /// first_unstable=…` (about a minute each), and with --out writes the device file's
+    /// closed through the arm's dynamics, a press held at five depths across a count with
+    /// each hand of the range; at each coupling damping, prints `STABLE damping_n_s_m=…
+    /// max_coupling_n_mm=… first_unstable=…` (several minutes each on two cores),
+    /// and with --out writes the device file's
     /// [stability] section, which `mccs check --device arm` holds couplings to half of.
     Stability {
         /// The device file.
@@ -116,7 +117,7 @@ fn stability(
     written: Option<&Path>,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    use crate::arm::closed_loop::{largest_stable, HANDS};
+    use crate::arm::closed_loop::{largest_stable, HANDS, HOLDS_PER_HAND};
     use crate::arm::dynamics::BodySpec;
     let spec = device_file::read(device).map_err(CliError::new)?;
     Arm::new(&spec).map_err(|e| arg_error("--device", &e.to_string()))?;
@@ -143,7 +144,7 @@ fn stability(
     let mut points = Vec::new();
     for &b in dampings {
         eprintln!(
-            "mccs arm stability: damping {b} N·s/m: a held press with each of {} hands, coupling 0.25 N/mm up by √2 until one is not stable",
+            "mccs arm stability: damping {b} N·s/m: a press held at {HOLDS_PER_HAND} depths across a count with each of {} hands, coupling 0.25 N/mm up by √2 until one hand's is not stable at most of them",
             HANDS.len()
         );
         let (k, why) = largest_stable(&config, &spec, BodySpec::STAND_IN, &HANDS, b, |k| {

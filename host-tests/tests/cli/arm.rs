@@ -487,7 +487,7 @@ fn calibrate_refuses_what_cannot_give_masses() {
 #[test]
 fn a_bad_stable_region_names_the_file_line_and_key() {
     let good_b = "coupling_damping_n_s_m = [0.0, 0.5, 1.0, 2.0, 5.0]";
-    let good_k = "max_coupling_n_mm = [16.0, 64.0, 64.0, 64.0, 64.0]";
+    let good_k = "max_coupling_n_mm = [64.0, 90.51, 90.51, 128.0, 181.019]";
     assert!(WOODEN.contains(good_b) && WOODEN.contains(good_k));
     let cases: [(&str, String, &str); 5] = [
         (
