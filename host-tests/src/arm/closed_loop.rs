@@ -476,6 +476,28 @@ pub fn hand_verdict(
     })
 }
 
+/// [`hand_verdict`] for each of `hands`, in their order, judged side by side (one thread
+/// each).
+pub fn hand_verdicts(
+    config: &BoardConfig,
+    spec: &ArmSpec,
+    body: BodySpec,
+    hands: &[Hand],
+) -> Vec<Result<Result<(), String>, Refused>> {
+    std::thread::scope(|s| {
+        let runs: Vec<_> = hands
+            .iter()
+            .map(|hand| s.spawn(|| hand_verdict(config, spec, body, *hand)))
+            .collect();
+        runs.into_iter()
+            .map(|r| {
+                r.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    })
+}
+
 /// The coupling stiffnesses tried, N/mm: 0.25 to 1024 by factors of √2.
 pub fn stiffness_grid() -> impl Iterator<Item = f64> {
     (0..=24).map(|i| 0.25 * 2f64.powf(i as f64 / 2.0))
@@ -485,7 +507,7 @@ pub fn stiffness_grid() -> impl Iterator<Item = f64> {
 /// [`stiffness_grid`] below the first that is not stable with every hand of `hands`
 /// ([`hand_verdict`]), and why that one is not (the first such hand's reason; the board
 /// refusing it; or the grid's end). `progress` is called with each stiffness tried. The
-/// hands are judged side by side, one thread each.
+/// hands are judged side by side ([`hand_verdicts`]).
 pub fn largest_stable(
     config: &BoardConfig,
     spec: &ArmSpec,
@@ -502,19 +524,11 @@ pub fn largest_stable(
             coupling_damping: damping,
             ..*config
         };
-        let verdicts: Vec<_> = std::thread::scope(|s| {
-            let runs: Vec<_> = hands
-                .iter()
-                .map(|hand| s.spawn(|| hand_verdict(&cfg, spec, body, *hand)))
-                .collect();
-            runs.into_iter().map(|r| r.join()).collect()
-        });
-        for (hand, v) in hands.iter().zip(verdicts) {
+        for (hand, v) in hands.iter().zip(hand_verdicts(&cfg, spec, body, hands)) {
             let why = match v {
-                Err(panic) => std::panic::resume_unwind(panic),
-                Ok(Err(Refused(e))) => format!("the board refuses it: {e}"),
-                Ok(Ok(Ok(()))) => continue,
-                Ok(Ok(Err(e))) => format!(
+                Err(Refused(e)) => format!("the board refuses it: {e}"),
+                Ok(Ok(())) => continue,
+                Ok(Err(e)) => format!(
                     "{e} (hand {} kg, {} N·s/m, {} N/m)",
                     hand.mass_kg, hand.damping_n_s_m, hand.stiffness_n_m
                 ),
