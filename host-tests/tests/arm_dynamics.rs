@@ -212,6 +212,20 @@ fn the_device_file_s_edge_is_stable_and_the_next_stiffness_is_not() {
     );
 }
 
+/// The count the stable region's holds and energy floor are measured in is one count of
+/// the forearm's joint at the probe, from the shipped arm: its length over its counts a
+/// turn (encoder counts times the capstan's ratio), to 1 µm.
+#[test]
+fn the_count_at_the_probe_is_the_forearm_s() {
+    use mccs_host::arm::closed_loop::COUNT_AT_PROBE_MM;
+    let c = &ARM.joints[2];
+    let count_mm = ARM.forearm_mm * std::f64::consts::TAU / (c.counts_per_rev * c.ratio);
+    assert!(
+        (count_mm - COUNT_AT_PROBE_MM).abs() < 1e-3,
+        "{count_mm} mm against {COUNT_AT_PROBE_MM}"
+    );
+}
+
 /// A held press's net energy out is judged against one count's energy in the coupling
 /// (½ k c², 0.131 mJ at 64 N/mm): at it, stable; past it, not, with both figures. A
 /// joint over 2 counts or a fault is not stable whatever the energy.

@@ -66,8 +66,11 @@ const fn round(v: f64) -> i32 {
     }
 }
 
-/// `(cos, sin)` of `phase` (2³² a turn), Q31 of amplitude [`AMPLITUDE`].
-#[inline(always)]
+/// `(cos, sin)` of `phase` (2³² a turn), Q31 of amplitude [`AMPLITUDE`] (`Arm::new` folds
+/// it into the lengths). Out of line, returned in two registers: the pose calls it for
+/// each joint, and inlined side by side the three spilled (the M4F's chain 334
+/// instructions, against 331).
+#[inline(never)]
 pub fn cos_sin(phase: u32) -> (i32, i32) {
     let k = (phase >> (32 - INDEX_BITS)) as usize;
     // The phase between point k and k + 1, 15 bits: with the two points' difference

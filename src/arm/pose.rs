@@ -53,14 +53,6 @@ impl Joint {
     }
 }
 
-/// `(cos, sin)` of `phase`, Q31 ([`super::cos_sin`]'s amplitude is folded into the
-/// lengths). Out of line, returned in two registers: one joint's values fit the
-/// registers, where three inlined side by side spilled (on the M4F).
-#[inline(never)]
-fn cos_sin(phase: u32) -> (i32, i32) {
-    super::cos_sin::cos_sin(phase)
-}
-
 /// The phase from home of a count `delta` from it, wrapping with the angle (a turn is
 /// 2³²): `delta` times the phase per count (Q16), shifted down 16. As the phase per
 /// count's whole part (a wrapping product) and its fraction's (one long product): the
@@ -84,7 +76,7 @@ impl Arm {
         let mut flags = 0u8;
         for k in 0..3 {
             let (phase, outside) = self.joints[k].phase(counts[k]);
-            cos_sin[k] = self::cos_sin(phase);
+            cos_sin[k] = super::cos_sin::cos_sin(phase);
             flags |= (outside as u8) << k;
         }
         let [(ca, sa), (cb, sb), (cc, sc)] = cos_sin;

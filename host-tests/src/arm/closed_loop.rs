@@ -421,8 +421,9 @@ pub fn held_press(
     held_press_at(config, spec, body, hand, 0)
 }
 
-/// One encoder count at the probe, mm (a count of joint B or C near the middle of the
-/// workspace; docs/safety.md, "The probe's velocity").
+/// One encoder count at the probe, mm: joint C's, the forearm's 245 mm over its 24,000
+/// counts a turn (`arm_dynamics::the_count_at_the_probe_is_the_forearm_s` holds it to the
+/// device file; docs/safety.md, "The probe's velocity").
 pub const COUNT_AT_PROBE_MM: f64 = 0.064;
 
 /// The holds a hand's verdict takes: [`HOLD_DEPTH_MM`] and deeper by fifths of
