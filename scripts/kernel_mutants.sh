@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Shows that the bench firmware's kernel check (firmware/src/bin/bench/kernel_check.rs)
-# catches faults in the M4F's assembly loops (src/arith/wide_dsp/): puts one fault at a
-# time into a scratch worktree of HEAD, runs the M4F bench up to its KERNEL line and
-# prints `MUTANT <fault>: <n> of <states> states differ`; the last line counts the
-# faults caught. Not in the test command (about 10 s per fault once built; the first
-# build takes a minute or two). Usage: scripts/kernel_mutants.sh
+# Shows that the bench firmware's kernel and arm checks (firmware/src/bin/bench/
+# kernel_check.rs, arm_check.rs) catch faults in the M4F's assembly (the loops,
+# src/arith/wide_dsp/; the arm's pose, src/arm/pose_dsp.rs): puts one fault at a time
+# into a scratch worktree of HEAD, runs the M4F bench up to its KERNEL and ARMCHECK lines
+# and prints `MUTANT <fault>: <n> of <states> states differ` (poses for the arm's); the
+# last line counts the faults caught. Not in the test command (about 10 s per fault once
+# built; the first build takes a minute or two). Usage: scripts/kernel_mutants.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 T=thumbv7em-none-eabihf
@@ -16,7 +17,8 @@ trap 'git worktree remove --force "$work" >/dev/null 2>&1 || rm -rf "$work"' EXI
 git worktree add --detach "$work" HEAD >/dev/null
 build_decoder --quiet
 export CARGO_TARGET_DIR="$root/target/mutants"
-srcs=("$work/src/arith/wide_dsp/spring_loop.rs" "$work/src/arith/wide_dsp/integrate.rs")
+srcs=("$work/src/arith/wide_dsp/spring_loop.rs" "$work/src/arith/wide_dsp/integrate.rs"
+  "$work/src/arm/pose_dsp.rs")
 for f in "${srcs[@]}"; do cp "$f" "$f.orig"; done
 
 # name | text to replace (its first occurrence) | replacement
@@ -49,6 +51,14 @@ mutants=(
   "graded corner's strain difference reversed|sub r3, r3, r9\\n|sub r3, r9, r3\\n"
   "graded corner's line above never taken|blt 54b|b 54b"
   "b's velocity read one word off|ldrd r11, lr, [r4], #8|ldrd r11, lr, [r4, #4]!"
+  "pose: cos's upper point one word off|ldr r9, [r5, #1028]|ldr r9, [r5, #1024]"
+  "pose: sin's interpolation one bit high|add r3, r3, r8, asr #7|add r3, r3, r8, asr #6"
+  "pose: a phase's fraction one bit short|lsr r4, r4, #16|lsr r4, r4, #17"
+  "pose: the joints' range one phase off at its edge|\"sub r5, r4, r5\\n\",|\"sub r5, r4, r5\\n\", \"sub r5, r5, #1\\n\","
+  "pose: C's share of the reach dropped|smmla r10, r4, r3, r10|smmul r10, r4, r3"
+  "pose: C's share of the height added|sub lr, lr, r4|add lr, lr, r4"
+  "pose: the probe's hold one bit wider|ssat r4, #24, r3|ssat r4, #25, r3"
+  "pose: OUTSIDE never set|orrne r11, r11, #{outside}|orrne r11, r11, #0"
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)
@@ -71,10 +81,15 @@ EOF
   (cd "$work" && cargo build --quiet --release -p mccs-firmware --target $T --bin bench)
   line=$( (cd "$work" && timeout --foreground 300 cargo run --quiet --release -p mccs-firmware \
       --target $T --bin bench < /dev/null 2>/dev/null || true) \
-    | "$DECODER" "$CARGO_TARGET_DIR/$T/release/bench" | grep -m1 '^KERNEL' || true)
+    | "$DECODER" "$CARGO_TARGET_DIR/$T/release/bench" | grep -E '^(KERNEL|ARMCHECK) ' || true)
+  # The kernel's faults stop the bench at its KERNEL line; the pose's show in ARMCHECK.
+  case $name in
+    pose:*) line=$(grep '^ARMCHECK' <<< "$line" || true); what=poses ;;
+    *) line=$(grep -m1 '^KERNEL' <<< "$line" || true); what=states ;;
+  esac
   n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
-  of=$(sed -n 's/.*states=\([0-9]*\).*/\1/p' <<< "$line")
-  echo "MUTANT $name: ${n:-no KERNEL line, so none} of ${of:-the} states differ"
+  of=$(sed -n "s/.*$what=\([0-9]*\).*/\1/p" <<< "$line")
+  echo "MUTANT $name: ${n:-no check line, so none} of ${of:-the} $what differ"
   if [ -n "$n" ] && [ "$n" != 0 ]; then caught=$((caught + 1)); fi
 done
 echo "$caught of ${#mutants[@]} faults caught"

@@ -26,7 +26,7 @@ pub const AMPLITUDE: f64 = SCALE / 2_147_483_648.0;
 
 /// `round(sin(2π k / POINTS) · SCALE)` for `k` in `0 ..= POINTS + POINTS / 4`: a turn and
 /// a quarter, so that `cos` (a quarter on) reads it without a wrap.
-static SINE: [i32; POINTS + POINTS / 4 + 1] = {
+pub(super) static SINE: [i32; POINTS + POINTS / 4 + 1] = {
     let mut t = [0i32; POINTS + POINTS / 4 + 1];
     let mut k = 0;
     while k < t.len() {

@@ -35,6 +35,8 @@ pub mod cos_sin;
 mod drive;
 pub mod inverse;
 mod pose;
+#[cfg(mccs_dsp)]
+mod pose_dsp;
 pub mod recip;
 mod spec;
 pub mod stable_region;

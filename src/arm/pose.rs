@@ -16,8 +16,10 @@ pub const LIMITS: u8 = LIMIT_A | LIMIT_B | LIMIT_C;
 /// the tissue is not touched.
 pub const OUTSIDE: u8 = 8;
 
-/// The arm at one tick.
+/// The arm at one tick. `repr(C)`: the M4F's pose (`pose_dsp.rs`) stores its fields by
+/// their offsets, pairs of them at once.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct ArmPose {
     /// `(cos, sin)` of A, B, C, Q31.
     pub cos_sin: [(i32, i32); 3],
@@ -70,8 +72,18 @@ fn from_home(delta: i32, joint: &Joint) -> i32 {
 const HOLD_Q16: i32 = 1 << 23;
 
 impl Arm {
-    /// The arm at joint counts `counts` (A, B, C).
+    /// The arm at joint counts `counts` (A, B, C). On the M4F in assembly
+    /// (`pose_dsp.rs`), bit for bit [`Arm::pose_portable`], which every other core runs.
     pub fn pose(&self, counts: [i32; 3]) -> ArmPose {
+        #[cfg(mccs_dsp)]
+        return super::pose_dsp::pose(self, &counts);
+        #[cfg(not(mccs_dsp))]
+        self.pose_portable(counts)
+    }
+
+    /// [`Arm::pose`] in portable Rust: what the M3 and M0 (and the host) run, and what
+    /// the M4F's assembly must equal (public so that the bench firmware checks it).
+    pub fn pose_portable(&self, counts: [i32; 3]) -> ArmPose {
         let mut cos_sin = [(0i32, 0i32); 3];
         let mut flags = 0u8;
         for k in 0..3 {

@@ -21,6 +21,8 @@ mod fw_common;
 #[cfg(target_os = "none")]
 mod arm;
 #[cfg(target_os = "none")]
+mod arm_check;
+#[cfg(target_os = "none")]
 mod cases;
 #[cfg(target_os = "none")]
 mod harness;
@@ -43,7 +45,7 @@ mod firmware {
         budget_test_requested, budgets, check_budgets, fits, largest_patch, substep_case, Figures,
         Steps, SPRING_PATH_SPREAD,
     };
-    use super::{arm, cases, harness, hold_check, kernel_check, report, ticks};
+    use super::{arm, arm_check, cases, harness, hold_check, kernel_check, report, ticks};
     use cases::TablePath;
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -78,8 +80,9 @@ mod firmware {
         });
         let table: &ForceTable64 = black_box(&TABLE2);
         // The assembly against the Rust it replaces, before any figure: the M4F's spring
-        // loop and integrator, the M0's holds.
+        // loop, integrator and arm pose, the M0's holds.
         kernel_check::check(table);
+        arm_check::check();
         hold_check::check();
         budget_breach_if_asked(&h, table);
         let mut b = Bench {

@@ -1,0 +1,118 @@
+//! The M4F's arm pose is assembly (`mccs/src/arm/pose_dsp.rs`); this checks it against
+//! the portable Rust it replaces ([`mccs::Arm::pose_portable`]), bit for bit (every field:
+//! the `cos`/`sin`, the reach, the device frame, the probe and the flags), on the core
+//! itself, before anything is measured.
+//!
+//! The arms: the WoodenHaptics arm (`WOODENHAPTICS`), then variants at the ends of what
+//! `ArmSpec::validate` allows: every joint's sign reversed and its home moved (count and
+//! angle), 16 counts a joint turn (the coarsest; its ranges ±90°, four counts exactly, so
+//! that the limit's compare is met at its edge) and 2³⁰ (the finest: the fraction of a
+//! phase per count in use), 1,000 mm links with the tissue's origin 2,000 mm off in every
+//! axis (the probe held at ±128 mm, `OUTSIDE`), and the narrowest and widest ranges
+//! (every count outside, then none). The counts: random at every magnitude from 2⁰ to
+//! 2³¹ (the phase wraps), within a turn of home, and each joint's range's ends ± 2.
+//! Prints `ARMCHECK core=<c> arms=<n> poses=<n> mismatches=<n>`; a mismatch exits with
+//! failure. On the M4F only: elsewhere both sides are the same function.
+
+use super::fw_common::exit;
+use super::rng::Rng;
+use mccs::{Arm, ArmSpec};
+use mccs_firmware::arm::device::WOODENHAPTICS;
+use mccs_firmware::target::{Core, CORE};
+
+/// Random poses per arm.
+const POSES: u32 = 3_000;
+
+/// The arms checked ([module docs](self)).
+fn arms() -> [ArmSpec; 6] {
+    let base = WOODENHAPTICS;
+    let mut reversed = base;
+    for (k, j) in reversed.joints.iter_mut().enumerate() {
+        j.sign = -1.0;
+        j.home_count = [-5_000, 77, 123_456][k];
+        j.home_angle_deg = [10.0, -20.0, 45.0][k];
+    }
+    let mut coarse = base;
+    let mut fine = base;
+    for (c, f) in coarse.joints.iter_mut().zip(fine.joints.iter_mut()) {
+        (c.counts_per_rev, c.ratio) = (4.0, 4.0);
+        // Ends a whole number of counts from home, each phase exact: the limit's
+        // compare decides at its very edge.
+        (c.min_angle_deg, c.max_angle_deg) = (-90.0, 90.0);
+        (f.counts_per_rev, f.ratio) = (65_536.0, 16_384.0);
+    }
+    let mut long = base;
+    long.upper_arm_mm = 1_000.0;
+    long.forearm_mm = 1_000.0;
+    long.base_height_mm = 1_000.0;
+    long.tissue_origin_mm = [-2_000.0, 2_000.0, -2_000.0];
+    let mut narrow = base;
+    let mut wide = base;
+    for (n, w) in narrow.joints.iter_mut().zip(wide.joints.iter_mut()) {
+        (n.min_angle_deg, n.max_angle_deg) = (-0.01, 0.01);
+        (w.min_angle_deg, w.max_angle_deg) = (-179.0, 179.0);
+    }
+    [reversed, coarse, fine, long, narrow, wide]
+}
+
+/// Runs the check and exits with failure on a mismatch.
+#[inline(never)]
+pub fn check() {
+    if CORE == Core::M4F {
+        run();
+    }
+}
+
+/// The check itself.
+#[inline(never)]
+fn run() {
+    let mut rng = Rng(0x1B87_3593);
+    let (mut poses, mut mismatches, mut arms_checked) = (0u32, 0u32, 0u32);
+    for spec in [WOODENHAPTICS].into_iter().chain(arms()) {
+        let Ok(arm) = Arm::new(&spec) else {
+            exit(false)
+        };
+        arms_checked += 1;
+        let home = arm.home_counts();
+        let mut one = |counts: [i32; 3]| {
+            poses += 1;
+            mismatches += (arm.pose(counts) != arm.pose_portable(counts)) as u32;
+        };
+        // Each joint's range's ends (in counts, from the spec), ± 2, the others at home.
+        for (k, j) in spec.joints.iter().enumerate() {
+            let per_degree = j.counts_per_rev * j.ratio / 360.0 * j.sign;
+            for angle in [j.min_angle_deg, j.max_angle_deg] {
+                let at = j.home_count as f64 + (angle - j.home_angle_deg) * per_degree;
+                for d in -2..=2 {
+                    let mut counts = home;
+                    counts[k] = (at as i32).wrapping_add(d);
+                    one(counts);
+                }
+            }
+        }
+        let turn = (spec.joints[0].counts_per_rev * spec.joints[0].ratio) as i32;
+        for i in 0..POSES {
+            let counts = core::array::from_fn(|k| {
+                if i % 2 == 0 {
+                    // Every magnitude, the phase wrapping.
+                    let x = rng.next();
+                    (x as i32) >> (x & 31)
+                } else {
+                    // Within a turn of home.
+                    home[k].wrapping_add((rng.next() % (2 * turn.max(1) as u32)) as i32 - turn)
+                }
+            });
+            one(counts);
+        }
+    }
+    defmt::println!(
+        "ARMCHECK core={=str} arms={=u32} poses={=u32} mismatches={=u32}",
+        CORE.name(),
+        arms_checked,
+        poses,
+        mismatches
+    );
+    if mismatches != 0 {
+        exit(false)
+    }
+}
