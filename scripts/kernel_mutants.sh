@@ -58,7 +58,7 @@ mutants=(
   "pose: C's share of the reach dropped|smmla r10, r4, r3, r10|smmul r10, r4, r3"
   "pose: C's share of the height added|sub lr, lr, r4|add lr, lr, r4"
   "pose: the probe's hold one bit wider|ssat r4, #24, r3|ssat r4, #25, r3"
-  "pose: OUTSIDE never set|orrne r11, r11, #{outside}|orrne r11, r11, #0"
+  "pose: OUTSIDE never set|orrne r11, r11, #{outside}|orrne r11, r11, #({outside} & 0)"
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)
