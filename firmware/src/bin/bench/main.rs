@@ -31,6 +31,8 @@ mod hold_check;
 #[cfg(target_os = "none")]
 mod kernel_check;
 #[cfg(target_os = "none")]
+mod peer_patch;
+#[cfg(target_os = "none")]
 mod report;
 #[cfg(target_os = "none")]
 mod rng;
@@ -45,7 +47,9 @@ mod firmware {
         budget_test_requested, budgets, check_budgets, fits, largest_patch, substep_case, Figures,
         Steps, SPRING_PATH_SPREAD,
     };
-    use super::{arm, arm_check, cases, harness, hold_check, kernel_check, report, ticks};
+    use super::{
+        arm, arm_check, cases, harness, hold_check, kernel_check, peer_patch, report, ticks,
+    };
     use cases::TablePath;
     use core::hint::black_box;
     use cortex_m_rt::entry;
@@ -101,6 +105,8 @@ mod firmware {
         b.memory();
         fits(&b.figs, &steps);
         largest_patch(&b.figs, &steps);
+        // The f32 and f64 peers' largest patches beside it, on the same substeps.
+        peer_patch::largest_patches(&b.h, &steps, table, empty);
         largest_patch(&b.figs, &Steps::new(table, Integrator::SymplecticDamped));
         let ok = check_budgets(&b.figs, budgets(false));
         exit(ok)
