@@ -18,7 +18,7 @@ pub const OUTSIDE: u8 = 8;
 
 /// The arm at one tick. `repr(C)`: the M4F's pose (`pose_dsp.rs`) stores its fields by
 /// their offsets, pairs of them at once.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(C)]
 pub struct ArmPose {
     /// `(cos, sin)` of A, B, C, Q31.
@@ -79,6 +79,17 @@ impl Arm {
         return super::pose_dsp::pose(self, &counts);
         #[cfg(not(mccs_dsp))]
         self.pose_portable(counts)
+    }
+
+    /// [`Arm::pose`] written into `out`: on the M4F the assembly stores its fields there
+    /// (where a returned pose is stored by a copy after it).
+    pub fn pose_into(&self, counts: [i32; 3], out: &mut ArmPose) {
+        #[cfg(mccs_dsp)]
+        super::pose_dsp::pose_into(self, &counts, out);
+        #[cfg(not(mccs_dsp))]
+        {
+            *out = self.pose_portable(counts);
+        }
     }
 
     /// [`Arm::pose`] in portable Rust: what the M3 and M0 (and the host) run, and what

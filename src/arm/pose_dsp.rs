@@ -115,14 +115,37 @@ macro_rules! probe_axis {
     };
 }
 
+/// [`Arm::pose_portable`] in assembly, written into `out` (the caller's pose, with no
+/// copy after).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn pose_into(arm: &Arm, counts: &[i32; 3], out: &mut ArmPose) {
+    // SAFETY: `out` is a pose, valid for writes.
+    unsafe { write(arm, counts, out) }
+}
+
 /// [`Arm::pose_portable`] in assembly.
 #[inline(always)]
 #[allow(unsafe_code)]
 pub(super) fn pose(arm: &Arm, counts: &[i32; 3]) -> ArmPose {
     let mut pose = MaybeUninit::<ArmPose>::uninit();
+    // SAFETY: `write` writes every field of the pose.
+    unsafe {
+        write(arm, counts, pose.as_mut_ptr());
+        pose.assume_init()
+    }
+}
+
+/// The pose at `counts` written into `*out`.
+///
+/// # Safety
+/// `out` must be valid for writes of an [`ArmPose`].
+#[inline(always)]
+#[allow(unsafe_code)]
+unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
     // SAFETY: reads `arm`, `counts` and the table `SINE` (at the index `phase >> 22`
     // and 1, 256 and 257 points on: at most 1,024 + 257 < its 1,281 points) at the offsets
-    // asserted above and given by `offset_of!`; writes every field of `pose` (its six
+    // asserted above and given by `offset_of!`; writes every field of `*out` (its six
     // `cos`/`sin`, the reach, the device frame's three, the probe's three and the flags)
     // and nothing else. Every register it writes is declared; the stack is untouched.
     unsafe {
@@ -177,7 +200,7 @@ pub(super) fn pose(arm: &Arm, counts: &[i32; 3]) -> ArmPose {
             outside = const super::pose::OUTSIDE,
             in("r0") core::ptr::from_ref(arm),
             in("r1") counts.as_ptr(),
-            in("r2") pose.as_mut_ptr(),
+            in("r2") out,
             out("r3") _,
             out("r4") _,
             out("r5") _,
@@ -189,6 +212,5 @@ pub(super) fn pose(arm: &Arm, counts: &[i32; 3]) -> ArmPose {
             out("lr") _,
             options(nostack),
         );
-        pose.assume_init()
     }
 }

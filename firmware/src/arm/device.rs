@@ -393,28 +393,31 @@ impl<A: Joint, B: Joint, C: Joint, EN: OutputPin, HOME: InputPin> HapticDevice
             deltas = [0; 3];
             self.runaway.forget_probe();
         }
-        let pose = self.arm.pose(counts);
-        self.pose = Some(pose);
+        // The pose written where it is kept (on the M4F the assembly stores it there; a
+        // returned pose took a copy of its 14 words after).
+        let pose = self.pose.get_or_insert_with(ArmPose::default);
+        self.arm.pose_into(counts, pose);
+        let (probe, flags) = (pose.probe, pose.flags);
         if self.homed {
             // (Before homing the counts mean nothing and every duty is zero.)
-            self.runaway.check(deltas, pose.probe)?;
+            self.runaway.check(deltas, probe)?;
             if !settled {
                 self.check_direction(counts)?;
             }
         }
-        let below = pose.probe[2] < Length::ZERO;
-        if pose.flags & OUTSIDE != 0 || settled {
+        let below = probe[2] < Length::ZERO;
+        if flags & OUTSIDE != 0 || settled {
             // Beyond the tissue's frame (or just homed): no contact, and none on coming
             // into it below the surface.
             self.below_entry |= below;
         } else if !below {
             self.below_entry = false;
         }
-        if pose.flags & OUTSIDE != 0 || self.below_entry || !self.direction_checked {
+        if flags & OUTSIDE != 0 || self.below_entry || !self.direction_checked {
             // Far above the tissue: no contact (nor before the direction check passes).
             return Ok([Length::ZERO, Length::ZERO, Length::MAX]);
         }
-        Ok(pose.probe)
+        Ok(probe)
     }
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), ArmFault> {

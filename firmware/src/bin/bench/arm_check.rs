@@ -1,5 +1,6 @@
-//! The M4F's arm pose is assembly (`mccs/src/arm/pose_dsp.rs`); this checks it against
-//! the portable Rust it replaces ([`mccs::Arm::pose_portable`]), bit for bit (every field:
+//! The M4F's arm pose is assembly (`mccs/src/arm/pose_dsp.rs`); this checks it, returned
+//! (`Arm::pose`) and written over the last pose (`Arm::pose_into`), against the portable
+//! Rust it replaces ([`mccs::Arm::pose_portable`]), bit for bit (every field:
 //! the `cos`/`sin`, the reach, the device frame, the probe and the flags), on the core
 //! itself, before anything is measured.
 //!
@@ -16,7 +17,7 @@
 
 use super::fw_common::exit;
 use super::rng::Rng;
-use mccs::{Arm, ArmSpec};
+use mccs::{Arm, ArmPose, ArmSpec};
 use mccs_firmware::arm::device::WOODENHAPTICS;
 use mccs_firmware::target::{Core, CORE};
 
@@ -74,9 +75,13 @@ fn run() {
         };
         arms_checked += 1;
         let home = arm.home_counts();
+        // `pose_into` writes over the last pose: a field it left would show.
+        let mut into = ArmPose::default();
         let mut one = |counts: [i32; 3]| {
             poses += 1;
-            mismatches += (arm.pose(counts) != arm.pose_portable(counts)) as u32;
+            let portable = arm.pose_portable(counts);
+            arm.pose_into(counts, &mut into);
+            mismatches += (arm.pose(counts) != portable || into != portable) as u32;
         };
         // Each joint's range's ends (in counts, from the spec), ± 2, the others at home.
         for (k, j) in spec.joints.iter().enumerate() {
