@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Shows that the bench firmware's kernel and arm checks (firmware/src/bin/bench/
 # kernel_check.rs, arm_check.rs) catch faults in the M4F's assembly (the loops,
-# src/arith/wide_dsp/; the arm's pose, src/arm/pose_dsp.rs): puts one fault at a time
-# into a scratch worktree of HEAD, runs the M4F bench up to its KERNEL and ARMCHECK lines
-# and prints `MUTANT <fault>: <n> of <states> states differ` (poses for the arm's); the
-# last line counts the faults caught. Not in the test command (about 10 s per fault once
-# built; the first build takes a minute or two). Usage: scripts/kernel_mutants.sh
+# src/arith/wide_dsp/; the arm's pose and drive, src/arm/pose_dsp.rs and drive_dsp.rs):
+# puts one fault at a time into a scratch worktree of HEAD, runs the M4F bench up to its
+# KERNEL and ARMCHECK lines and prints `MUTANT <fault>: <n> of <states> states differ`
+# (poses for the arm's); the last line counts the faults caught. Not in the test command
+# (about 25 s per fault once built; the first build takes a minute or two).
+# Usage: scripts/kernel_mutants.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 T=thumbv7em-none-eabihf
@@ -18,7 +19,7 @@ git worktree add --detach "$work" HEAD >/dev/null
 build_decoder --quiet
 export CARGO_TARGET_DIR="$root/target/mutants"
 srcs=("$work/src/arith/wide_dsp/spring_loop.rs" "$work/src/arith/wide_dsp/integrate.rs"
-  "$work/src/arm/pose_dsp.rs")
+  "$work/src/arm/pose_dsp.rs" "$work/src/arm/drive_dsp.rs")
 for f in "${srcs[@]}"; do cp "$f" "$f.orig"; done
 
 # name | text to replace (its first occurrence) | replacement
@@ -58,7 +59,13 @@ mutants=(
   "pose: C's share of the reach dropped|smmla r10, r4, r3, r10|smmul r10, r4, r3"
   "pose: C's share of the height added|sub lr, lr, r4|add lr, lr, r4"
   "pose: the probe's hold one bit wider|ssat r4, #24, r3|ssat r4, #25, r3"
-  "pose: OUTSIDE never set|orrne r11, r11, #{outside}|orrne r11, r11, #({outside} & 0)"
+  "pose: OUTSIDE read from the V flag, not Q|ubfx r3, r3, #27, #1|ubfx r3, r3, #28, #1"
+  "drive: A's torque shifted one bit short|lsr r8, r8, #27|lsr r8, r8, #26"
+  "drive: v's difference reversed|sub r10, r10, r11|sub r10, r11, r10"
+  "drive: a duty's overflow check one bit short|cmp r8, r5, asr #31\\n|cmp r8, r5, asr #30\\n"
+  "drive: a saturated duty's value one bit off|eorne r5, r5, #0x80000000\\n|eorne r5, r5, #0x40000000\\n"
+  "drive: a duty's shift down logical|asr r5, r5, r9\\n|lsr r5, r5, r9\\n"
+  "drive: 100 % offset halved in the scaling's check|add r4, r5, #0x10000\\n|add r4, r5, #0x8000\\n"
 )
 echo "... building the M4F bench once in a scratch worktree (a minute or two from clean)" >&2
 (cd "$work" && cargo build --release -p mccs-firmware --target $T --bin bench)
@@ -82,9 +89,9 @@ EOF
   line=$( (cd "$work" && timeout --foreground 300 cargo run --quiet --release -p mccs-firmware \
       --target $T --bin bench < /dev/null 2>/dev/null || true) \
     | "$DECODER" "$CARGO_TARGET_DIR/$T/release/bench" | grep -E '^(KERNEL|ARMCHECK) ' || true)
-  # The kernel's faults stop the bench at its KERNEL line; the pose's show in ARMCHECK.
+  # The kernel's faults stop the bench at its KERNEL line; the arm's show in ARMCHECK.
   case $name in
-    pose:*) line=$(grep '^ARMCHECK' <<< "$line" || true); what=poses ;;
+    pose:* | drive:*) line=$(grep '^ARMCHECK' <<< "$line" || true); what=poses ;;
     *) line=$(grep -m1 '^KERNEL' <<< "$line" || true); what=states ;;
   esac
   n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")

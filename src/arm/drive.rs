@@ -17,7 +17,7 @@ pub struct Drive {
 }
 
 /// 100 % duty, Q16.
-const FULL_DUTY_Q16: i32 = 1 << 16;
+pub(super) const FULL_DUTY_Q16: i32 = 1 << 16;
 
 /// `m · up` (`up` a power of two, `limit` = `i32::MAX / up`), saturated at the ends of
 /// `i32`: a compare each way and a product (a saturating product is a long one).
@@ -34,8 +34,29 @@ fn mul_saturating(m: i32, up: i32, limit: i32) -> i32 {
 
 impl Arm {
     /// The duties that render `force` (N, tissue frame: all of `Force`'s ±2,048 N) at
-    /// `pose`.
+    /// `pose`. On the M4F its every-tick part in assembly (`drive_dsp.rs`), bit for bit
+    /// [`Arm::drive_portable`], which every other core runs.
     pub fn drive(&self, pose: &ArmPose, force: [Force; 3]) -> Drive {
+        #[cfg(mccs_dsp)]
+        {
+            let mut drive = Drive {
+                torque_q8: [0; 3],
+                duty_q16: [0; 3],
+                scaled: false,
+            };
+            if super::drive_dsp::torques_and_duties(self, pose, &force, &mut drive) {
+                drive.duty_q16 = scale_to_full(drive.duty_q16);
+                drive.scaled = true;
+            }
+            drive
+        }
+        #[cfg(not(mccs_dsp))]
+        self.drive_portable(pose, force)
+    }
+
+    /// [`Arm::drive`] in portable Rust: what the M3 and M0 (and the host) run, and what
+    /// the M4F's assembly must equal (public so that the bench firmware checks it).
+    pub fn drive_portable(&self, pose: &ArmPose, force: [Force; 3]) -> Drive {
         let [(ca, sa), (cb, sb), (cc, sc)] = pose.cos_sin;
         // Q19 N: each product below within half of `i32`, so that two sum within it.
         let [fx, fy, fz] = force.map(|f| f.to_bits() >> 1);

@@ -33,6 +33,8 @@
 
 pub mod cos_sin;
 mod drive;
+#[cfg(mccs_dsp)]
+mod drive_dsp;
 pub mod inverse;
 mod pose;
 #[cfg(mccs_dsp)]

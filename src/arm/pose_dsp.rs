@@ -20,6 +20,8 @@ use super::cos_sin::SINE;
 use super::{Arm, ArmPose, Joint};
 use core::mem::{offset_of, size_of, MaybeUninit};
 
+// OUTSIDE is the flag's bit 3, where the Q flag's read puts it.
+const _: () = assert!(super::pose::OUTSIDE == 1 << 3);
 // The stores pair words (`strd`), which needs each pair's layout: `(cos, sin)` as two
 // consecutive words, and `reach_q17` then `device_q16` (`ArmPose` is `repr(C)`).
 const _: () = assert!(offset_of!((i32, i32), 0) == 0 && offset_of!((i32, i32), 1) == 4);
@@ -92,8 +94,9 @@ macro_rules! joint {
 }
 
 /// The probe's axis at byte offset `$k` of the device frame (its value in `$reg`): less
-/// the origin, held to ±2²³ (Q16: ±128 mm) with [`super::pose::OUTSIDE`] set in r11
-/// where that changed it, shifted to the core's `Length` (Q24) and stored.
+/// the origin, held to ±2²³ (Q16: ±128 mm) by `ssat`, which sets the sticky Q flag where
+/// that changed it (cleared at the start, read into [`super::pose::OUTSIDE`] at the end),
+/// shifted to the core's `Length` (Q24) and stored.
 macro_rules! probe_axis {
     ($reg:literal, $k:literal) => {
         concat!(
@@ -104,9 +107,6 @@ macro_rules! probe_axis {
             $reg,
             ", r3\n",
             "ssat r4, #24, r3\n",
-            "cmp r4, r3\n",
-            "it ne\n",
-            "orrne r11, r11, #{outside}\n",
             "lsl r4, r4, #8\n",
             "str r4, [r2, #({probe} + ",
             $k,
@@ -153,6 +153,8 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
             "movw r12, :lower16:{sine}",
             "movt r12, :upper16:{sine}",
             "mov r11, #0",
+            // Q cleared (and the other flags, which nothing reads): the probe's holds set it.
+            "msr APSR_nzcvq, r11",
             // B: reach = hi(upper_q18, sB) in r10, height = base + hi(upper_q17, cB) in lr.
             joint!("{joint_b}", "4", "2", "{cs} + 8"),
             "ldr r4, [r0, #{upper_q18}]",
@@ -176,6 +178,10 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
             probe_axis!("r8", "0"),
             probe_axis!("r9", "4"),
             probe_axis!("lr", "8"),
+            // OUTSIDE (bit 3) from Q (APSR bit 27).
+            "mrs r3, APSR",
+            "ubfx r3, r3, #27, #1",
+            "orr r11, r11, r3, lsl #3",
             "strb r11, [r2, #{flags}]",
             sine = sym SINE,
             home_count = const offset_of!(Joint, home_count),
@@ -197,7 +203,6 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
             reach = const offset_of!(ArmPose, reach_q17),
             probe = const offset_of!(ArmPose, probe),
             flags = const offset_of!(ArmPose, flags),
-            outside = const super::pose::OUTSIDE,
             in("r0") core::ptr::from_ref(arm),
             in("r1") counts.as_ptr(),
             in("r2") out,

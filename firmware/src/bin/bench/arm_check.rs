@@ -10,14 +10,20 @@
 //! that the limit's compare is met at its edge) and 2³⁰ (the finest: the fraction of a
 //! phase per count in use), 1,000 mm links with the tissue's origin 2,000 mm off in every
 //! axis (the probe held at ±128 mm, `OUTSIDE`), and the narrowest and widest ranges
-//! (every count outside, then none). The counts: random at every magnitude from 2⁰ to
+//! (every count outside, then none), and motors so weak that every duty's gain saturates
+//! its product and so strong that it shifts down, and masses near the gravity terms'
+//! limit. The counts: random at every magnitude from 2⁰ to
 //! 2³¹ (the phase wraps), within a turn of home, and each joint's range's ends ± 2.
-//! Prints `ARMCHECK core=<c> arms=<n> poses=<n> mismatches=<n>`; a mismatch exits with
-//! failure. On the M4F only: elsewhere both sides are the same function.
+//! At each pose, the drive (`Arm::drive` against `Arm::drive_portable`) at a random force
+//! of any magnitude up to `Force`'s ±2,048 N; at 20 poses an arm, 500 forces across all
+//! of that range; and at 24 poses an arm, on a random
+//! direction, the forces each side of where the duties come to be scaled (found by
+//! halving), two steps beyond. Prints `ARMCHECK core=<c> arms=<n> poses=<n>
+//! full_forces=<n> scale_edges=<n> mismatches=<n>`; a mismatch exits with failure. On the M4F only: elsewhere both sides are the same function.
 
 use super::fw_common::exit;
 use super::rng::Rng;
-use mccs::{Arm, ArmPose, ArmSpec};
+use mccs::{Arm, ArmPose, ArmSpec, Force};
 use mccs_firmware::arm::device::WOODENHAPTICS;
 use mccs_firmware::target::{Core, CORE};
 
@@ -25,7 +31,7 @@ use mccs_firmware::target::{Core, CORE};
 const POSES: u32 = 3_000;
 
 /// The arms checked ([module docs](self)).
-fn arms() -> [ArmSpec; 6] {
+fn arms() -> [ArmSpec; 9] {
     let base = WOODENHAPTICS;
     let mut reversed = base;
     for (k, j) in reversed.joints.iter_mut().enumerate() {
@@ -53,7 +59,55 @@ fn arms() -> [ArmSpec; 6] {
         (n.min_angle_deg, n.max_angle_deg) = (-0.01, 0.01);
         (w.min_angle_deg, w.max_angle_deg) = (-179.0, 179.0);
     }
-    [reversed, coarse, fine, long, narrow, wide]
+    // Motors so weak that each duty's gain takes the most shifts up (its product
+    // saturates), and so strong that it takes shifts down.
+    let mut weak = base;
+    let mut strong = base;
+    for (w, s) in weak.joints.iter_mut().zip(strong.joints.iter_mut()) {
+        (
+            w.torque_constant_nm_per_a,
+            w.max_current_a,
+            w.continuous_current_a,
+        ) = (1e-6, 1e-3, 1e-3);
+        (
+            s.torque_constant_nm_per_a,
+            s.max_current_a,
+            s.continuous_current_a,
+        ) = (50.0, 500.0, 1.0);
+    }
+    // Masses near the gravity terms' limit (32,768 N·mm at the shoulder).
+    let mut heavy = base;
+    heavy.gravity = Some(mccs::GravitySpec {
+        upper_arm_mass_kg: 8.0,
+        upper_arm_com_mm: 300.0,
+        forearm_mass_kg: 4.0,
+        forearm_com_mm: 300.0,
+        g: 9.81,
+    });
+    [
+        reversed, coarse, fine, long, narrow, wide, weak, strong, heavy,
+    ]
+}
+
+/// Random poses an arm at which the drive takes forces across `Force`'s whole range, and
+/// the forces at each.
+const WIDE_POSES: u32 = 20;
+const WIDE_FORCES: u32 = 500;
+
+/// Random poses whose duties are checked where they come to be scaled, per arm.
+const EDGES: u32 = 24;
+
+/// A force at every magnitude up to all of `Force`'s ±2,048 N, each axis its own.
+fn force(rng: &mut Rng) -> [Force; 3] {
+    core::array::from_fn(|_| {
+        let x = rng.next();
+        Force::from_bits((rng.next() as i32) >> (x & 31))
+    })
+}
+
+/// Whether the drive differs from the portable one at `pose` and `force`.
+fn differs(arm: &Arm, pose: &ArmPose, force: [Force; 3]) -> bool {
+    arm.drive(pose, force) != arm.drive_portable(pose, force)
 }
 
 /// Runs the check and exits with failure on a mismatch.
@@ -69,6 +123,7 @@ pub fn check() {
 fn run() {
     let mut rng = Rng(0x1B87_3593);
     let (mut poses, mut mismatches, mut arms_checked) = (0u32, 0u32, 0u32);
+    let (mut edges, mut wide) = (0u32, 0u32);
     for spec in [WOODENHAPTICS].into_iter().chain(arms()) {
         let Ok(arm) = Arm::new(&spec) else {
             exit(false)
@@ -77,11 +132,12 @@ fn run() {
         let home = arm.home_counts();
         // `pose_into` writes over the last pose: a field it left would show.
         let mut into = ArmPose::default();
-        let mut one = |counts: [i32; 3]| {
+        let mut one = |counts: [i32; 3], force: [Force; 3]| {
             poses += 1;
             let portable = arm.pose_portable(counts);
             arm.pose_into(counts, &mut into);
             mismatches += (arm.pose(counts) != portable || into != portable) as u32;
+            mismatches += differs(&arm, &portable, force) as u32;
         };
         // Each joint's range's ends (in counts, from the spec), ± 2, the others at home.
         for (k, j) in spec.joints.iter().enumerate() {
@@ -91,7 +147,7 @@ fn run() {
                 for d in -2..=2 {
                     let mut counts = home;
                     counts[k] = (at as i32).wrapping_add(d);
-                    one(counts);
+                    one(counts, force(&mut rng));
                 }
             }
         }
@@ -107,14 +163,55 @@ fn run() {
                     home[k].wrapping_add((rng.next() % (2 * turn.max(1) as u32)) as i32 - turn)
                 }
             });
-            one(counts);
+            one(counts, force(&mut rng));
+        }
+        // Forces across all of `Force`'s range (the most scaled duties, the weak arm's
+        // saturated products).
+        for _ in 0..WIDE_POSES {
+            let counts = core::array::from_fn(|k| {
+                home[k].wrapping_add((rng.next() % (turn.max(1) as u32)) as i32 - turn / 2)
+            });
+            let pose = arm.pose_portable(counts);
+            for _ in 0..WIDE_FORCES {
+                let f = core::array::from_fn(|_| Force::from_bits(rng.next() as i32));
+                wide += 1;
+                mismatches += differs(&arm, &pose, f) as u32;
+            }
+        }
+        // Where the duties come to be scaled, each side of it.
+        for _ in 0..EDGES {
+            let counts = core::array::from_fn(|k| {
+                home[k].wrapping_add((rng.next() % (turn.max(1) as u32)) as i32 - turn / 2)
+            });
+            let pose = arm.pose_portable(counts);
+            let dir: [i32; 3] = core::array::from_fn(|_| (rng.next() % 3) as i32 - 1);
+            let at = |s: i32| dir.map(|d| Force::from_bits(d.wrapping_mul(s)));
+            let scaled = |s: i32| arm.drive_portable(&pose, at(s)).scaled;
+            let (mut lo, mut hi) = (0, i32::MAX);
+            if scaled(lo) || !scaled(hi) {
+                continue;
+            }
+            while hi - lo > 1 {
+                let mid = lo + ((hi - lo) >> 1);
+                if scaled(mid) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            for s in lo.saturating_sub(2)..=hi.saturating_add(2) {
+                edges += 1;
+                mismatches += differs(&arm, &pose, at(s)) as u32;
+            }
         }
     }
     defmt::println!(
-        "ARMCHECK core={=str} arms={=u32} poses={=u32} mismatches={=u32}",
+        "ARMCHECK core={=str} arms={=u32} poses={=u32} full_forces={=u32} scale_edges={=u32} mismatches={=u32}",
         CORE.name(),
         arms_checked,
         poses,
+        wide,
+        edges,
         mismatches
     );
     if mismatches != 0 {
