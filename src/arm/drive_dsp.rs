@@ -61,6 +61,39 @@ macro_rules! duty {
     };
 }
 
+/// Joint B's or C's torque into `$out`: `($len · (hi(c, u) $op hi(s, fz))) >> 26` and
+/// `hi($gravity, s) >> 7` joined by `$sat` (`qsub` for B, whose term is the negative,
+/// `qadd` for C), its `(cos, sin)` at byte `$cs` of the pose's. Reads r0 (the arm), r1
+/// (the pose), r2 (u), lr (fz); writes r4, r5, r8, r9.
+macro_rules! upper_joint {
+    ($cs:literal, $op:literal, $len:literal, $gravity:literal, $sat:literal, $out:literal) => {
+        concat!(
+            "ldrd r8, r9, [r1, #({cs} + ",
+            $cs,
+            ")]\n",
+            "smmul r4, r8, r2\n",
+            "smmul r5, r9, lr\n",
+            $op,
+            " r4, r4, r5\n",
+            "ldr r5, [r0, #",
+            $len,
+            "]\n",
+            "smull r4, r5, r5, r4\n",
+            "lsr r4, r4, #26\n",
+            "orr r4, r4, r5, lsl #6\n",
+            "ldr r5, [r0, #",
+            $gravity,
+            "]\n",
+            "smmul r5, r5, r9\n",
+            "asr r5, r5, #7\n",
+            $sat,
+            " ",
+            $out,
+            ", r4, r5\n",
+        )
+    };
+}
+
 /// `Jᵀ F` plus gravity, the three torques and duties into `out`; whether any duty passes
 /// 100 % (then `out`'s duties are to be scaled).
 #[inline(always)]
@@ -96,33 +129,10 @@ pub(super) fn torques_and_duties(
             "lsr r8, r8, #27",
             "orr r12, r8, r9, lsl #5",
             // B: (upper · (hi(cB, u) − hi(sB, fz))) >> 26, less hi(gravity_b, sB) >> 7
-            // saturating, in r11.
-            "ldrd r8, r9, [r1, #({cs} + 8)]",
-            "smmul r4, r8, r2",
-            "smmul r5, r9, lr",
-            "sub r4, r4, r5",
-            "ldr r5, [r0, #{upper_q17}]",
-            "smull r4, r5, r5, r4",
-            "lsr r4, r4, #26",
-            "orr r4, r4, r5, lsl #6",
-            "ldr r5, [r0, #{gravity_b}]",
-            "smmul r5, r5, r9",
-            "asr r5, r5, #7",
-            "qsub r11, r4, r5",
-            // C: (fore · (hi(cC, u) + hi(sC, fz))) >> 26, plus hi(gravity_c, sC) >> 7
-            // saturating, in r10.
-            "ldrd r8, r9, [r1, #({cs} + 16)]",
-            "smmul r4, r8, r2",
-            "smmul r5, r9, lr",
-            "add r4, r4, r5",
-            "ldr r5, [r0, #{fore_q17}]",
-            "smull r4, r5, r5, r4",
-            "lsr r4, r4, #26",
-            "orr r4, r4, r5, lsl #6",
-            "ldr r5, [r0, #{gravity_c}]",
-            "smmul r5, r5, r9",
-            "asr r5, r5, #7",
-            "qadd r10, r4, r5",
+            // saturating, in r11; C: (fore · (hi(cC, u) + hi(sC, fz))) >> 26, plus
+            // hi(gravity_c, sC) >> 7 saturating, in r10.
+            upper_joint!("8", "sub", "{upper_q17}", "{gravity_b}", "qsub", "r11"),
+            upper_joint!("16", "add", "{fore_q17}", "{gravity_c}", "qadd", "r10"),
             "strd r12, r11, [r3, #{torque}]",
             "str r10, [r3, #({torque} + 8)]",
             // The duties; the largest offset value (unsigned) in r1.

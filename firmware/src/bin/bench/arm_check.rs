@@ -118,103 +118,132 @@ pub fn check() {
     }
 }
 
+/// What the check did, and how often the assembly differed.
+#[derive(Default)]
+struct Tally {
+    arms: u32,
+    poses: u32,
+    full_forces: u32,
+    scale_edges: u32,
+    mismatches: u32,
+}
+
 /// The check itself.
 #[inline(never)]
 fn run() {
     let mut rng = Rng(0x1B87_3593);
-    let (mut poses, mut mismatches, mut arms_checked) = (0u32, 0u32, 0u32);
-    let (mut edges, mut wide) = (0u32, 0u32);
+    let mut t = Tally::default();
     for spec in [WOODENHAPTICS].into_iter().chain(arms()) {
         let Ok(arm) = Arm::new(&spec) else {
             exit(false)
         };
-        arms_checked += 1;
-        let home = arm.home_counts();
-        // `pose_into` writes over the last pose: a field it left would show.
-        let mut into = ArmPose::default();
-        let mut one = |counts: [i32; 3], force: [Force; 3]| {
-            poses += 1;
-            let portable = arm.pose_portable(counts);
-            arm.pose_into(counts, &mut into);
-            mismatches += (arm.pose(counts) != portable || into != portable) as u32;
-            mismatches += differs(&arm, &portable, force) as u32;
-        };
-        // Each joint's range's ends (in counts, from the spec), ± 2, the others at home.
-        for (k, j) in spec.joints.iter().enumerate() {
-            let per_degree = j.counts_per_rev * j.ratio / 360.0 * j.sign;
-            for angle in [j.min_angle_deg, j.max_angle_deg] {
-                let at = j.home_count as f64 + (angle - j.home_angle_deg) * per_degree;
-                for d in -2..=2 {
-                    let mut counts = home;
-                    counts[k] = (at as i32).wrapping_add(d);
-                    one(counts, force(&mut rng));
-                }
-            }
-        }
-        let turn = (spec.joints[0].counts_per_rev * spec.joints[0].ratio) as i32;
-        for i in 0..POSES {
-            let counts = core::array::from_fn(|k| {
-                if i % 2 == 0 {
-                    // Every magnitude, the phase wrapping.
-                    let x = rng.next();
-                    (x as i32) >> (x & 31)
-                } else {
-                    // Within a turn of home.
-                    home[k].wrapping_add((rng.next() % (2 * turn.max(1) as u32)) as i32 - turn)
-                }
-            });
-            one(counts, force(&mut rng));
-        }
-        // Forces across all of `Force`'s range (the most scaled duties, the weak arm's
-        // saturated products).
-        for _ in 0..WIDE_POSES {
-            let counts = core::array::from_fn(|k| {
-                home[k].wrapping_add((rng.next() % (turn.max(1) as u32)) as i32 - turn / 2)
-            });
-            let pose = arm.pose_portable(counts);
-            for _ in 0..WIDE_FORCES {
-                let f = core::array::from_fn(|_| Force::from_bits(rng.next() as i32));
-                wide += 1;
-                mismatches += differs(&arm, &pose, f) as u32;
-            }
-        }
-        // Where the duties come to be scaled, each side of it.
-        for _ in 0..EDGES {
-            let counts = core::array::from_fn(|k| {
-                home[k].wrapping_add((rng.next() % (turn.max(1) as u32)) as i32 - turn / 2)
-            });
-            let pose = arm.pose_portable(counts);
-            let dir: [i32; 3] = core::array::from_fn(|_| (rng.next() % 3) as i32 - 1);
-            let at = |s: i32| dir.map(|d| Force::from_bits(d.wrapping_mul(s)));
-            let scaled = |s: i32| arm.drive_portable(&pose, at(s)).scaled;
-            let (mut lo, mut hi) = (0, i32::MAX);
-            if scaled(lo) || !scaled(hi) {
-                continue;
-            }
-            while hi - lo > 1 {
-                let mid = lo + ((hi - lo) >> 1);
-                if scaled(mid) {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            for s in lo.saturating_sub(2)..=hi.saturating_add(2) {
-                edges += 1;
-                mismatches += differs(&arm, &pose, at(s)) as u32;
-            }
-        }
+        t.arms += 1;
+        poses(&arm, &spec, &mut rng, &mut t);
+        full_forces(&arm, &spec, &mut rng, &mut t);
+        scale_edges(&arm, &spec, &mut rng, &mut t);
     }
     defmt::println!(
         "ARMCHECK core={=str} arms={=u32} poses={=u32} full_forces={=u32} scale_edges={=u32} mismatches={=u32}",
         CORE.name(),
-        arms_checked,
-        poses,
-        wide,
-        edges,
-        mismatches
+        t.arms,
+        t.poses,
+        t.full_forces,
+        t.scale_edges,
+        t.mismatches
     );
-    if mismatches != 0 {
+    if t.mismatches != 0 {
         exit(false)
+    }
+}
+
+/// Counts a joint turn (joint A's), for the counts near home.
+fn turn(spec: &ArmSpec) -> i32 {
+    (spec.joints[0].counts_per_rev * spec.joints[0].ratio) as i32
+}
+
+/// Counts within half a turn of home.
+fn near_home(arm: &Arm, spec: &ArmSpec, rng: &mut Rng) -> [i32; 3] {
+    let (home, turn) = (arm.home_counts(), turn(spec).max(1));
+    core::array::from_fn(|k| home[k].wrapping_add((rng.next() % turn as u32) as i32 - turn / 2))
+}
+
+/// The pose (returned and written over the last) and the drive at a random force, at each
+/// range's ends and at random counts.
+fn poses(arm: &Arm, spec: &ArmSpec, rng: &mut Rng, t: &mut Tally) {
+    let home = arm.home_counts();
+    // `pose_into` writes over the last pose: a field it left would show.
+    let mut into = ArmPose::default();
+    let mut one = |counts: [i32; 3], force: [Force; 3], t: &mut Tally| {
+        t.poses += 1;
+        let portable = arm.pose_portable(counts);
+        arm.pose_into(counts, &mut into);
+        t.mismatches += (arm.pose(counts) != portable || into != portable) as u32;
+        t.mismatches += differs(arm, &portable, force) as u32;
+    };
+    // Each joint's range's ends (in counts, from the spec), ± 2, the others at home.
+    for (k, j) in spec.joints.iter().enumerate() {
+        let per_degree = j.counts_per_rev * j.ratio / 360.0 * j.sign;
+        for angle in [j.min_angle_deg, j.max_angle_deg] {
+            let at = j.home_count as f64 + (angle - j.home_angle_deg) * per_degree;
+            for d in -2..=2 {
+                let mut counts = home;
+                counts[k] = (at as i32).wrapping_add(d);
+                one(counts, force(rng), t);
+            }
+        }
+    }
+    let turn = turn(spec);
+    for i in 0..POSES {
+        let counts = core::array::from_fn(|k| {
+            if i % 2 == 0 {
+                // Every magnitude, the phase wrapping.
+                let x = rng.next();
+                (x as i32) >> (x & 31)
+            } else {
+                // Within a turn of home.
+                home[k].wrapping_add((rng.next() % (2 * turn.max(1) as u32)) as i32 - turn)
+            }
+        });
+        one(counts, force(rng), t);
+    }
+}
+
+/// The drive at forces across all of `Force`'s range (the most scaled duties, the weak
+/// arm's saturated products).
+fn full_forces(arm: &Arm, spec: &ArmSpec, rng: &mut Rng, t: &mut Tally) {
+    for _ in 0..WIDE_POSES {
+        let pose = arm.pose_portable(near_home(arm, spec, rng));
+        for _ in 0..WIDE_FORCES {
+            let f = core::array::from_fn(|_| Force::from_bits(rng.next() as i32));
+            t.full_forces += 1;
+            t.mismatches += differs(arm, &pose, f) as u32;
+        }
+    }
+}
+
+/// The drive each side of where the duties come to be scaled, on a random direction
+/// (found by halving the force on it), two steps beyond.
+fn scale_edges(arm: &Arm, spec: &ArmSpec, rng: &mut Rng, t: &mut Tally) {
+    for _ in 0..EDGES {
+        let pose = arm.pose_portable(near_home(arm, spec, rng));
+        let dir: [i32; 3] = core::array::from_fn(|_| (rng.next() % 3) as i32 - 1);
+        let at = |s: i32| dir.map(|d| Force::from_bits(d.wrapping_mul(s)));
+        let scaled = |s: i32| arm.drive_portable(&pose, at(s)).scaled;
+        let (mut lo, mut hi) = (0, i32::MAX);
+        if scaled(lo) || !scaled(hi) {
+            continue;
+        }
+        while hi - lo > 1 {
+            let mid = lo + ((hi - lo) >> 1);
+            if scaled(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        for s in lo.saturating_sub(2)..=hi.saturating_add(2) {
+            t.scale_edges += 1;
+            t.mismatches += differs(arm, &pose, at(s)) as u32;
+        }
     }
 }
