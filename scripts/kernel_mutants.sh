@@ -4,7 +4,8 @@
 # src/arith/wide_dsp/; the arm's pose and drive, src/arm/pose_dsp.rs and drive_dsp.rs):
 # puts one fault at a time into a scratch worktree of HEAD, runs the M4F bench up to its
 # KERNEL and ARMCHECK lines and prints `MUTANT <fault>: <n> of <states> states differ`
-# (poses for the arm's); the last line counts the faults caught. Not in the test command
+# (for the arm's: of its comparisons, two a pose and one each other force); the last line
+# counts the faults caught. Not in the test command
 # (about 25 s per fault once built; the first build takes a minute or two).
 # Usage: scripts/kernel_mutants.sh
 set -euo pipefail
@@ -91,12 +92,19 @@ EOF
     | "$DECODER" "$CARGO_TARGET_DIR/$T/release/bench" | grep -E '^(KERNEL|ARMCHECK) ' || true)
   # The kernel's faults stop the bench at its KERNEL line; the arm's show in ARMCHECK.
   case $name in
-    pose:* | drive:*) line=$(grep '^ARMCHECK' <<< "$line" || true); what=poses ;;
-    *) line=$(grep -m1 '^KERNEL' <<< "$line" || true); what=states ;;
+    pose:* | drive:*)
+      line=$(grep '^ARMCHECK' <<< "$line" || true)
+      n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
+      # Each pose is checked twice (its pose, its drive), each other force once.
+      of=$(sed -n 's/.*poses=\([0-9]*\) full_forces=\([0-9]*\) scale_edges=\([0-9]*\).*/\1 \2 \3/p' <<< "$line" \
+        | awk '{print 2 * $1 + $2 + $3}')
+      echo "MUTANT $name: ${n:-no check line, so none} of ${of:-the} comparisons differ" ;;
+    *)
+      line=$(grep -m1 '^KERNEL' <<< "$line" || true)
+      n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
+      of=$(sed -n 's/.*states=\([0-9]*\).*/\1/p' <<< "$line")
+      echo "MUTANT $name: ${n:-no check line, so none} of ${of:-the} states differ" ;;
   esac
-  n=$(sed -n 's/.*mismatches=\([0-9]*\).*/\1/p' <<< "$line")
-  of=$(sed -n "s/.*$what=\([0-9]*\).*/\1/p" <<< "$line")
-  echo "MUTANT $name: ${n:-no check line, so none} of ${of:-the} $what differ"
   if [ -n "$n" ] && [ "$n" != 0 ]; then caught=$((caught + 1)); fi
 done
 echo "$caught of ${#mutants[@]} faults caught"
