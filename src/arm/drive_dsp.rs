@@ -7,7 +7,7 @@
 //!
 //! Why assembly: the compiler's drive spilled about ten of its loads to the stack and
 //! back and masked each duty's shift (about 20 of its 125 instructions;
-//! docs/experiments/performance.md, "The arm's drive in assembly").
+//! docs/experiments/performance.md, "The arm's pose and drive in assembly").
 //!
 //! The arithmetic is [`Arm::drive_portable`]'s, step for step; its comments give the
 //! formats and ranges. One step differs in form, not in bits: a duty's saturating

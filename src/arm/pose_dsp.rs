@@ -7,8 +7,8 @@
 //! Why assembly: the compiler's pose kept the joints' limit checks for after the three
 //! `cos`/`sin` calls (their loads ahead of each call, as the call might write memory, and
 //! spilled across it), and inlining the calls spilled the six values instead (the M4F's
-//! chain 331 and 334 instructions; docs/experiments/performance.md, "The arm's pose in
-//! assembly"). Here each joint runs start to end in five scratch registers: its phase,
+//! chain 331 and 334 instructions; docs/experiments/performance.md, "The arm's pose and
+//! drive in assembly"). Here each joint runs start to end in five scratch registers: its phase,
 //! its limit check, its `cos`/`sin` from the table, stored, and its share of the forward
 //! kinematics kept in a register (B's and C's in the reach and the height, A's last).
 //!
