@@ -169,6 +169,50 @@ fn the_drive_takes_the_whole_force_range() {
     }
 }
 
+/// The torques' saturating sums (`Jᵀ F` plus gravity, `saturating_add`; `qadd`/`qsub` in
+/// the M4F's assembly, `src/arm/drive_dsp.rs`) are never reached by an arm `ArmSpec`
+/// allows: on the longest links (1,000 mm), with masses whose gravity torques come near
+/// the 32,768 N·mm limit, at every pose of a whole turn of each joint and every force
+/// at the corners, edges and faces of `Force`'s range (`Jᵀ F` is linear in the force, so
+/// its most is at a corner), each torque stays within ±1.6·10⁹ (Q8 N·mm; gravity's term
+/// is within ±2²³), against `i32`'s ±2.1·10⁹.
+#[test]
+fn the_torques_never_reach_their_saturation() {
+    let mut spec = woodenhaptics();
+    (spec.upper_arm_mm, spec.forearm_mm) = (1_000.0, 1_000.0);
+    spec.gravity = Some(mccs::GravitySpec {
+        upper_arm_mass_kg: 1.0,
+        upper_arm_com_mm: 1_000.0,
+        forearm_mass_kg: 2.3,
+        forearm_com_mm: 1_000.0,
+        g: 9.81,
+    });
+    let arm = Arm::new(&spec).unwrap();
+    let twin = ArmTwin { spec };
+    let mut most = 0i64;
+    for a in 0..16 {
+        for b in 0..64 {
+            for c in 0..64 {
+                let turn = |k: i32, n: i32| (k as f64 / n as f64 * 360.0 - 180.0).to_radians();
+                let counts = twin
+                    .counts([turn(a, 16), turn(b, 64), turn(c, 64)])
+                    .map(|x| x.round() as i32);
+                let pose = arm.pose(counts);
+                for corner in 0..27 {
+                    let f: [Force; 3] = std::array::from_fn(|k| {
+                        [Force::MIN, Force::ZERO, Force::MAX][(corner / 3usize.pow(k as u32)) % 3]
+                    });
+                    for t in arm.drive(&pose, f).torque_q8 {
+                        most = most.max((t as i64).abs());
+                    }
+                }
+            }
+        }
+    }
+    println!("ARM case=torque_bound max_q8={most}");
+    assert!(most <= 1_600_000_000, "{most}");
+}
+
 #[test]
 fn gravity_is_the_gradient_of_the_potential() {
     let spec = woodenhaptics();

@@ -15,8 +15,9 @@
 //! 32 bits exactly when its high word is not the low word's sign), where the portable
 //! code compares against the stored limit. The torques' saturating sums (`qsub`,
 //! `qadd`, as the portable `saturating_add`) are never reached by an arm `ArmSpec`
-//! allows: `Jᵀ F` is within ±10⁹ (Q8 N·mm; 9.1·10⁸ at 1,000 mm links and all of `Force`'s
-//! range), gravity's term within ±2²³: no check can tell them from plain sums.
+//! allows: its torques stay within ±1.6·10⁹ (Q8 N·mm) at 1,000 mm links, gravity near its
+//! limit and all of `Force`'s range, against `i32`'s ±2.1·10⁹ (`host-tests/tests/arm.rs`,
+//! `the_torques_never_reach_their_saturation`): no check can tell them from plain sums.
 
 use super::{Arm, ArmPose, Drive, Joint};
 use crate::units::Force;
