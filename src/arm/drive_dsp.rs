@@ -21,7 +21,7 @@
 
 use super::{Arm, ArmPose, Drive, Joint};
 use crate::units::Force;
-use core::mem::{offset_of, size_of};
+use core::mem::offset_of;
 
 // The duty's parameters are read by one `ldm`: gain, up, limit, down in this order.
 const _: () = {
@@ -108,10 +108,10 @@ pub(super) fn torques_and_duties(
     let most: u32;
     // SAFETY: reads `arm`, `pose` and `force` at the offsets given by `offset_of!` (the
     // duty's four parameters one `ldm`, asserted above); writes `out`'s torques and
-    // duties and nothing else. Every register it writes is declared; the stack is
-    // untouched.
+    // duties and nothing else. Every register it writes is declared (here and by
+    // `arm_asm!`); the stack is untouched.
     unsafe {
-        core::arch::asm!(
+        arm_asm!(
             // F in Q19 N (x, y) and Q18 N (z), in r4, r5, lr.
             "ldm r2, {{r4, r5, lr}}",
             "asr r4, r4, #1",
@@ -154,24 +154,12 @@ pub(super) fn torques_and_duties(
             gravity_b = const offset_of!(Arm, gravity_b_q16),
             gravity_c = const offset_of!(Arm, gravity_c_q16),
             gain = const offset_of!(Joint, duty_gain),
-            joint_a = const offset_of!(Arm, joints),
-            joint_b = const offset_of!(Arm, joints) + size_of::<Joint>(),
-            joint_c = const offset_of!(Arm, joints) + 2 * size_of::<Joint>(),
             torque = const offset_of!(Drive, torque_q8),
             duty = const offset_of!(Drive, duty_q16),
             in("r0") core::ptr::from_ref(arm),
             inout("r1") core::ptr::from_ref(pose) => most,
             inout("r2") force.as_ptr() => _,
             in("r3") core::ptr::from_mut(out),
-            out("r4") _,
-            out("r5") _,
-            out("r8") _,
-            out("r9") _,
-            out("r10") _,
-            out("r11") _,
-            out("r12") _,
-            out("lr") _,
-            options(nostack),
         );
     }
     most > 2 * super::drive::FULL_DUTY_Q16 as u32

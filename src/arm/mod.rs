@@ -31,6 +31,33 @@
 //! tick ([`Arm::pose`], [`Arm::drive`]) multiplies and shifts, and scales the duties by a
 //! reciprocal found by Newton's iteration ([`recip`]).
 
+/// `asm!` for the M4F's pose and drive (`pose_dsp.rs`, `drive_dsp.rs`): the operands
+/// given, then the joints' byte offsets in the arm (`joint_a`, `joint_b`, `joint_c`) and
+/// the registers both blocks write (r4, r5, r8–r12, lr; their own inputs in r0–r3), with
+/// no stack.
+#[cfg(mccs_dsp)]
+macro_rules! arm_asm {
+    ($($operands:tt)*) => {
+        core::arch::asm!(
+            $($operands)*
+            joint_a = const core::mem::offset_of!($crate::arm::Arm, joints),
+            joint_b = const core::mem::offset_of!($crate::arm::Arm, joints)
+                + core::mem::size_of::<$crate::arm::Joint>(),
+            joint_c = const core::mem::offset_of!($crate::arm::Arm, joints)
+                + 2 * core::mem::size_of::<$crate::arm::Joint>(),
+            out("r4") _,
+            out("r5") _,
+            out("r8") _,
+            out("r9") _,
+            out("r10") _,
+            out("r11") _,
+            out("r12") _,
+            out("lr") _,
+            options(nostack),
+        )
+    };
+}
+
 pub mod cos_sin;
 mod drive;
 #[cfg(mccs_dsp)]

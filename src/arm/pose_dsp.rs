@@ -18,7 +18,7 @@
 
 use super::cos_sin::SINE;
 use super::{Arm, ArmPose, Joint};
-use core::mem::{offset_of, size_of, MaybeUninit};
+use core::mem::{offset_of, MaybeUninit};
 
 // OUTSIDE is the flag's bit 3, where the Q flag's read puts it.
 const _: () = assert!(super::pose::OUTSIDE == 1 << 3);
@@ -147,9 +147,10 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
     // and 1, 256 and 257 points on: at most 1,024 + 257 < its 1,281 points) at the offsets
     // asserted above and given by `offset_of!`; writes every field of `*out` (its six
     // `cos`/`sin`, the reach, the device frame's three, the probe's three and the flags)
-    // and nothing else. Every register it writes is declared; the stack is untouched.
+    // and nothing else. Every register it writes is declared (here and by `arm_asm!`); the
+    // stack is untouched.
     unsafe {
-        core::arch::asm!(
+        arm_asm!(
             "movw r12, :lower16:{sine}",
             "movt r12, :upper16:{sine}",
             "mov r11, #0",
@@ -190,9 +191,6 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
             min_phase = const offset_of!(Joint, min_phase),
             phase_span = const offset_of!(Joint, phase_span),
             home_phase = const offset_of!(Joint, home_phase),
-            joint_a = const offset_of!(Arm, joints),
-            joint_b = const offset_of!(Arm, joints) + size_of::<Joint>(),
-            joint_c = const offset_of!(Arm, joints) + 2 * size_of::<Joint>(),
             upper_q18 = const offset_of!(Arm, upper_q18),
             fore_q18 = const offset_of!(Arm, fore_q18),
             upper_q17 = const offset_of!(Arm, upper_q17),
@@ -207,15 +205,6 @@ unsafe fn write(arm: &Arm, counts: &[i32; 3], out: *mut ArmPose) {
             in("r1") counts.as_ptr(),
             in("r2") out,
             out("r3") _,
-            out("r4") _,
-            out("r5") _,
-            out("r8") _,
-            out("r9") _,
-            out("r10") _,
-            out("r11") _,
-            out("r12") _,
-            out("lr") _,
-            options(nostack),
         );
     }
 }
