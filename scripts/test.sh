@@ -328,12 +328,14 @@ sim_board() {
 # examples/python/scene.py), against the simulated arm board in QEMU
 # (scripts/qemu-link.sh --sim): the C ABI, the example compiled with gcc as its header
 # comment says, the Python package pip-installed into a fresh venv; each opens, loads,
-# arms, holds 2 s, moves the pose, reads a mesh and disarms. (The library from the dev
-# build, whose dependencies the host build has built: the same code as the release
-# build the examples name, in 26 s, where the release build from scratch took 129 s.)
+# arms, holds 2 s, moves the pose, reads a mesh and disarms. (The library the host build
+# wrote, `deps/libmccs_client.so`: the same code as the release build the examples name,
+# where the release build from scratch took 129 s. Not `cargo build -p mccs-client`:
+# without the tests' dev-dependencies its dependencies resolve other features (serde's,
+# postcard's), and it built them and the core again, 55 s of CPU from a fresh clone.)
 scene_examples() {
-  local sock=target/qemu/scene.sock venv=target/venv-scene qemu_pid status=0 lib=$TARGET_DIR/debug
-  cargo build -p mccs-client || return 1
+  local sock=target/qemu/scene.sock venv=target/venv-scene qemu_pid status=0 lib=$TARGET_DIR/debug/deps
+  [ -e "$lib/libmccs_client.so" ] || { echo "no $lib/libmccs_client.so: the host build did not write it"; return 1; }
   gcc examples/c/scene.c -I client/include -L "$lib" -lmccs_client \
     -o target/qemu/scene-c || return 1
   if [ ! -x "$venv/bin/python" ]; then python3 -m venv "$venv" || return 1; fi
