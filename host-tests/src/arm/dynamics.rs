@@ -194,12 +194,24 @@ impl ArmBody {
         ]
     }
 
+    /// The Jacobians of the points with mass ([`Self::masses`], in its order) at the
+    /// arm's angles: computed once a step, as each of them takes six of the point's
+    /// positions (the probe's also gives its velocity).
+    fn jacobians(&self) -> [Matrix3<f64>; 3] {
+        self.masses(&Hand::OFF)
+            .map(|(point, _)| jacobian(&self.spec, point, &self.angle))
+    }
+
     fn mass_matrix(&self, hand: &Hand) -> Matrix3<f64> {
+        self.mass_matrix_of(hand, &self.jacobians())
+    }
+
+    /// [`Self::mass_matrix`] from the points' Jacobians ([`Self::jacobians`]).
+    fn mass_matrix_of(&self, hand: &Hand, jacobians: &[Matrix3<f64>; 3]) -> Matrix3<f64> {
         let mut m = Matrix3::from_diagonal(&Vector3::from(std::array::from_fn(|k| {
             self.body.rotor_kg_m2[k] * self.spec.joints[k].ratio.powi(2)
         })));
-        for (point, mass) in self.masses(hand) {
-            let j = jacobian(&self.spec, point, &self.angle);
+        for ((_, mass), j) in self.masses(hand).into_iter().zip(jacobians) {
             m += mass * j.transpose() * j;
         }
         m
@@ -229,7 +241,8 @@ impl ArmBody {
                 * self.current[k];
         }
         let rate = Vector3::from(self.rate);
-        let gravity_torque = self.gravity_torque();
+        let jacobians = self.jacobians();
+        let gravity_torque = self.gravity_torque_of(&jacobians);
         // What the motors render: their torque less what holds the arm against gravity.
         self.rendered_j += (tau - gravity_torque).dot(&rate) * dt;
         let mut force = tau + gravity_torque.map(|t| -t);
@@ -238,15 +251,15 @@ impl ArmBody {
             let coulomb = self.body.coulomb_nm[k] * (w / self.body.stiction_rad_s).clamp(-1.0, 1.0);
             force[k] -= self.body.viscous_nm_s[k] * w + coulomb;
         }
-        let (p, v) = self.probe();
+        // (As `probe()` gives them, its Jacobian the one computed above.)
+        let (p, v) = (probe(&s, &self.angle), jacobians[2] * rate);
         let pull = (led - p) * hand.stiffness_n_m + (led_velocity - v) * hand.damping_n_s_m;
-        force += jacobian(&s, probe, &self.angle).transpose() * pull;
-        for (point, mass) in self.masses(hand) {
-            let j = jacobian(&s, point, &self.angle);
+        force += jacobians[2].transpose() * pull;
+        for ((point, mass), j) in self.masses(hand).into_iter().zip(&jacobians) {
             force -= mass * j.transpose() * velocity_product(&s, point, &self.angle, &self.rate);
         }
         let accel = self
-            .mass_matrix(hand)
+            .mass_matrix_of(hand, &jacobians)
             .lu()
             .solve(&force)
             .unwrap_or_else(Vector3::zeros);
@@ -258,11 +271,15 @@ impl ArmBody {
 
     /// `∂U/∂q`, N·m: the torque that holds the arm still against gravity.
     pub fn gravity_torque(&self) -> Vector3<f64> {
+        self.gravity_torque_of(&self.jacobians())
+    }
+
+    /// [`Self::gravity_torque`] from the points' Jacobians ([`Self::jacobians`]).
+    fn gravity_torque_of(&self, jacobians: &[Matrix3<f64>; 3]) -> Vector3<f64> {
         // (A hand carries its own weight: the arm's masses only.)
         let g = gravity(&self.spec).g;
         let mut t = Vector3::zeros();
-        for (point, mass) in self.masses(&Hand::OFF) {
-            let j = jacobian(&self.spec, point, &self.angle);
+        for ((_, mass), j) in self.masses(&Hand::OFF).into_iter().zip(jacobians) {
             t += j.transpose() * Vector3::new(0.0, 0.0, mass * g);
         }
         t
