@@ -354,9 +354,11 @@ scene_examples() {
 }
 
 # `mccs view` in headless Chromium (host-tests/tests/browser/view.py: each step named):
-# against the demo's soft device, then against the simulated arm board in QEMU.
+# its screenshots' PNG reader on random images first, then against the demo's soft
+# device, then against the simulated arm board in QEMU.
 view_browser() {
   local sock=target/qemu/view.sock qemu_pid status=0
+  python3 host-tests/tests/browser/view.py --self-test || return 1
   echo "mccs view --demo"
   timeout --foreground 120 python3 host-tests/tests/browser/view.py target/debug/mccs --demo || status=1
   sim_board "$sock" target/qemu/view-firmware.log || return 1

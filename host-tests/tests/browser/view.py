@@ -3,6 +3,7 @@
 protocol on a pipe (`--remote-debugging-pipe`: no port, no package beyond Python's own).
 
     view.py MCCS (--demo | --connect ADDR) [--screenshot PNG [--settle S]]
+    view.py --self-test
 
 Starts `MCCS view … --port 0`, opens its page, and checks, each a named step:
   connects      the page's events arrive (its id, the device's facts, a status);
@@ -15,7 +16,8 @@ Starts `MCCS view … --port 0`, opens its page, and checks, each a named step:
   drops         the view stopped, the page says its connection is lost.
 Exit status 0 when every step passes, 1 at the first that fails (its name and why).
 --screenshot keeps the `draws` step's screenshot (docs/view.png is one, after
---settle 10: the plots' 10 s filled).
+--settle 10: the plots' 10 s filled). --self-test holds the screenshots' PNG reader
+to images of random pixels, each row under one of the five filters (`self_test`).
 """
 import base64
 import json
@@ -37,7 +39,9 @@ class Failed(Exception):
 
 
 def png_pixels(data):
-    """(width, height, rows of (r, g, b)) of an 8-bit RGB or RGBA PNG, not interlaced."""
+    """(width, height, rows of (r, g, b)) of an 8-bit RGB or RGBA PNG, not interlaced.
+    Rows filtered with None, Sub or Up are unfiltered a whole row at a time (bytewise sums
+    on integers); Average and Paeth byte by byte."""
     if data[:8] != b"\x89PNG\r\n\x1a\n":
         raise Failed("the screenshot is not a PNG")
     pos, idat, head = 8, b"", None
@@ -53,25 +57,49 @@ def png_pixels(data):
     if depth != 8 or colour not in (2, 6) or interlace:
         raise Failed(f"a PNG this reader does not take: depth {depth}, colour {colour}")
     bpp = 3 if colour == 2 else 4
-    raw, stride, rows, prev = zlib.decompress(idat), w * bpp, [], bytearray(w * bpp)
+    raw, stride, rows, prev = zlib.decompress(idat), w * bpp, [], bytes(w * bpp)
+    add = bytewise_add(stride)
     for y in range(h):
-        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1 : (y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - bpp] if i >= bpp else 0
-            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
-            if f == 1:
-                line[i] = (line[i] + a) & 255
-            elif f == 2:
-                line[i] = (line[i] + b) & 255
-            elif f == 3:
-                line[i] = (line[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append([tuple(line[x * bpp : x * bpp + 3]) for x in range(w)])
+        f, line = raw[y * (stride + 1)], raw[y * (stride + 1) + 1 : (y + 1) * (stride + 1)]
+        if f == 1:
+            # Each byte plus the one a pixel before it, decoded: a running sum per
+            # channel, in log2(width) doublings.
+            shift = bpp
+            while shift < stride:
+                line = add(line, bytes(shift) + line[:-shift])
+                shift *= 2
+        elif f == 2:
+            line = add(line, prev)
+        elif f in (3, 4):
+            # The first pixel has no left neighbour (nor upper left): Average takes half
+            # the byte above, Paeth the byte above.
+            line = bytearray(line)
+            for i in range(bpp):
+                line[i] = (line[i] + (prev[i] // 2 if f == 3 else prev[i])) & 255
+            if f == 3:
+                for i in range(bpp, stride):
+                    line[i] = (line[i] + (line[i - bpp] + prev[i]) // 2) & 255
+            else:
+                for i in range(bpp, stride):
+                    a, b, c = line[i - bpp], prev[i], prev[i - bpp]
+                    # |p − a|, |p − b|, |p − c| for Paeth's p = a + b − c.
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - c - c)
+                    line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+            line = bytes(line)
+        rows.append(list(zip(line[0::bpp], line[1::bpp], line[2::bpp])))
         prev = line
     return w, h, rows
+
+
+def bytewise_add(n):
+    """A function of two `n`-byte strings: their sum byte by byte, mod 256, on two
+    integers (the low 7 bits of each byte summed without reaching the next byte, the top
+    bit by exclusive or)."""
+    low, high = int.from_bytes(b"\x7f" * n, "big"), int.from_bytes(b"\x80" * n, "big")
+    def add(x, y):
+        a, b = int.from_bytes(x, "big"), int.from_bytes(y, "big")
+        return (((a & low) + (b & low)) ^ ((a ^ b) & high)).to_bytes(n, "big")
+    return add
 
 
 class Browser:
@@ -270,8 +298,58 @@ def step_drops(tab, view):
     return repr(text)
 
 
+def png_of(w, bpp, pixel_rows, filters):
+    """An 8-bit RGB (`bpp` 3) or RGBA (4) PNG of `pixel_rows` (bytes, `w * bpp` each),
+    row `y` filtered with `filters[y]`: PNG's filters as its specification writes them,
+    each byte less its predictor from the unfiltered neighbours."""
+    def predictor(f, a, b, c):
+        if f == 0:
+            return 0
+        if f == 1:
+            return a
+        if f == 2:
+            return b
+        if f == 3:
+            return (a + b) // 2
+        p = a + b - c
+        pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+        return a if pa <= pb and pa <= pc else b if pb <= pc else c
+    raw, prev = bytearray(), bytes(w * bpp)
+    for line, f in zip(pixel_rows, filters):
+        raw.append(f)
+        for i, x in enumerate(line):
+            a = line[i - bpp] if i >= bpp else 0
+            c = prev[i - bpp] if i >= bpp else 0
+            raw.append((x - predictor(f, a, prev[i], c)) & 255)
+        prev = line
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    head = struct.pack(">IIBBBBB", w, len(pixel_rows), 8, 2 if bpp == 3 else 6, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", head) + chunk(b"IDAT", zlib.compress(bytes(raw))) + chunk(b"IEND", b"")
+
+
+def self_test():
+    """The PNG reader against 300 images of random pixels (1 to 80 wide, RGB and RGBA),
+    their rows' filters drawn from all five: every pixel read back."""
+    import random
+    r = random.Random(2026)
+    for case in range(300):
+        w, h, bpp = r.randrange(1, 81), r.randrange(1, 9), r.choice((3, 4))
+        rows = [bytes(r.randrange(256) for _ in range(w * bpp)) for _ in range(h)]
+        filters = [r.randrange(5) for _ in range(h)]
+        got = png_pixels(png_of(w, bpp, rows, filters))
+        want = (w, h, [[tuple(line[x * bpp : x * bpp + 3]) for x in range(w)] for line in rows])
+        if got != want:
+            print(f"FAILED self-test: image {case} ({w} x {h}, {bpp} bytes a pixel, filters {filters}) read back wrong")
+            return 1
+    print("ok self-test: 300 images, every filter, RGB and RGBA, read back", flush=True)
+    return 0
+
+
 def main():
     args = sys.argv[1:]
+    if args == ["--self-test"]:
+        return self_test()
     shot, settle = None, 0.0
     for flag in ("--screenshot", "--settle"):
         if flag in args:
