@@ -195,7 +195,14 @@ impl Reference {
 
     /// Tangent stiffness `dF/dΔ = 1/Δ'(F)` at strain `delta` (`k` at the kink `F_T`).
     pub fn stiffness(&self, delta: f64) -> f64 {
-        1.0 / self.compliance(self.force(delta))
+        self.force_and_stiffness(delta).1
+    }
+
+    /// [`Reference::force`] and [`Reference::stiffness`] at `delta`, the inverse taken
+    /// once for both.
+    pub fn force_and_stiffness(&self, delta: f64) -> (f64, f64) {
+        let f = self.force(delta);
+        (f, 1.0 / self.compliance(f))
     }
 
     /// Whether `delta` lies where the law is curved (the cone's nonlinear phase).

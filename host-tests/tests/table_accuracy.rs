@@ -40,7 +40,8 @@ fn sweep<const S: usize>(r: &Reference, t: &ForceTable<S>) -> Stats {
         let (f, k) = (f.to_num::<f64>(), k.to_num::<f64>());
         // The force format saturates at ±2048 N: compare with the clamped law.
         let limit = mccs::Force::MAX.to_num::<f64>();
-        let err = (f - r.force(e).clamp(-limit, limit)).abs() / scale;
+        let (fr, kr) = r.force_and_stiffness(e);
+        let err = (f - fr.clamp(-limit, limit)).abs() / scale;
         s.max_force = s.max_force.max(err);
         sum_sq += err * err;
         if f < prev {
@@ -52,7 +53,6 @@ fn sweep<const S: usize>(r: &Reference, t: &ForceTable<S>) -> Stats {
         prev = f;
         // The stiffness is undefined exactly at the kink: skip a hair around it.
         if (e - kink).abs() > 1e-6 {
-            let kr = r.stiffness(e);
             s.max_stiffness_rel = s.max_stiffness_rel.max((k - kr).abs() / kr);
         }
     }

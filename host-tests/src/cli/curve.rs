@@ -43,7 +43,10 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
             let r = Reference::new(&p).map_err(|e| file_error(&a.params, e))?;
             strains
                 .iter()
-                .map(|&e| (e, r.force(e), r.stiffness(e)))
+                .map(|&e| {
+                    let (f, k) = r.force_and_stiffness(e);
+                    (e, f, k)
+                })
                 .collect::<Vec<_>>()
         }
         Backend::Fixed => {

@@ -221,13 +221,14 @@ fn independent_dense<const S: usize>(p: &Params, t: &ForceTable<S>, dense: usize
         let q = Strain::from_num(e);
         let e = q.to_num::<f64>();
         let (f, k) = t.force_and_stiffness(q);
-        let err = (f.to_num::<f64>() - r.force(e).clamp(-f_lim, f_lim)).abs() / scale;
+        let (fr, kr) = r.force_and_stiffness(e);
+        let err = (f.to_num::<f64>() - fr.clamp(-f_lim, f_lim)).abs() / scale;
         worst.force = worst.force.max(err);
         if kinks
             .iter()
             .all(|x| (e - x).abs() > mccs::table::KINK_MARGIN)
         {
-            let kr = r.stiffness(e).min(k_lim);
+            let kr = kr.min(k_lim);
             worst.stiffness = worst.stiffness.max((k.to_num::<f64>() - kr).abs() / kr);
         }
     }
