@@ -86,6 +86,8 @@ def png_pixels(data):
                     pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - c - c)
                     line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
             line = bytes(line)
+        elif f != 0:
+            raise Failed(f"a PNG row with filter {f}, which PNG does not define")
         rows.append(list(zip(line[0::bpp], line[1::bpp], line[2::bpp])))
         prev = line
     return w, h, rows
@@ -330,7 +332,8 @@ def png_of(w, bpp, pixel_rows, filters):
 
 def self_test():
     """The PNG reader against 300 images of random pixels (1 to 80 wide, RGB and RGBA),
-    their rows' filters drawn from all five: every pixel read back."""
+    their rows' filters drawn from all five: every pixel read back; and a row under a
+    filter PNG does not define refused."""
     import random
     r = random.Random(2026)
     for case in range(300):
@@ -342,7 +345,13 @@ def self_test():
         if got != want:
             print(f"FAILED self-test: image {case} ({w} x {h}, {bpp} bytes a pixel, filters {filters}) read back wrong")
             return 1
-    print("ok self-test: 300 images, every filter, RGB and RGBA, read back", flush=True)
+    try:
+        png_pixels(png_of(1, 3, [b"\0\0\0"], [5]))
+        print("FAILED self-test: a row with filter 5 (none such) was read")
+        return 1
+    except Failed:
+        pass
+    print("ok self-test: 300 images, every filter, RGB and RGBA, read back; filter 5 refused", flush=True)
     return 0
 
 
