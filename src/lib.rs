@@ -22,6 +22,31 @@
 // Lets generated tables (`tables/*.rs`, which say `mccs::…`) be included here too.
 extern crate self as mccs;
 
+/// `asm!` for the M4F's assembly blocks (`arith/wide_dsp`, `arm`): the operands given,
+/// then r4, r5, r8–r12 and lr declared written (what every block uses beyond its inputs),
+/// then the options after `options(…);`, if given. The blocks' own macros add the rest:
+/// `asm_writing_all!` r1–r3, `arm_asm!` the joints' offsets and `nostack`.
+#[cfg(mccs_dsp)]
+macro_rules! asm_writing_r4_to_lr {
+    (options($($options:tt)*); $($operands:tt)*) => {
+        core::arch::asm!(
+            $($operands)*
+            out("r4") _,
+            out("r5") _,
+            out("r8") _,
+            out("r9") _,
+            out("r10") _,
+            out("r11") _,
+            out("r12") _,
+            out("lr") _,
+            options($($options)*),
+        )
+    };
+    ($($operands:tt)*) => {
+        asm_writing_r4_to_lr!(options(); $($operands)*)
+    };
+}
+
 pub mod arith;
 pub mod arm;
 pub mod coupling;

@@ -38,22 +38,14 @@
 #[cfg(mccs_dsp)]
 macro_rules! arm_asm {
     ($($operands:tt)*) => {
-        core::arch::asm!(
+        asm_writing_r4_to_lr!(
+            options(nostack);
             $($operands)*
             joint_a = const core::mem::offset_of!($crate::arm::Arm, joints),
             joint_b = const core::mem::offset_of!($crate::arm::Arm, joints)
                 + core::mem::size_of::<$crate::arm::Joint>(),
             joint_c = const core::mem::offset_of!($crate::arm::Arm, joints)
                 + 2 * core::mem::size_of::<$crate::arm::Joint>(),
-            out("r4") _,
-            out("r5") _,
-            out("r8") _,
-            out("r9") _,
-            out("r10") _,
-            out("r11") _,
-            out("r12") _,
-            out("lr") _,
-            options(nostack),
         )
     };
 }

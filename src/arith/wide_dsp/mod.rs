@@ -29,19 +29,11 @@
 /// below use them all (r0 is each block's input, r6 and r7 they save themselves).
 macro_rules! asm_writing_all {
     ($($operands:tt)*) => {
-        core::arch::asm!(
+        asm_writing_r4_to_lr!(
             $($operands)*
             out("r1") _,
             out("r2") _,
             out("r3") _,
-            out("r4") _,
-            out("r5") _,
-            out("r8") _,
-            out("r9") _,
-            out("r10") _,
-            out("r11") _,
-            out("r12") _,
-            out("lr") _,
         )
     };
 }
