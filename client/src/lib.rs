@@ -40,6 +40,7 @@ pub mod paramfile;
 pub mod pose_text;
 pub mod replay;
 mod session;
+pub mod shown;
 pub mod substeps;
 pub mod telemetry;
 pub mod tissue;

@@ -2,6 +2,7 @@
 //! one-line errors that name the file and the key. The schema is the core's
 //! [`ParamKey`]: its sections, keys, which are required, and how each is stored.
 
+use crate::shown::Shown;
 use mccs::{Derived, ParamError, ParamKey, Params};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -99,8 +100,12 @@ impl fmt::Display for ParamFileError {
             } => {
                 at(f, path, *line)?;
                 match nearest {
-                    Some(n) => write!(f, "{key}: unknown key; did you mean {n}?"),
-                    None => write!(f, "{key}: unknown key (docs/model.md lists the schema)"),
+                    Some(n) => write!(f, "{}: unknown key; did you mean {n}?", Shown(key)),
+                    None => write!(
+                        f,
+                        "{}: unknown key (docs/model.md lists the schema)",
+                        Shown(key)
+                    ),
                 }
             }
             Self::Invalid {

@@ -3,6 +3,7 @@
 //! rate. Every rejected file gets one line naming the file and the row (the header is row 1,
 //! as in `mccs fit`'s data).
 
+use crate::shown::Shown;
 use std::fmt;
 use std::path::Path;
 
@@ -85,14 +86,6 @@ impl Trajectory {
     }
 }
 
-/// What was read, for a message: at most 60 characters.
-fn shown(text: &str) -> String {
-    match text.char_indices().nth(60) {
-        Some((i, _)) => format!("{}…", &text[..i]),
-        None => text.to_string(),
-    }
-}
-
 /// Reads a trajectory file.
 pub fn read(path: &Path) -> Result<Trajectory, TrajectoryError> {
     let file = path.display().to_string();
@@ -117,7 +110,7 @@ pub fn parse(text: &str, file: &str) -> Result<Trajectory, TrajectoryError> {
         Some((_, h)) => {
             return Err(err(
                 Some(1),
-                format!("the header must be `{HEADER}`, not `{}`", shown(h.trim())),
+                format!("the header must be `{HEADER}`, not `{}`", Shown(h.trim())),
             ))
         }
         None => return Err(err(None, "empty file".into())),
@@ -142,7 +135,7 @@ pub fn parse(text: &str, file: &str) -> Result<Trajectory, TrajectoryError> {
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| err(Some(n), format!("`{f}` is not a finite number")))?;
+                .ok_or_else(|| err(Some(n), format!("`{}` is not a finite number", Shown(f))))?;
         }
         let (t, p) = (v[0], [v[1], v[2], v[3]]);
         if p.iter().any(|x| x.abs() > MAX_POSITION_MM) {

@@ -29,6 +29,22 @@ pub const TARGETS: [(&str, Check); 11] = [
     ("arm_inputs", arm_inputs),
 ];
 
+/// The longest error line a parser may give: what it says, a line number and a user's
+/// text, which it shows through `mccs_client::shown::Shown` (at most 60 characters).
+pub const MAX_ERROR_CHARS: usize = 300;
+
+/// A parser's error as the command line prints it: one line that starts with `prefix`,
+/// no control character in it (a line break, a carriage return, a terminal's escape),
+/// at most [`MAX_ERROR_CHARS`] characters.
+fn one_line(e: &str, prefix: &str) {
+    assert!(
+        e.starts_with(prefix)
+            && !e.chars().any(char::is_control)
+            && e.chars().count() <= MAX_ERROR_CHARS,
+        "{e:?}"
+    );
+}
+
 /// A parameter file: a one-line error naming the file, or parameters that validate,
 /// build a law, and round-trip through the writer.
 pub fn param_file(data: &[u8]) {
@@ -45,11 +61,7 @@ pub fn param_file(data: &[u8]) {
             assert_eq!(again, Ok(p), "round trip");
         }
         Err(e) => {
-            let line = e.to_string();
-            assert!(
-                line.starts_with("fuzz.toml: ") && !line.contains('\n'),
-                "{line}"
-            );
+            one_line(&e.to_string(), "fuzz.toml: ");
         }
     }
 }
@@ -70,11 +82,7 @@ pub fn fit_data(data: &[u8]) {
             assert!(m.mean_abs.is_finite());
         }
         Err(e) => {
-            let line = e.to_string();
-            assert!(
-                line.starts_with("fuzz.csv: ") && !line.contains('\n'),
-                "{line}"
-            );
+            one_line(&e.to_string(), "fuzz.csv: ");
         }
     }
 }
@@ -97,11 +105,7 @@ pub fn trajectory(data: &[u8]) {
             }
         }
         Err(e) => {
-            let line = e.to_string();
-            assert!(
-                line.starts_with("fuzz.csv") && !line.contains('\n'),
-                "{line}"
-            );
+            one_line(&e.to_string(), "fuzz.csv");
         }
     }
 }
@@ -399,7 +403,7 @@ pub fn arm_device_file(data: &[u8]) {
             let drive = arm.drive(&pose, [mccs::Force::from_num(1); 3]);
             assert!(drive.duty_q16.iter().all(|d| d.abs() <= 65_536));
         }
-        Err(e) => assert!(e.starts_with("fuzz.toml") && !e.contains('\n'), "{e}"),
+        Err(e) => one_line(&e, "fuzz.toml"),
     }
 }
 
@@ -416,7 +420,7 @@ pub fn joints(data: &[u8]) {
             let ticks = crate::arm::joints::ticks(&rows, 10.0, &arm);
             assert!(!ticks.is_empty());
         }
-        Err(e) => assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}"),
+        Err(e) => one_line(&e, "fuzz.csv"),
     }
 }
 
@@ -427,7 +431,6 @@ pub fn arm_inputs(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let one_line = |e: &str| assert!(e.starts_with("fuzz.csv") && !e.contains('\n'), "{e}");
     let spec = mccs_firmware::arm::device::WOODENHAPTICS;
     let counts = ["count_a", "count_b", "count_c"];
     match crate::arm::columns::parse(text, "fuzz.csv", &counts) {
@@ -443,7 +446,7 @@ pub fn arm_inputs(data: &[u8]) {
                 assert!(d.duty_q16.iter().all(|x| x.abs() <= 65_536));
             }
         }
-        Err(e) => one_line(&e),
+        Err(e) => one_line(&e, "fuzz.csv"),
     }
     let held = ["count_a", "count_b", "count_c", "duty_b", "duty_c"];
     match crate::arm::columns::parse(text, "fuzz.csv", &held) {
@@ -477,10 +480,10 @@ pub fn arm_inputs(data: &[u8]) {
                         .chain(&f.offset_duty)
                         .all(|x| x.is_finite()));
                 }
-                Err(e) => assert!(!e.contains('\n'), "{e}"),
+                Err(e) => one_line(&e, ""),
             }
         }
-        Err(e) => one_line(&e),
+        Err(e) => one_line(&e, "fuzz.csv"),
     }
 }
 
@@ -493,10 +496,10 @@ pub fn view_request(data: &[u8]) {
         Ok(r) => {
             assert!(r.body.len() <= MAX_BODY && !r.path.contains('?'));
             if let Err(why) = crate::view::pose_of(&r.body) {
-                assert!(!why.contains('\n'));
+                one_line(why, "");
             }
             if let Err(why) = crate::view::tissue_of(&r.body) {
-                assert!(!why.contains('\n'), "{why}");
+                one_line(&why, "");
             }
         }
         Err(e) => assert!([400, 413, 431].contains(&e.status), "{e:?}"),

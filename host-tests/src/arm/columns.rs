@@ -2,6 +2,8 @@
 //! --poses`, and the recorded motion of `replay --joints`): a fixed header, then rows of
 //! finite numbers, each column held to its kind.
 
+use mccs_client::shown::Shown;
+
 /// The rows of numeric CSV text with exactly `header`; one line naming `file` and the
 /// row (the header is row 1) for anything else. Counts (`count_*`) whole and within
 /// `i32`, forces (`*_n`) within ±2,000 N, duties (`duty_*`) within ±1. Blank lines are
@@ -26,7 +28,7 @@ pub fn numbered(text: &str, file: &str, header: &[&str]) -> Result<Vec<(usize, V
         Some(h) => {
             return Err(format!(
                 "{file}: row 1: the header must be `{want}`, not `{}`",
-                h.escape_debug()
+                Shown(h)
             ))
         }
         None => return Err(format!("{file}: empty file")),
@@ -60,7 +62,7 @@ fn value(field: &str, name: &str) -> Result<f64, String> {
         .parse()
         .ok()
         .filter(|x: &f64| x.is_finite())
-        .ok_or_else(|| format!("`{}` is not a finite number", field.escape_debug()))?;
+        .ok_or_else(|| format!("`{}` is not a finite number", Shown(field)))?;
     if name.starts_with("count_") && (x.fract() != 0.0 || x.abs() > i32::MAX as f64) {
         return Err("must be a whole number of counts".into());
     }

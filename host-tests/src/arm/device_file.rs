@@ -6,6 +6,7 @@
 
 use crate::paramfile::{key_line, nearest_in, section_line};
 use mccs::{ArmSpec, GravitySpec, JointSpec};
+use mccs_client::shown::Shown;
 use std::path::Path;
 
 /// The keys of `[arm]`.
@@ -274,9 +275,12 @@ impl Doc<'_> {
         let file = self.file;
         let place = line.map_or(format!("{file}: "), |l| format!("{file}: line {l}: "));
         match nearest_in(name, all_keys()) {
-            Some(n) => format!("{place}{name}: unknown key; did you mean {n}?"),
+            Some(n) => format!("{place}{}: unknown key; did you mean {n}?", Shown(name)),
             None => {
-                format!("{place}{name}: unknown key (docs/arm.md lists the device file's keys)")
+                format!(
+                    "{place}{}: unknown key (docs/arm.md lists the device file's keys)",
+                    Shown(name)
+                )
             }
         }
     }

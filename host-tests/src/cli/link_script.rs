@@ -21,6 +21,7 @@
 use super::link::{device_error, pose_line, telemetry_row, tissue_of, TELEMETRY_COLUMNS};
 use super::{io_error, CliError};
 use mccs_client::pose_text::{self, numbers};
+use mccs_client::shown::Shown;
 use mccs_client::{Device, Pose, Tissue};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -61,7 +62,7 @@ fn every(words: &[&str], default: u16) -> Result<u16, String> {
             .strip_prefix("every=")
             .and_then(|n| n.parse::<u16>().ok())
             .filter(|n| (1..=1000).contains(n))
-            .ok_or_else(|| format!("'{w}': expected every=N, N of 1 … 1000 ticks")),
+            .ok_or_else(|| format!("'{}': expected every=N, N of 1 … 1000 ticks", Shown(w))),
         _ => Err("expected at most every=N".into()),
     }
 }
@@ -94,7 +95,7 @@ impl Script {
             if rest.is_empty() {
                 Ok(s)
             } else {
-                Err(format!("'{}' takes no argument", words[0]))
+                Err(format!("'{}' takes no argument", Shown(words[0])))
             }
         };
         match words[0] {
@@ -116,7 +117,7 @@ impl Script {
                     [] => None,
                     [f] => Some(
                         f.strip_prefix("friction=")
-                            .ok_or_else(|| format!("'{f}': expected friction=MUS,MUK"))?,
+                            .ok_or_else(|| format!("'{}': expected friction=MUS,MUK", Shown(f)))?,
                     ),
                     _ => return Err("load FILE [friction=MUS,MUK]".into()),
                 };
@@ -155,7 +156,8 @@ impl Script {
                 _ => Err("wait SECONDS: 0 … 3600".into()),
             },
             other => Err(format!(
-                "unknown step '{other}' (hello, status, load, pose, arm, disarm, telemetry, mesh, wait)"
+                "unknown step '{}' (hello, status, load, pose, arm, disarm, telemetry, mesh, wait)",
+                Shown(other)
             )),
         }
     }

@@ -3,6 +3,7 @@
 
 use super::Fitted;
 use mccs::Params;
+use mccs_client::shown::Shown;
 use std::fmt;
 use std::path::Path;
 
@@ -80,9 +81,7 @@ pub fn parse_data_noted(text: &str, file: &str) -> Result<(Vec<Point>, Option<St
             Some(1),
             format!(
                 "the header must be `strain,force_n`, not `{}`",
-                // (Escaped: a quoted field may hold a line break, and the error is one
-                // line.)
-                found.join(",").escape_debug()
+                Shown(&found.join(","))
             ),
         ));
     }
@@ -118,7 +117,7 @@ fn row_values(record: &csv::StringRecord) -> Result<(f64, f64), String> {
     let value = |k: usize, name: &str| -> Result<f64, String> {
         let v: f64 = record[k]
             .parse()
-            .map_err(|_| format!("{name} `{}` is not a number", &record[k]))?;
+            .map_err(|_| format!("{name} `{}` is not a number", Shown(&record[k])))?;
         if v.is_finite() {
             Ok(v)
         } else {

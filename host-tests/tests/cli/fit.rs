@@ -171,6 +171,17 @@ fn fit_errors_name_the_file_and_row() {
         &mccs(&["fit", "--data", "no/such.csv"]),
         &["no/such.csv", "cannot read"],
     );
+    // A quoted field over two lines (a fuzzing run's find): its line break shown escaped,
+    // the message one line.
+    let quoted = temp_file("quoted.csv", "strain,force_n\n0.1,\"0.05\n0.1\"\n");
+    assert_usage_error(
+        &mccs(&["fit", "--data", quoted.to_str().unwrap()]),
+        &[
+            "quoted.csv",
+            "row 2",
+            r"force_n `0.05\n0.1` is not a number",
+        ],
+    );
 }
 
 /// A first row at (0, 0), the unloaded sample every compression test starts from, is

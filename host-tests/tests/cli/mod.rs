@@ -82,9 +82,14 @@ pub(crate) fn assert_one_line_error(out: &Output, needles: &[&str]) {
 }
 
 /// A message in words a user reads: no Rust range syntax (`3..=64`), no subject said
-/// twice (`--friction: friction: …`).
+/// twice (`--friction: friction: …`), no control character (a user's text in it is
+/// shown escaped: `mccs_client::shown::Shown`).
 fn assert_plain_words(err: &str) {
     assert!(!err.contains("..="), "Rust syntax in {err:?}");
+    assert!(
+        !err.trim_end_matches('\n').chars().any(char::is_control),
+        "a control character in {err:?}"
+    );
     let parts: Vec<String> = err
         .split(": ")
         .map(|p| p.trim_start_matches('-').replace('-', " ").to_lowercase())

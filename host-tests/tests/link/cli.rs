@@ -365,28 +365,34 @@ fn a_script_holds_the_device_armed_as_long_as_it_says() {
         last = Some((seq, tick, dropped));
     }
     assert!(armed_rows > 150, "{armed_rows} armed rows");
-    // A bad line: exit 2 naming it, before the device is reached.
-    std::fs::write(&script, "hello\narm\nwiat 1\n").unwrap();
-    let out = mccs(&[
-        "link",
-        "--connect",
-        dev.addr(),
-        "script",
-        script.to_str().unwrap(),
-    ]);
-    crate::cli::assert_one_line_error(
-        &out,
-        &[&format!("{}:3: unknown step 'wiat'", script.display())],
-    );
+    // The script `text` run on the device.
+    let run = |text: &str| {
+        std::fs::write(&script, text).unwrap();
+        mccs(&[
+            "link",
+            "--connect",
+            dev.addr(),
+            "script",
+            script.to_str().unwrap(),
+        ])
+    };
+    // A bad line: exit 2 naming it, before the device is reached; a word with a
+    // terminal's escape in it shown escaped.
+    for (text, what) in [
+        ("hello\narm\nwiat 1\n", "3: unknown step 'wiat'"),
+        (
+            "hello\n\u{1b}[2Jwait 1\n",
+            r"2: unknown step '\u{1b}[2Jwait'",
+        ),
+        (
+            "telemetry on every=\u{1b}]0;t\u{7}\n",
+            r"1: 'every=\u{1b}]0;t\u{7}': expected every=N",
+        ),
+    ] {
+        crate::cli::assert_one_line_error(&run(text), &[&format!("{}:{what}", script.display())]);
+    }
     // A refusal: exit 2 naming its line, after a disarm.
-    std::fs::write(&script, "arm\npose 0,0,90\nwait 1\n").unwrap();
-    let out = mccs(&[
-        "link",
-        "--connect",
-        dev.addr(),
-        "script",
-        script.to_str().unwrap(),
-    ]);
+    let out = run("arm\npose 0,0,90\nwait 1\n");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");

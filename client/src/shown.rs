@@ -1,0 +1,58 @@
+//! A user's text inside a one-line message: [`Shown`].
+
+use std::fmt;
+
+/// The most characters of a user's text a message shows; past them, `…`.
+pub const SHOWN_CHARS: usize = 60;
+
+/// A user's text (a file's field, header or key, a script's word) as a one-line message
+/// shows it: its first [`SHOWN_CHARS`] characters, then `…` if there are more, with every
+/// character Rust's `escape_debug` escapes written escaped (`\n`, `\r`, `\t`,
+/// `\u{1b}`, `\u{202e}`, …) but quotes and backslashes, which are shown as they are.
+/// A quoted CSV field or TOML key may hold a line break, and a file may hold a
+/// terminal's escape sequence: neither reaches the terminal, and the message stays one
+/// line of bounded length whatever the file holds.
+///
+/// A field `0.05⏎0.1` is shown `0.05\n0.1`, and 61 nines as 60 and `…` (the tests below
+/// hold every character of the first three planes to it).
+#[derive(Clone, Copy, Debug)]
+pub struct Shown<'a>(pub &'a str);
+
+impl fmt::Display for Shown<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, c) in self.0.chars().enumerate() {
+            if i == SHOWN_CHARS {
+                return f.write_str("…");
+            }
+            match c {
+                '"' | '\'' | '\\' => fmt::Write::write_char(f, c)?,
+                _ => write!(f, "{}", c.escape_debug())?,
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_character_shown_is_a_control_and_at_most_the_limit_are_shown() {
+        // Every character of the first planes, alone and in a long run.
+        for c in (0u32..0x3_0000).filter_map(char::from_u32) {
+            let s = Shown(c.encode_utf8(&mut [0; 4])).to_string();
+            assert!(!s.chars().any(char::is_control), "{c:?} shown as {s:?}");
+            assert!(!s.contains(['\u{2028}', '\u{2029}', '\u{202e}']), "{c:?}");
+        }
+        let long = "ab\n".repeat(100);
+        let s = Shown(&long).to_string();
+        assert!(s.ends_with('…') && !s.contains('\n'), "{s}");
+        assert_eq!(s.matches("ab").count(), 20, "{s}");
+        // Exactly the limit: all of it, no ellipsis.
+        let exact = "x".repeat(SHOWN_CHARS);
+        assert_eq!(Shown(&exact).to_string(), exact);
+        // Quotes and backslashes as they are.
+        assert_eq!(Shown(r#""a"\'b'"#).to_string(), r#""a"\'b'"#);
+    }
+}
