@@ -2,13 +2,15 @@
 
 use std::fmt;
 
-/// The most characters of a user's text a message shows; past them, `…`.
+/// The most characters a message shows of a user's text, its escapes written out; past
+/// them, `…`.
 pub const SHOWN_CHARS: usize = 60;
 
 /// A user's text (a file's field, header or key, a script's word) as a one-line message
-/// shows it: its first [`SHOWN_CHARS`] characters, then `…` if there are more, with every
-/// character Rust's `escape_debug` escapes written escaped (`\n`, `\r`, `\t`,
-/// `\u{1b}`, `\u{202e}`, …) but quotes and backslashes, which are shown as they are.
+/// shows it: every character Rust's `escape_debug` escapes written escaped (`\n`, `\r`,
+/// `\t`, `\u{1b}`, `\u{202e}`, …) but quotes and backslashes, which are shown as they
+/// are; at most [`SHOWN_CHARS`] characters so written (an escape counts as its length),
+/// then `…` if the text goes on.
 /// A quoted CSV field or TOML key may hold a line break, and a file may hold a
 /// terminal's escape sequence: neither reaches the terminal, and the message stays one
 /// line of bounded length whatever the file holds.
@@ -20,13 +22,18 @@ pub struct Shown<'a>(pub &'a str);
 
 impl fmt::Display for Shown<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, c) in self.0.chars().enumerate() {
-            if i == SHOWN_CHARS {
+        let mut shown = 0;
+        for c in self.0.chars() {
+            let plain = matches!(c, '"' | '\'' | '\\');
+            // (An escape counts as the characters it shows: `\u{1b}` is six.)
+            shown += if plain { 1 } else { c.escape_debug().len() };
+            if shown > SHOWN_CHARS {
                 return f.write_str("…");
             }
-            match c {
-                '"' | '\'' | '\\' => fmt::Write::write_char(f, c)?,
-                _ => write!(f, "{}", c.escape_debug())?,
+            if plain {
+                fmt::Write::write_char(f, c)?;
+            } else {
+                write!(f, "{}", c.escape_debug())?;
             }
         }
         Ok(())
@@ -45,10 +52,15 @@ mod tests {
             assert!(!s.chars().any(char::is_control), "{c:?} shown as {s:?}");
             assert!(!s.contains(['\u{2028}', '\u{2029}', '\u{202e}']), "{c:?}");
         }
+        // `ab\n` shows as four characters: 15 of them fill the 60.
         let long = "ab\n".repeat(100);
         let s = Shown(&long).to_string();
         assert!(s.ends_with('…') && !s.contains('\n'), "{s}");
-        assert_eq!(s.matches("ab").count(), 20, "{s}");
+        assert_eq!(s.matches("ab").count(), 15, "{s}");
+        assert_eq!(s.chars().count(), SHOWN_CHARS + 1, "{s}");
+        // Escapes alone: as many whole ones as fit.
+        let s = Shown(&"\u{15}".repeat(100)).to_string();
+        assert_eq!(s, format!("{}…", r"\u{15}".repeat(10)));
         // Exactly the limit: all of it, no ellipsis.
         let exact = "x".repeat(SHOWN_CHARS);
         assert_eq!(Shown(&exact).to_string(), exact);
