@@ -175,7 +175,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
         ..a.tuning.config(rate)?
     };
     let p = paramfile::read(&a.params)?;
-    let (substeps, paths) = with_knots!(a.table.knots(), |S| {
+    let ((substeps, conservative), paths) = with_knots!(a.table.knots(), |S| {
         let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
         let paths = TablePaths {
             corner: t.corner().is_some(),
@@ -214,8 +214,20 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     if fits {
         Ok(())
     } else {
+        // What lowers the substeps: a heavier node where the estimated bound sets them;
+        // where the patch is too lightly damped for the estimate to see its edge, the
+        // conservative bound (about `2 C / k`, whatever the mass) sets them, and more
+        // damping or a lighter node (back within the estimate's reach) lowers them.
+        // At one substep, only a smaller patch or a slower tick.
+        let remedy = if substeps == 1 {
+            "a smaller --grid or a lower --rate (one substep a tick already)"
+        } else if conservative {
+            "more --spring-damping or a lighter --node-mass (the patch is too lightly damped for the stability estimate, and takes the conservative bound), a smaller --grid or a lower --rate"
+        } else {
+            "a smaller --grid, a lower --rate or a heavier --node-mass"
+        };
         Err(CliError::check_failed(format!(
-            "the tick would take {tick} instructions, over its budget of {budget}: a smaller --grid, a lower --rate or a heavier --node-mass"
+            "the tick would take {tick} instructions, over its budget of {budget}: {remedy}"
         )))
     }
 }
@@ -354,14 +366,16 @@ fn device_share(core: CoreArg, device: DeviceArg, patch_tick: u64) -> (u64, Stri
 }
 
 /// The substeps per tick the core's stability bound asks for on the standard `n × n`
-/// patch at `spacing` mm with `table` and `cfg`, in arithmetic `A`.
+/// patch at `spacing` mm with `table` and `cfg`, in arithmetic `A`, and whether they
+/// are the conservative bound's where the estimate was asked for (the patch too lightly
+/// damped for the estimate to see its edge: `mccs::solver::stability`).
 fn substeps_of<const S: usize, A: Arith>(
     table: ForceTable<S>,
     n: usize,
     spacing: f64,
     cfg: &SolverConfig,
     arith: A,
-) -> Result<u32, CliError> {
+) -> Result<(u32, bool), CliError> {
     if !(3..=crate::replay::MAX_GRID_FIXED).contains(&n) {
         return Err(arg_error("--grid", "must be 3 … 12"));
     }
@@ -381,6 +395,10 @@ fn substeps_of<const S: usize, A: Arith>(
             topology_error(e)
         }
     })?;
+    let bounds = mccs::solver::stability::bounds(&topo, &table, cfg);
     let s = Solver::with_arith(topo, table, cfg, arith).map_err(|e| config_error(e, cfg))?;
-    Ok(s.substeps())
+    let conservative = bounds.is_ok_and(|b| {
+        b.estimated.is_some() && b.chosen == mccs::solver::stability::CONSERVATIVE_FACTOR * b.closed
+    });
+    Ok((s.substeps(), conservative))
 }

@@ -99,6 +99,47 @@ fn what_does_not_fit_or_cannot_run_says_why() {
         "{err}"
     );
     let t2 = "params/table2.toml";
+    // What it advises lowers the tick: a heavier node where the estimate sets the
+    // substeps; where a heavy node leaves the patch too lightly damped for the estimate
+    // (the conservative bound, whatever the mass), more damping or a lighter node; at
+    // one substep, a smaller patch or a slower tick only.
+    let check = |extra: &[&str]| {
+        let out = mccs(&[&["check", "--params", t2][..], extra].concat());
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        (
+            out.status.code(),
+            err.lines().last().unwrap_or("").to_string(),
+        )
+    };
+    for (args, advice, remedies) in [
+        (
+            &["--grid", "8", "--node-mass", "1"][..],
+            "a smaller --grid, a lower --rate or a heavier --node-mass",
+            &[&["--grid", "8", "--node-mass", "5"][..]][..],
+        ),
+        (
+            &["--node-mass", "2000"],
+            "more --spring-damping or a lighter --node-mass (the patch is too lightly damped",
+            &[
+                &["--node-mass", "2000", "--spring-damping", "5"][..],
+                &["--node-mass", "1000"],
+            ],
+        ),
+        (
+            &["--rate", "5000"],
+            "a smaller --grid or a lower --rate (one substep a tick already)",
+            &[&["--rate", "4000"]],
+        ),
+    ] {
+        let (code, last) = check(args);
+        assert!(
+            code == Some(1) && last.contains(advice),
+            "{args:?}: {code:?} {last}"
+        );
+        for r in remedies {
+            assert_eq!(check(r).0, Some(0), "{r:?} after {args:?}");
+        }
+    }
     let stiff = temp_file(
         "stiff40.toml",
         &TABLE2
