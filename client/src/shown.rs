@@ -40,6 +40,27 @@ impl fmt::Display for Shown<'_> {
     }
 }
 
+/// The longest a [`ShownNumber`] is written in full; past it, in exponent form.
+pub const SHOWN_NUMBER_CHARS: usize = 12;
+
+/// A user's number as a one-line message shows it: as Rust writes it (`0.15`, `-3`)
+/// where that takes at most [`SHOWN_NUMBER_CHARS`] characters, else in exponent form
+/// (`1.071e267`, `1e-300`), where Rust would write every digit (268 of them for
+/// `1.071e267`). Either way the shortest that reads back as the same `f64`.
+#[derive(Clone, Copy, Debug)]
+pub struct ShownNumber(pub f64);
+
+impl fmt::Display for ShownNumber {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let full = self.0.to_string();
+        if full.len() <= SHOWN_NUMBER_CHARS {
+            f.write_str(&full)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,5 +87,31 @@ mod tests {
         assert_eq!(Shown(&exact).to_string(), exact);
         // Quotes and backslashes as they are.
         assert_eq!(Shown(r#""a"\'b'"#).to_string(), r#""a"\'b'"#);
+    }
+
+    #[test]
+    fn a_number_is_short_and_reads_back_as_itself() {
+        for (x, shown) in [
+            (0.15, "0.15"),
+            (-3.0, "-3"),
+            (123456789.5, "123456789.5"),
+            (1.071e267, "1.071e267"),
+            (1e-300, "1e-300"),
+            (f64::MAX, "1.7976931348623157e308"),
+            (f64::NAN, "NaN"),
+            (f64::NEG_INFINITY, "-inf"),
+        ] {
+            assert_eq!(ShownNumber(x).to_string(), shown);
+        }
+        // Every exponent, both signs, an awkward mantissa: at most 24 characters, and
+        // the same `f64` read back.
+        for k in -1074..=1023 {
+            for m in [1.0, -1.0, 1.234_567_890_123_456_7] {
+                let x = m * 2f64.powi(k);
+                let s = ShownNumber(x).to_string();
+                assert!(s.len() <= 24, "{s}");
+                assert_eq!(s.parse::<f64>().unwrap(), x, "{s}");
+            }
+        }
     }
 }

@@ -7,6 +7,7 @@ use super::patch_args::PatchArgs;
 use crate::replay::Engine;
 use crate::roam::{Shape, Tissue};
 use mccs::SolverConfig;
+use mccs_client::shown::ShownNumber;
 
 /// The line a run prints before its first row: `mccs <command>: <what it simulates>`.
 pub fn setup_line(
@@ -60,7 +61,8 @@ pub fn setup_line(
     format!(
         "mccs {command}: {geometry}; {engine}, {} Hz × {substeps} substeps, node mass {} g, spring damping {} N·s/m; {probe}",
         cfg.tick_hz,
-        cfg.node_mass * 1000.0,
+        // (The one figure here without an upper limit: `--node-mass 1e300`.)
+        ShownNumber(cfg.node_mass * 1000.0),
         cfg.spring_damping,
     )
 }

@@ -3,7 +3,7 @@
 
 use super::Fitted;
 use mccs::Params;
-use mccs_client::shown::Shown;
+use mccs_client::shown::{Shown, ShownNumber};
 use std::fmt;
 use std::path::Path;
 
@@ -134,12 +134,14 @@ fn row_values(record: &csv::StringRecord) -> Result<(f64, f64), String> {
 fn row_admissible(points: &[Point], e: f64, f: f64) -> Result<(), String> {
     if !(e > 0.0 && e < 1.0) {
         return Err(format!(
-            "strain {e} is outside (0, 1): the models take compressive strains above zero and below 1"
+            "strain {} is outside (0, 1): the models take compressive strains above zero and below 1",
+            ShownNumber(e)
         ));
     }
     if f <= 0.0 {
         return Err(format!(
-            "force_n {f} must be > 0 (the loading branch, from zero load)"
+            "force_n {} must be > 0 (the loading branch, from zero load)",
+            ShownNumber(f)
         ));
     }
     if points.len() >= MAX_ROWS {
