@@ -1,4 +1,4 @@
-//! A user's text inside a one-line message: [`Shown`].
+//! A user's text and numbers inside a one-line message: [`Shown`], [`ShownNumber`].
 
 use std::fmt;
 

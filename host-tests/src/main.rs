@@ -11,7 +11,8 @@ fn usage_error(e: &clap::Error) -> String {
     let mut parts = text.split("\n\n");
     let head = parts.next().unwrap_or("");
     let line: Vec<&str> = head.split_whitespace().collect();
-    let line = line.join(" ");
+    // (clap's ranges in words: `70000 is not in 0 … 65535`, not `0..=65535`.)
+    let line = line.join(" ").replace("..=", " … ");
     let line = line.trim_start_matches("error: ");
     let usage = text
         .lines()

@@ -25,6 +25,14 @@ fn a_port_in_use_is_one_line_naming_it() {
     assert_one_line_error(&out, &["--port", &format!("127.0.0.1:{port}"), "in use"]);
 }
 
+/// A port past `u16`: clap's range in words (`0 … 65535`), as every number's range is
+/// said (`--every` of `link watch` and `mesh` the same).
+#[test]
+fn a_port_past_its_range_says_the_range_in_words() {
+    let out = mccs(&["view", "--demo", "--port", "99999"]);
+    super::assert_usage_error(&out, &["--port", "99999 is not in 0 … 65535"]);
+}
+
 #[test]
 fn a_view_needs_one_device() {
     for args in [
