@@ -63,8 +63,14 @@ fn value(field: &str, name: &str) -> Result<f64, String> {
         .ok()
         .filter(|x: &f64| x.is_finite())
         .ok_or_else(|| format!("`{}` is not a finite number", Shown(field)))?;
-    if name.starts_with("count_") && (x.fract() != 0.0 || x.abs() > i32::MAX as f64) {
-        return Err("must be a whole number of counts".into());
+    if name.starts_with("count_") {
+        if x.fract() != 0.0 {
+            return Err("must be a whole number of counts".into());
+        }
+        // (An encoder's count is an `i32`: −2147483648 is one.)
+        if !(f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&x) {
+            return Err("must be within −2147483648 … 2147483647 counts (an i32)".into());
+        }
     }
     if name.starts_with("duty_") && x.abs() > 1.0 {
         return Err("must be within ±1 (a fraction of full duty)".into());

@@ -139,6 +139,10 @@ fn bad_rows_are_named() {
             "row 2: count_b: must be a whole number of counts",
         ),
         (
+            "count_a,count_b,count_c\n-2147483648,0,2147483648\n",
+            "row 2: count_c: must be within −2147483648 … 2147483647 counts (an i32)",
+        ),
+        (
             "count_a,count_b,count_c\n0,0\n",
             "row 2: 2 fields, 3 expected",
         ),
