@@ -50,17 +50,6 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
         }
         Backend::Fixed => {
-            // The printed strain must be the one evaluated: none is held at the format's
-            // edge.
-            let (min, max) = (Strain::MIN.to_num::<f64>(), Strain::MAX.to_num::<f64>());
-            for (name, v) in [("--from", a.from), ("--to", a.to)] {
-                if !(min..=max).contains(&v) {
-                    return Err(arg_error(
-                        name,
-                        "must be within the fixed point's strains, -128 … 127.99999994 (Q24), with --backend fixed",
-                    ));
-                }
-            }
             let rows = with_knots!(a.table.knots(), |S| {
                 let t = build::<S>(&p, &a.params, Domain::Default, a.table.accept_error, true)?;
                 fixed_curve(&t, &strains)
@@ -97,6 +86,19 @@ pub fn strain_grid(from: f64, to: f64, step: f64) -> Result<Vec<f64>, CliError> 
     for (name, v) in [("--from", from), ("--to", to), ("--step", step)] {
         if !v.is_finite() {
             return Err(arg_error(name, "must be a finite number"));
+        }
+    }
+    // The fixed point's strains, for either backend: the fixed one's printed strain must
+    // be the one evaluated (none held at the format's edge), and the reference's takes
+    // the same, so that the two compare (past them its force left f64: `-inf` at
+    // -1e308, and the strain printed in 309 digits).
+    let (min, max) = (Strain::MIN.to_num::<f64>(), Strain::MAX.to_num::<f64>());
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if !(min..=max).contains(&v) {
+            return Err(arg_error(
+                name,
+                "must be within the fixed point's strains, -128 … 127.99999994 (Q24)",
+            ));
         }
     }
     if step <= 0.0 {

@@ -187,6 +187,14 @@ fn fixed_curve_off_its_domain_warns_and_refuses_what_it_cannot_hold() {
     ] {
         assert_one_line_error(&curve(from, to, "1"), &[arg, "-128 … 127.99999994 (Q24)"]);
     }
+    // The reference takes the same strains: past them its force left f64 (`-inf` at
+    // -1e308, the strain printed in 309 digits).
+    for (from, to, arg) in [("-1e308", "-1e307", "--from"), ("0", "1e300", "--to")] {
+        assert_one_line_error(
+            &mccs(&curve_table2(from, to, "1e306")),
+            &[arg, "-128 … 127.99999994 (Q24)"],
+        );
+    }
     let edge = curve("-128", "-127", "1");
     assert!(edge.status.success());
     assert_eq!(numbers(&edge).len(), 2);
