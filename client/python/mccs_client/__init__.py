@@ -377,6 +377,36 @@ def _cause(code: int) -> str:
     return name.decode() if name else f"cause-{code}"
 
 
+def _text(name: str, value: str) -> bytes:
+    """``value`` as the C string the library reads: ctypes would cut it at a NUL byte,
+    silently (``"tcp:a:1\\0b"`` opened ``tcp:a:1``), so one is refused."""
+    if not isinstance(value, str):
+        raise MccsError(ERR_ARGUMENT, f"{name}: must be a str, not {type(value).__name__}")
+    if "\0" in value:
+        raise MccsError(ERR_ARGUMENT, f"{name}: holds a NUL byte")
+    return value.encode()
+
+
+def _numbers(name: str, values, k: int) -> Tuple[float, ...]:
+    """Exactly ``k`` numbers: ctypes takes the six of a pose as one list, so four and two
+    would pass as another pose."""
+    try:
+        out = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        raise MccsError(ERR_ARGUMENT, f"{name}: must be {k} numbers") from None
+    if len(out) != k:
+        raise MccsError(ERR_ARGUMENT, f"{name}: must be {k} numbers, not {len(out)}")
+    return out
+
+
+def _period(name: str, every: int) -> int:
+    """A period in ticks, 0 … 65535: ctypes would wrap another (-1 as 65535, 70000 as
+    4464)."""
+    if isinstance(every, bool) or not isinstance(every, int) or not 0 <= every <= 0xFFFF:
+        raise MccsError(ERR_ARGUMENT, f"{name}: must be a whole number of ticks, 0 … 65535 (got {every!r})")
+    return every
+
+
 def _check(code: int) -> None:
     if code != OK:
         message = _lib.mccs_last_error() or b""
@@ -390,7 +420,7 @@ class Device:
 
     def __init__(self, addr: str):
         handle = ctypes.c_void_p()
-        _check(_lib.mccs_open(addr.encode(), ctypes.byref(handle)))
+        _check(_lib.mccs_open(_text("addr", addr), ctypes.byref(handle)))
         self._h: Optional[ctypes.c_void_p] = handle
 
     def __enter__(self) -> "Device":
@@ -441,18 +471,21 @@ class Device:
         _check(_lib.mccs_status(self._handle(), ctypes.byref(s)))
         return Status(s.ticks, s.overruns, s.bad_frames, s.dropped_telemetry, bool(s.armed), s.fault, s.gain)
 
-    def load_tissue(self, path: str, friction: Optional[Tuple[float, float]] = None) -> int:
+    def load_tissue(self, path: "str | os.PathLike[str]", friction: Optional[Tuple[float, float]] = None) -> int:
         """Loads a tissue from a parameter ``.toml`` or a table ``.bin``, with friction
         ``(mu_s, mu_k)`` (None: keep the live one's); its hash, once the device runs it.
         The device's refusal is a ``MccsError`` with ``code == ERR_REFUSED``."""
-        mu_s, mu_k = friction if friction is not None else (math.nan, math.nan)
+        name = _text("path", os.fspath(path) if isinstance(path, os.PathLike) else path)
+        mu_s, mu_k = _numbers("friction", friction, 2) if friction is not None else (math.nan, math.nan)
         h = ctypes.c_uint32()
-        _check(_lib.mccs_load_tissue(self._handle(), path.encode(), mu_s, mu_k, ctypes.byref(h)))
+        _check(_lib.mccs_load_tissue(self._handle(), name, mu_s, mu_k, ctypes.byref(h)))
         return h.value
 
     def set_pose(self, origin_mm: Tuple[float, float, float], rotation_deg: Tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         """Places the tissue: its origin and a rotation ``Rz Ry Rx`` in degrees."""
-        _check(_lib.mccs_set_pose(self._handle(), *origin_mm, *rotation_deg))
+        origin = _numbers("origin_mm", origin_mm, 3)
+        rotation = _numbers("rotation_deg", rotation_deg, 3)
+        _check(_lib.mccs_set_pose(self._handle(), *origin, *rotation))
 
     def arm(self) -> None:
         """Arms the device; the library keeps it alive until ``disarm`` or ``close``."""
@@ -473,7 +506,7 @@ class Device:
 
     def watch(self, every: int) -> None:
         """Telemetry every ``every`` ticks (0: none)."""
-        _check(_lib.mccs_watch(self._handle(), every))
+        _check(_lib.mccs_watch(self._handle(), _period("every", every)))
 
     def telemetry(self) -> Optional[Telemetry]:
         """The latest telemetry sample, or None before the first."""
@@ -486,7 +519,7 @@ class Device:
 
     def watch_mesh(self, every: int) -> None:
         """A mesh every ``every`` ticks (0: none)."""
-        _check(_lib.mccs_watch_mesh(self._handle(), every))
+        _check(_lib.mccs_watch_mesh(self._handle(), _period("every", every)))
 
     def mesh(self) -> Optional[Tuple[int, List[MeshNode]]]:
         """The latest whole mesh as ``(seq, nodes)``, or None before the first."""

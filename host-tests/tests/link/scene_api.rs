@@ -2,7 +2,8 @@
 //! would) and through the Python module (`client/python`, ctypes over the same library,
 //! run by `python3`), against the soft device's fixture run (`soft::last_run`): each
 //! field and tick the same as the Rust client reads, a short buffer refused with the
-//! count a second call needs, bad arguments refused without a crash.
+//! count a second call needs, bad arguments refused without a crash; and the Python
+//! module's own argument checks, for what ctypes would pass on changed.
 
 use mccs::{ForceTable64, Params};
 use mccs_client::ffi::{
@@ -129,17 +130,31 @@ fn every_stop_cause_has_its_name_through_the_c_abi_and_none_other_does() {
     }
 }
 
+/// `python3 -c script args…` with the module and this build's library (target/…/deps,
+/// beside this test binary): its stdout, once it exits with success.
+fn python(script: &str, args: &[&std::ffi::OsStr]) -> String {
+    let exe = std::env::current_exe().unwrap();
+    let lib = exe.parent().unwrap().join("libmccs_client.so");
+    assert!(lib.exists(), "{} (built with the workspace)", lib.display());
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(script)
+        .args(args)
+        .env("PYTHONPATH", crate::cli::root().join("client/python"))
+        .env("MCCS_CLIENT_LIB", &lib)
+        .output()
+        .expect("python3");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "python3: {stderr}");
+    String::from_utf8(out.stdout).unwrap()
+}
+
 /// The Python module's `Device.black_box()` on the same device: its line and its ticks
 /// as the Rust client's CSV rows, through ctypes over this build's library.
 #[test]
 fn the_python_module_reads_the_black_box_as_the_rust_client_does() {
     let dev = device("python");
     let want = reference(dev.addr());
-    // The library this test binary's build made (target/…/deps), beside it.
-    let exe = std::env::current_exe().unwrap();
-    let lib = exe.parent().unwrap().join("libmccs_client.so");
-    assert!(lib.exists(), "{} (built with the workspace)", lib.display());
-    let root = crate::cli::root();
     let script = r#"
 import sys
 from mccs_client import Device
@@ -149,15 +164,7 @@ with Device(sys.argv[1]) as d:
     for t in b.ticks:
         print(t.csv_row())
 "#;
-    let out = std::process::Command::new("python3")
-        .args(["-c", script, dev.addr()])
-        .env("PYTHONPATH", root.join("client/python"))
-        .env("MCCS_CLIENT_LIB", &lib)
-        .output()
-        .expect("python3");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "python3: {stderr}");
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = python(script, &[dev.addr().as_ref()]);
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
@@ -168,4 +175,57 @@ with Device(sys.argv[1]) as d:
     for (i, (row, t)) in rows.iter().zip(&want.ticks).enumerate() {
         assert_eq!(*row, mccs_client::BlackBox::csv_row(t), "tick {i}");
     }
+}
+
+/// What ctypes would pass on changed, the Python module refuses as an argument error
+/// (`MccsError`, `code == ERR_ARGUMENT`) naming the argument: a NUL byte in an address
+/// or a path (ctypes cut the string there: `"unix:PATH\0junk"` opened `unix:PATH`), a
+/// period outside `u16` (ctypes wrapped -1 to 65535 and 70000 to 4464), and a pose of
+/// other than three and three numbers (four and two made another pose). A `pathlib.Path`
+/// loads as its `str` does.
+#[test]
+fn the_python_module_refuses_what_ctypes_would_change() {
+    let dev = device("python-arguments");
+    let script = r#"
+import pathlib, sys
+import mccs_client as m
+addr, params = sys.argv[1], sys.argv[2]
+def refused(what, call):
+    try:
+        call()
+    except m.MccsError as e:
+        print(f"{what}: {e.code == m.ERR_ARGUMENT} {e}")
+    else:
+        print(f"{what}: accepted")
+refused("addr", lambda: m.Device(addr + "\0junk"))
+refused("addr type", lambda: m.Device(7))
+with m.Device(addr) as d:
+    refused("path", lambda: d.load_tissue(params + "\0.bin"))
+    refused("friction", lambda: d.load_tissue(params, friction=(0.5,)))
+    refused("watch -1", lambda: d.watch(-1))
+    refused("watch 70000", lambda: d.watch(70000))
+    refused("watch 2.5", lambda: d.watch(2.5))
+    refused("mesh 65536", lambda: d.watch_mesh(65536))
+    refused("pose 4+2", lambda: d.set_pose((1, 2, 3, 4), (5, 6)))
+    refused("pose text", lambda: d.set_pose(("a", 0, 0)))
+    print("hashes", d.load_tissue(pathlib.Path(params)) == d.load_tissue(params))
+    d.watch(65535)
+    d.watch_mesh(0)
+"#;
+    let params = crate::cli::root().join("params/table2.toml");
+    let text = python(script, &[dev.addr().as_ref(), params.as_os_str()]);
+    let want = [
+        "addr: True addr: holds a NUL byte",
+        "addr type: True addr: must be a str, not int",
+        "path: True path: holds a NUL byte",
+        "friction: True friction: must be 2 numbers, not 1",
+        "watch -1: True every: must be a whole number of ticks, 0 … 65535 (got -1)",
+        "watch 70000: True every: must be a whole number of ticks, 0 … 65535 (got 70000)",
+        "watch 2.5: True every: must be a whole number of ticks, 0 … 65535 (got 2.5)",
+        "mesh 65536: True every: must be a whole number of ticks, 0 … 65535 (got 65536)",
+        "pose 4+2: True origin_mm: must be 3 numbers, not 4",
+        "pose text: True origin_mm: must be 3 numbers",
+        "hashes True",
+    ];
+    assert_eq!(text.lines().collect::<Vec<_>>(), want);
 }
