@@ -61,6 +61,9 @@ pub fn read_data_noted(path: &Path) -> Result<(Vec<Point>, Option<String>), Data
     parse_data_noted(&text, &file)
 }
 
+/// The fewest data rows a fit takes.
+const MIN_ROWS: usize = 5;
+
 /// [`read_data_noted`] on text.
 pub fn parse_data_noted(text: &str, file: &str) -> Result<(Vec<Point>, Option<String>), DataError> {
     let err = |row: Option<usize>, what: String| DataError {
@@ -68,6 +71,14 @@ pub fn parse_data_noted(text: &str, file: &str) -> Result<(Vec<Point>, Option<St
         row,
         what,
     };
+    if text.trim().is_empty() {
+        return Err(err(
+            None,
+            format!(
+                "empty file: it needs the header `strain,force_n` and at least {MIN_ROWS} rows"
+            ),
+        ));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
@@ -100,10 +111,10 @@ pub fn parse_data_noted(text: &str, file: &str) -> Result<(Vec<Point>, Option<St
         row_admissible(&points, e, f).map_err(|what| err(Some(row), what))?;
         points.push((e, f));
     }
-    if points.len() < 5 {
+    if points.len() < MIN_ROWS {
         return Err(err(
             None,
-            format!("{} data rows, at least 5 needed", points.len()),
+            format!("{} data rows, at least {MIN_ROWS} needed", points.len()),
         ));
     }
     Ok((points, note))

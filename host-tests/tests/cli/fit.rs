@@ -146,6 +146,12 @@ fn fit_errors_name_the_file_and_row() {
         &mccs(&["fit", "--data", bad.to_str().unwrap()]),
         &["bad.csv", "row 4", "strain"],
     );
+    // An empty file (or only blank lines) says so, not that its header is ``.
+    let empty = temp_file("empty.csv", " \n\n");
+    assert_usage_error(
+        &mccs(&["fit", "--data", empty.to_str().unwrap()]),
+        &["empty.csv: empty file", "`strain,force_n`"],
+    );
     let short = temp_file("short.csv", "strain,force_n\n0.1,0.1\n");
     assert_usage_error(
         &mccs(&["fit", "--data", short.to_str().unwrap()]),
