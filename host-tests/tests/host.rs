@@ -42,6 +42,8 @@ mod float_patch;
 mod fuzz_inputs;
 #[path = "link/mod.rs"]
 mod link;
+#[path = "passivity.rs"]
+mod passivity;
 #[path = "patch.rs"]
 mod patch;
 #[path = "proxy.rs"]
