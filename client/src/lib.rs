@@ -35,6 +35,7 @@ pub mod device;
 pub mod error;
 mod facts;
 pub mod ffi;
+pub mod input;
 pub mod mesh;
 pub mod paramfile;
 pub mod pose_text;

@@ -128,9 +128,11 @@ impl std::error::Error for ParamFileError {}
 
 /// Reads and validates a parameter file.
 pub fn read(path: &Path) -> Result<Params, ParamFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ParamFileError::Read {
-        path: path.to_owned(),
-        reason: e.to_string(),
+    let text = crate::input::read_text(path, crate::input::CONFIG_BYTES).map_err(|e| {
+        ParamFileError::Read {
+            path: path.to_owned(),
+            reason: e.to_string(),
+        }
     })?;
     parse(&text, path)
 }

@@ -105,10 +105,13 @@ impl Tissue {
 
     /// From a `.bin` file.
     pub fn from_bin_file(path: &Path) -> Result<Tissue, TissueError> {
-        let data = std::fs::read(path).map_err(|source| TissueError::Read {
-            file: path.to_path_buf(),
-            source,
-        })?;
+        let data =
+            crate::input::read_bytes(path, crate::input::CONFIG_BYTES).map_err(|source| {
+                TissueError::Read {
+                    file: path.to_path_buf(),
+                    source,
+                }
+            })?;
         Self::from_bin(&data).map_err(|source| TissueError::Bin {
             file: path.to_path_buf(),
             source,

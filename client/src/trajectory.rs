@@ -89,11 +89,12 @@ impl Trajectory {
 /// Reads a trajectory file.
 pub fn read(path: &Path) -> Result<Trajectory, TrajectoryError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| TrajectoryError {
-        file: file.clone(),
-        row: None,
-        what: format!("cannot read: {e}"),
-    })?;
+    let text =
+        crate::input::read_text(path, crate::input::DATA_BYTES).map_err(|e| TrajectoryError {
+            file: file.clone(),
+            row: None,
+            what: format!("cannot read: {e}"),
+        })?;
     parse(&text, &file)
 }
 

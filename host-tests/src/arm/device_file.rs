@@ -85,7 +85,7 @@ impl StableRegion {
 
 /// Reads a device file's `[stability]` (None: the file has none).
 pub fn read_stability(path: &Path) -> Result<Option<StableRegion>, String> {
-    let text = std::fs::read_to_string(path)
+    let text = mccs_client::input::read_text(path, mccs_client::input::CONFIG_BYTES)
         .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     parse_stability(&text, path)
 }
@@ -192,7 +192,7 @@ pub fn with_stability(text: &str, region: &StableRegion, comment: &str) -> Strin
 
 /// Reads and checks a device file.
 pub fn read(path: &Path) -> Result<ArmSpec, String> {
-    let text = std::fs::read_to_string(path)
+    let text = mccs_client::input::read_text(path, mccs_client::input::CONFIG_BYTES)
         .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     parse(&text, path)
 }

@@ -9,7 +9,8 @@ use mccs::{Arm, ArmPose};
 /// row 1).
 pub fn read(path: &std::path::Path) -> Result<Vec<(f64, [f64; 3])>, String> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{file}: cannot read: {e}"))?;
+    let text = mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES)
+        .map_err(|e| format!("{file}: cannot read: {e}"))?;
     parse(&text, &file)
 }
 

@@ -80,7 +80,7 @@ enum Command {
 /// The rows of a numeric CSV file with exactly `header` ([`columns::parse`]).
 fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
+    let text = mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES)
         .map_err(|e| CliError::new(format!("{file}: cannot read: {e}")))?;
     columns::parse(&text, &file, header).map_err(CliError::new)
 }
@@ -165,7 +165,7 @@ fn stability(
         points.push((b, (k * 1000.0).round() / 1000.0));
     }
     if let Some(path) = written {
-        let text = std::fs::read_to_string(device)
+        let text = mccs_client::input::read_text(device, mccs_client::input::CONFIG_BYTES)
             .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
         let region = device_file::StableRegion { points };
         let new = device_file::with_stability(
@@ -297,7 +297,7 @@ fn calibrate(
         );
     }
     if let Some(path) = written {
-        let text = std::fs::read_to_string(device)
+        let text = mccs_client::input::read_text(device, mccs_client::input::CONFIG_BYTES)
             .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
         let new = gravity_fit::with_masses(&text, &fit).ok_or_else(|| {
             CliError::new(format!(

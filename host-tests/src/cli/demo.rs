@@ -115,7 +115,7 @@ fn check_demo_log(
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
     let name = log.display();
-    let text = std::fs::read_to_string(log)
+    let text = mccs_client::input::read_text(log, mccs_client::input::DATA_BYTES)
         .map_err(|e| CliError::new(format!("{name}: cannot read: {e}")))?;
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
     let start = format!("mccs haptic demo: core={core} ");

@@ -70,8 +70,8 @@ fn every(words: &[&str], default: u16) -> Result<u16, String> {
 impl Script {
     /// Reads and checks `file`: every step, its arguments and its files.
     pub(super) fn read(file: &Path) -> Result<Script, CliError> {
-        let text = std::fs::read_to_string(file)
-            .map_err(|e| CliError::new(format!("{}: {e}", file.display())))?;
+        let text = mccs_client::input::read_text(file, mccs_client::input::CONFIG_BYTES)
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", file.display())))?;
         let mut steps = Vec::new();
         for (i, raw) in text.lines().enumerate() {
             let n = i + 1;

@@ -53,11 +53,14 @@ pub fn parse_data(text: &str, file: &str) -> Result<Vec<Point>, DataError> {
 /// through, is dropped (the models take strains above zero), and said so: the note.
 pub fn read_data_noted(path: &Path) -> Result<(Vec<Point>, Option<String>), DataError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| DataError {
-        file: file.clone(),
-        row: None,
-        what: format!("cannot read: {e}"),
-    })?;
+    let text =
+        mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES).map_err(|e| {
+            DataError {
+                file: file.clone(),
+                row: None,
+                what: format!("cannot read: {e}"),
+            }
+        })?;
     parse_data_noted(&text, &file)
 }
 

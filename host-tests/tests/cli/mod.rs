@@ -178,6 +178,49 @@ fn bad_files_name_file_and_key() {
     assert_usage_error(&curve_of("no/such.toml"), &["no/such.toml", "cannot read"]);
 }
 
+/// Every file the CLI reads is read to its limit and no further: `/dev/zero`, which
+/// never ends, given as each kind of file, is one line naming it and the limit (1 MiB
+/// for configuration, 256 MiB for data), where it was read until memory ran out.
+#[cfg(unix)]
+#[test]
+fn a_file_that_never_ends_is_refused_at_its_limit() {
+    let z = "/dev/zero";
+    let t2 = "params/table2.toml";
+    let arm = "devices/woodenhaptics.toml";
+    let cases: [(&[&str], &str); 9] = [
+        (&["table", "--params", z], "1 MiB"),
+        (&["check", "--params", z], "1 MiB"),
+        (&["arm", "fk", "--device", z, "--counts", z], "1 MiB"),
+        (
+            &["link", "--connect", "tcp:127.0.0.1:1", "script", z],
+            "1 MiB",
+        ),
+        (
+            &[
+                "link",
+                "--connect",
+                "tcp:127.0.0.1:1",
+                "load",
+                "--params",
+                z,
+            ],
+            "1 MiB",
+        ),
+        (&["fit", "--data", z], "256 MiB"),
+        (&["replay", "--params", t2, "--probe", z], "256 MiB"),
+        (&["arm", "fk", "--device", arm, "--counts", z], "256 MiB"),
+        (&["demo", "--core", "m4f", "--check", z], "256 MiB"),
+    ];
+    for (args, limit) in cases {
+        assert_usage_error(
+            &mccs(args),
+            &[&format!(
+                "{z}: cannot read: the file is larger than {limit}"
+            )],
+        );
+    }
+}
+
 /// The front door: a bare `mccs` prints its full help; a usage error names the argument
 /// and gives a usage hint; `demo --check` takes only a demo log of its core whose SUMMARY
 /// equals the host's run, with the exit statuses its help states.
