@@ -15,7 +15,7 @@ use std::path::Path;
 pub type Check = fn(&[u8]);
 
 /// The targets, by name, with their checks.
-pub const TARGETS: [(&str, Check); 11] = [
+pub const TARGETS: [(&str, Check); 13] = [
     ("param_file", param_file),
     ("fit_data", fit_data),
     ("trajectory", trajectory),
@@ -27,6 +27,8 @@ pub const TARGETS: [(&str, Check); 11] = [
     ("joints", joints),
     ("view_request", view_request),
     ("arm_inputs", arm_inputs),
+    ("link_host", link_host),
+    ("link_script", link_script),
 ];
 
 /// The longest error line a parser may give: what it says, a line number and a user's
@@ -503,5 +505,205 @@ pub fn view_request(data: &[u8]) {
             }
         }
         Err(e) => assert!([400, 413, 431].contains(&e.status), "{e:?}"),
+    }
+}
+
+/// A device's bytes for [`link_host`]: chunks of `[tag, length, bytes…]` (the last one
+/// takes what is left), each sent raw where its tag is even, or as one frame around its
+/// bytes (at most [`mccs_link::MAX_PAYLOAD`]) where it is odd, so that the messages'
+/// parser is reached past the CRC; then a delimiter.
+fn device_bytes(data: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut rest = data;
+    while let [tag, len, tail @ ..] = rest {
+        let n = (*len as usize).min(tail.len());
+        let (chunk, next) = tail.split_at(n);
+        if tag % 2 == 0 {
+            out.extend_from_slice(chunk);
+        } else {
+            out.extend(frame_around(&chunk[..n.min(mccs_link::MAX_PAYLOAD)]));
+        }
+        rest = next;
+    }
+    out.extend_from_slice(rest);
+    out.push(0);
+    out
+}
+
+/// Bytes that postcard writes as they are (a tuple of `u8`s: no length in front).
+struct Verbatim<'a>(&'a [u8]);
+
+impl serde::Serialize for Verbatim<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeTuple;
+        let mut t = s.serialize_tuple(self.0.len())?;
+        for b in self.0 {
+            t.serialize_element(b)?;
+        }
+        t.end()
+    }
+}
+
+/// `payload` (at most [`mccs_link::MAX_PAYLOAD`] bytes) framed as
+/// [`mccs_link::encode`] frames a message: its CRC, COBS and the delimiter.
+fn frame_around(payload: &[u8]) -> Vec<u8> {
+    let mut out = [0u8; mccs_link::MAX_FRAME];
+    mccs_link::encode(&Verbatim(payload), &mut out)
+        .expect("a payload that fits")
+        .to_vec()
+}
+
+/// A hello the library takes: the soft device's, read once.
+fn soft_hello() -> mccs_link::HelloInfo {
+    static HELLO: std::sync::OnceLock<mccs_link::HelloInfo> = std::sync::OnceLock::new();
+    *HELLO.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("mccs-fuzz-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a temporary folder");
+        let table = mccs::ForceTable64::new(&Params::TABLE2).expect("Table 2");
+        let soft = crate::link::soft::serve(&dir.join("hello.sock"), table).expect("a soft device");
+        let hello = mccs_client::Device::open(soft.addr())
+            .expect("its hello")
+            .info()
+            .hello;
+        soft.stop();
+        hello
+    })
+}
+
+/// A device that answers a `Hello` with `hello` and every other request with a `Status`,
+/// and sends `bytes` after its first answer; it ends when the host closes.
+fn scripted_device(
+    listener: std::os::unix::net::UnixListener,
+    hello: mccs_link::HelloInfo,
+    bytes: Vec<u8>,
+) {
+    use mccs_link::{encode, parse, Decoder, StatusInfo, ToDevice, ToHost, MAX_FRAME};
+    use std::io::{Read, Write};
+    let Ok((mut s, _)) = listener.accept() else {
+        return;
+    };
+    let _ = s.set_read_timeout(Some(std::time::Duration::from_secs(30)));
+    let (mut decoder, mut buf, mut sent) = (Decoder::new(), [0u8; 256], false);
+    while let Ok(n @ 1..) = s.read(&mut buf) {
+        for &b in &buf[..n] {
+            let Some(Ok(p)) = decoder.push(b) else {
+                continue;
+            };
+            let reply = match parse::<ToDevice>(p) {
+                Ok(ToDevice::Hello) => ToHost::Hello(hello),
+                _ => ToHost::Status(StatusInfo::default()),
+            };
+            let mut frame = [0u8; MAX_FRAME];
+            let frame = encode(&reply, &mut frame).expect("a frame");
+            if s.write_all(frame).is_err() || (!sent && s.write_all(&bytes).is_err()) {
+                return;
+            }
+            sent = true;
+        }
+    }
+}
+
+/// The scene's library's side of the link on any bytes from a device ([`device_bytes`]),
+/// sent after its hello's answer: no thread panics, what the library keeps of it is
+/// finite, and an error is one line. Where the bytes hold no message at all (noise on
+/// the line), the library drops each frame and counts it as the decoder does, and the
+/// next request is answered.
+pub fn link_host(data: &[u8]) {
+    use mccs_link::{parse, Decoder, ToHost};
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let hello = soft_hello();
+    let bytes = device_bytes(data);
+    let (mut dropped, mut messages) = (0u32, 0usize);
+    let mut decoder = Decoder::new();
+    for &b in &bytes {
+        match decoder.push(b) {
+            Some(Ok(p)) if parse::<ToHost>(p).is_ok() => messages += 1,
+            Some(_) => dropped += 1,
+            None => {}
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("mccs-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let socket = dir.join(format!("host-{n}.sock"));
+    let _ = std::fs::remove_file(&socket);
+    let listener = std::os::unix::net::UnixListener::bind(&socket).expect("a socket");
+    let device = std::thread::spawn(move || scripted_device(listener, hello, bytes));
+    let options = mccs_client::Options {
+        answer_timeout: std::time::Duration::from_secs(10),
+        ..Default::default()
+    };
+    let d = mccs_client::Device::open_with(&format!("unix:{}", socket.display()), options)
+        .expect("the hello is answered before the bytes");
+    let status = d.status();
+    if messages == 0 {
+        assert!(status.is_ok(), "{status:?}");
+        assert_eq!(d.bad_frames(), dropped);
+    } else if let Err(e) = &status {
+        one_line(&e.to_string(), "");
+    }
+    if let Some(t) = d.telemetry() {
+        let all = [t.probe_mm, t.force_n, t.duties, t.proxy_mm];
+        assert!(
+            all.iter()
+                .flatten()
+                .chain(&t.window_mm)
+                .all(|x| x.is_finite())
+                && t.gain.is_finite()
+        );
+    }
+    if let Some(m) = d.mesh() {
+        assert!(m
+            .nodes
+            .iter()
+            .flat_map(|n| n.position_mm)
+            .all(f64::is_finite));
+    }
+    drop(d);
+    device.join().expect("the device's thread");
+    let _ = std::fs::remove_file(&socket);
+}
+
+/// A scene's script (`mccs link script`): a one-line error naming the file and a line,
+/// or steps each on a line that names it, in order. A `load` reads no file here: its
+/// tissue is Table 2's, but for a path that names `missing`, which is an error.
+pub fn link_script(data: &[u8]) {
+    use crate::cli::link_script::Script;
+    static TISSUE: std::sync::OnceLock<mccs_client::Tissue> = std::sync::OnceLock::new();
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let tissue =
+        TISSUE.get_or_init(|| mccs_client::Tissue::from_params(&Params::TABLE2).expect("Table 2"));
+    let load = |path: &Path| {
+        if path.to_string_lossy().contains("missing") {
+            Err(format!(
+                "{}: cannot read: no such file",
+                mccs_client::shown::Shown(&path.to_string_lossy())
+            ))
+        } else {
+            Ok(tissue.clone())
+        }
+    };
+    match Script::parse(text, Path::new("fuzz.txt"), &load) {
+        Ok(script) => {
+            let lines: Vec<&str> = text.lines().collect();
+            let mut last = 0;
+            for (n, name) in script.step_names() {
+                assert!(n > last && n <= lines.len(), "line {n}");
+                let first = lines[n - 1]
+                    .split('#')
+                    .next()
+                    .unwrap_or("")
+                    .split_whitespace()
+                    .next();
+                assert_eq!(first, Some(name), "line {n}");
+                last = n;
+            }
+        }
+        Err(e) => {
+            assert_eq!(e.status, 2);
+            one_line(&e.message, "fuzz.txt:");
+        }
     }
 }

@@ -245,6 +245,15 @@ pub(super) fn tissue_of(
     arg: &str,
 ) -> Result<Tissue, CliError> {
     let t = Tissue::from_file(file).map_err(|e| CliError::new(e.to_string()))?;
+    with_friction(t, friction, arg)
+}
+
+/// `t` with `friction` (`MU_S,MU_K`, for the argument `arg`), where one is given.
+pub(super) fn with_friction(
+    t: Tissue,
+    friction: Option<&str>,
+    arg: &str,
+) -> Result<Tissue, CliError> {
     match friction {
         None => Ok(t),
         Some(f) => {

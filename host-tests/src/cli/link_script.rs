@@ -18,7 +18,7 @@
 //! and checked whole before the device is reached: a bad line is exit 2 with its line
 //! number; a refusal at run time is exit 2 with the step's line number, after a disarm.
 
-use super::link::{device_error, pose_line, telemetry_row, tissue_of, TELEMETRY_COLUMNS};
+use super::link::{device_error, pose_line, telemetry_row, with_friction, TELEMETRY_COLUMNS};
 use super::{io_error, CliError};
 use mccs_client::pose_text::{self, numbers};
 use mccs_client::shown::Shown;
@@ -44,7 +44,7 @@ enum Step {
 }
 
 /// A script, checked.
-pub(super) struct Script {
+pub(crate) struct Script {
     file: PathBuf,
     steps: Vec<(usize, Step)>,
 }
@@ -67,11 +67,23 @@ fn every(words: &[&str], default: u16) -> Result<u16, String> {
     }
 }
 
+/// What a script's `load FILE` reads: the tissue at a path (resolved as the step says),
+/// or why not in one line.
+pub(crate) type Loader<'a> = &'a dyn Fn(&Path) -> Result<Tissue, String>;
+
 impl Script {
     /// Reads and checks `file`: every step, its arguments and its files.
     pub(super) fn read(file: &Path) -> Result<Script, CliError> {
         let text = mccs_client::input::read_text(file, mccs_client::input::CONFIG_BYTES)
             .map_err(|e| CliError::new(format!("{}: cannot read: {e}", file.display())))?;
+        Self::parse(&text, file, &|path| {
+            Tissue::from_file(path).map_err(|e| e.to_string())
+        })
+    }
+
+    /// Checks `text`, the script `file`: every step and its arguments, each `load`'s
+    /// tissue through `load`.
+    pub(crate) fn parse(text: &str, file: &Path, load: Loader) -> Result<Script, CliError> {
         let mut steps = Vec::new();
         for (i, raw) in text.lines().enumerate() {
             let n = i + 1;
@@ -80,7 +92,7 @@ impl Script {
                 continue;
             }
             let words: Vec<&str> = line.split_whitespace().collect();
-            let step = Self::step(file, &words).map_err(|why| at(file, n, why))?;
+            let step = Self::step(file, &words, load).map_err(|why| at(file, n, why))?;
             steps.push((n, step));
         }
         Ok(Script {
@@ -89,7 +101,25 @@ impl Script {
         })
     }
 
-    fn step(file: &Path, words: &[&str]) -> Result<Step, String> {
+    /// The steps, each as its line number and its name.
+    pub(crate) fn step_names(&self) -> impl Iterator<Item = (usize, &'static str)> + '_ {
+        self.steps.iter().map(|(n, s)| {
+            let name = match s {
+                Step::Hello => "hello",
+                Step::Status => "status",
+                Step::Load(_) => "load",
+                Step::Pose(_) => "pose",
+                Step::Arm => "arm",
+                Step::Disarm => "disarm",
+                Step::Telemetry(_) => "telemetry",
+                Step::Mesh(_) => "mesh",
+                Step::Wait(_) => "wait",
+            };
+            (*n, name)
+        })
+    }
+
+    fn step(file: &Path, words: &[&str], load: Loader) -> Result<Step, String> {
         let rest = &words[1..];
         let none = |s: Step| {
             if rest.is_empty() {
@@ -121,7 +151,8 @@ impl Script {
                     ),
                     _ => return Err("load FILE [friction=MUS,MUK]".into()),
                 };
-                tissue_of(&path, friction, "friction")
+                let tissue = load(&path)?;
+                with_friction(tissue, friction, "friction")
                     .map(Step::Load)
                     .map_err(|e| e.message)
             }

@@ -15,7 +15,7 @@ mod curve;
 mod demo;
 mod fit;
 mod link;
-mod link_script;
+pub(crate) mod link_script;
 mod patch;
 mod patch_args;
 mod progress;

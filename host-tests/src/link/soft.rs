@@ -171,8 +171,21 @@ fn live() -> Live {
 /// link blackbox` has a record to read): its palpation's first [`LAST_RUN_TICKS`] ticks,
 /// recorded as the board records a tick, stopped there as if its encoder's frames had
 /// failed (a read fault), then ended by a HardFault at PC `0x0800_1234`, and kept
-/// through a watchdog's reset (IWDG).
+/// through a watchdog's reset (IWDG). Made once a table, kept for the process (a
+/// static: every soft device on that table shares it).
 pub fn last_run(table: ForceTable64) -> &'static LastRun {
+    static RUNS: std::sync::Mutex<Vec<(ForceTable64, &'static LastRun)>> =
+        std::sync::Mutex::new(Vec::new());
+    let mut runs = RUNS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, run)) = runs.iter().find(|(t, _)| *t == table) {
+        return run;
+    }
+    let run = record_last_run(table);
+    runs.push((table, run));
+    run
+}
+
+fn record_last_run(table: ForceTable64) -> &'static LastRun {
     use haptic_f405::black_box::{record, tick_record};
     use haptic_f405::device::DevicePart;
     let mut live = Box::new(LastRun::EMPTY);
