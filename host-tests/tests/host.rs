@@ -72,5 +72,7 @@ mod table_bound;
 mod table_edges;
 #[path = "table_source.rs"]
 mod table_source;
+#[path = "tissue_pose.rs"]
+mod tissue_pose;
 #[path = "velocity.rs"]
 mod velocity;
