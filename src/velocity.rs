@@ -41,6 +41,12 @@ pub const DEFAULT_ZETA: f64 = 0.7;
 /// (twice the arm's runaway limit of 1 m/s), mm/s.
 pub const JUMP_MM_S: f64 = 2000.0;
 
+/// The largest error that is not a jump, Q24 mm (2²⁹: 32 mm): the tick doubles the
+/// error in an `i32`. Below 62.5 Hz, where [`JUMP_MM_S`] would move further in a tick,
+/// a reading 32 mm off the prediction is a jump. (Without it, at 1 Hz a probe moving
+/// 33 mm a tick read as moving the other way: the doubled error wrapped.)
+pub const MAX_JUMP: u32 = 1 << 29;
+
 /// Why gains cannot be made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrackerError {
@@ -60,7 +66,7 @@ pub struct TrackerGains {
     beta_q31: i32,
     /// The tick rate, Hz.
     tick_hz: i32,
-    /// A jump: an error beyond this, Q24 mm (at most 20 mm: 100 Hz at 2 m/s).
+    /// A jump: an error beyond this, Q24 mm ([`JUMP_MM_S`]'s tick, at most [`MAX_JUMP`]).
     jump: u32,
 }
 
@@ -93,7 +99,9 @@ impl TrackerGains {
             alpha_q31: a as i32,
             beta_q31: b as i32,
             tick_hz: tick_hz as i32,
-            jump: crate::units::from_f64(JUMP_MM_S / tick_hz as f64, LEN_FRAC).unsigned_abs(),
+            jump: crate::units::from_f64(JUMP_MM_S / tick_hz as f64, LEN_FRAC)
+                .unsigned_abs()
+                .min(MAX_JUMP),
         })
     }
 
@@ -150,7 +158,7 @@ impl VelocityTracker {
                 self.w[i] = 0;
                 return Velocity::ZERO;
             }
-            // |e| ≤ the jump, at most 20 mm (2²⁹ in Q24) at 100 Hz: `2e` fits.
+            // |e| ≤ the jump, at most 2²⁹ (`MAX_JUMP`): `2e` fits.
             let step = q::mulhi(e << 1, gains.alpha_q31);
             self.x[i] = predicted.saturating_add(step);
             self.w[i] = self.w[i].saturating_add(q::mulhi(e << 1, gains.beta_q31));

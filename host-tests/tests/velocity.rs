@@ -252,3 +252,46 @@ fn the_tracker_takes_a_count_s_dither_out_of_the_coupling_s_damping() {
     );
     assert!(still.0 > 0.1, "the press pushes back: {still:?}");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(512))]
+
+    /// Any gains the tracker takes (any tick rate from 1 Hz, any stable loop) on a probe
+    /// moving at a constant speed it does not take for a jump: once settled, the
+    /// velocity it gives is that speed, within a few of its steps (mm/s), and never of
+    /// the other sign; where the speed is a jump, zero. (Below 62.5 Hz, 2 m/s is more
+    /// than the 32 mm a tick the error's doubling holds in an `i32`: the jump there is
+    /// 32 mm a tick.)
+    #[test]
+    fn any_gains_track_a_constant_speed(
+        hz in proptest::prop_oneof![1u32..200, 200u32..100_000],
+        wt in 0.01f64..1.0,
+        zeta in 0.3f64..1.5,
+        per_tick_mm in -60.0f64..60.0,
+    ) {
+        let Ok(gains) = TrackerGains::new(hz, wt * hz as f64, zeta) else {
+            return Ok(());
+        };
+        let mut t = VelocityTracker::new();
+        // From one end of the range toward the other, a tick at a time, settling first.
+        let start = if per_tick_mm > 0.0 { -120.0 } else { 120.0 };
+        let ticks = ((240.0 / per_tick_mm.abs().max(1e-3)) as usize).min(5000);
+        let speed = per_tick_mm * hz as f64;
+        let jump = (mccs::velocity::JUMP_MM_S / hz as f64).min(32.0);
+        let mut last = 0.0;
+        for k in 0..ticks {
+            let p = Length::from_num(start + per_tick_mm * k as f64);
+            last = t.update(&gains, [p; 3])[0].to_num::<f64>();
+            proptest::prop_assert!(last * speed >= 0.0, "tick {}: {} mm/s for {} mm/s", k, last, speed);
+        }
+        // Ten time constants of the loop's slower pole (`ζω`, or `(ζ − √(ζ² − 1))ω` past 1).
+        let slow = if zeta <= 1.0 { zeta } else { zeta - (zeta * zeta - 1.0).sqrt() };
+        let settle = (10.0 / (slow * wt)) as usize;
+        if per_tick_mm.abs() > jump * 1.01 {
+            proptest::prop_assert_eq!(last, 0.0);
+        } else if ticks > settle + 2 && per_tick_mm.abs() < jump * 0.99 {
+            let within = 3.0 * hz as f64 * 2f64.powi(-24) + 1e-3 * speed.abs() + 1e-4;
+            proptest::prop_assert!((last - speed.clamp(-32768.0, 32767.99)).abs() <= within, "{} mm/s for {} mm/s", last, speed);
+        }
+    }
+}
