@@ -12,7 +12,7 @@
 //!   `Device`;
 //! - telemetry ([`Device::watch`], [`Device::telemetry`], [`Device::telemetry_stream`])
 //!   and the mesh ([`Device::watch_mesh`], [`Device::mesh`]) arrive in the background;
-//! - a lost connection is an error within [`crate::session::LIVENESS`] while armed (at
+//! - a lost connection is an error within `session::LIVENESS` (400 ms) while armed (at
 //!   once where the transport tells), and the background thread ends with it.
 //!
 //! `Device` is `Send + Sync`: requests from several threads take turns.

@@ -1,7 +1,7 @@
 //! `FloatPatch`: the patch substep in floating point (`f32` or `f64`), for the benchmark's
 //! comparison with the fixed-point solver only — not used by the firmware.
 //!
-//! The same algorithm as [`Solver`](crate::Solver)'s substep: per spring the length (a
+//! The same algorithm as [`Solver`](mccs::Solver)'s substep: per spring the length (a
 //! square root here, the hardware `vsqrt.f32` on a Cortex-M4F, software elsewhere), the
 //! strain, the table's cubic, the force along the edge and the relative damping; per node
 //! the improved Euler step; the probe coupling on the contact node. Software floating point

@@ -3,9 +3,8 @@
 //! What a controller needs beyond the model and the solver (`mccs`), kept apart from
 //! them so that the core builds for every target without any of it:
 //!
-//! - [`device`]: [`HapticDevice`](device::HapticDevice), what the tick needs of the
-//!   hardware, and the [`SimulatedDevice`](device::SimulatedDevice) replaying a
-//!   [`ProbePath`](probe_path::ProbePath);
+//! - [`device`]: [`HapticDevice`], what the tick needs of the hardware, and the
+//!   [`SimulatedDevice`] replaying a [`ProbePath`];
 //! - [`drivers`]: the AS5047P SPI encoder and the PWM motor (embedded-hal 1.0), and
 //!   [`one_dof`], a 1-DOF device made of the two; [`lever_sim`], a simulated lever
 //!   behind those parts;

@@ -603,7 +603,7 @@ fn scripted_device(
     }
 }
 
-/// The scene's library's side of the link on any bytes from a device ([`device_bytes`]),
+/// The scene's library's side of the link on any bytes from a device (`device_bytes`),
 /// sent after its hello's answer: no thread panics, what the library keeps of it is
 /// finite, and an error is one line. Where the bytes hold no message at all (noise on
 /// the line), the library drops each frame and counts it as the decoder does, and the

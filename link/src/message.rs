@@ -34,7 +34,7 @@ pub enum ToDevice<'a> {
     TissueChunk {
         /// Where it goes (the bytes so far).
         offset: u32,
-        /// The bytes (at most [`TISSUE_CHUNK`]).
+        /// The bytes (at most [`TISSUE_CHUNK`](crate::TISSUE_CHUNK)).
         bytes: &'a [u8],
     },
     /// (7) The table is whole: the device checks it (the old tissue renders meanwhile) and

@@ -3,7 +3,7 @@
 //! ([`HEADER_WORDS`] + 4 per segment: 1,112 bytes at 65 knots). The hash names a tissue
 //! in `Ack` and `Hello`: FNV-1a over those bytes.
 //!
-//! The field order is written once, in [`fields!`]: [`write`], [`hash`] and the
+//! The field order is written once, in `fields!`: [`write()`], [`hash()`] and the
 //! [`Assembler`] that a device fills as the bytes arrive all read it from there.
 
 use mccs::fnv::Fnv1a;

@@ -4,7 +4,7 @@
 use postcard_schema::Schema;
 use serde::{Deserialize, Serialize};
 
-/// The most table bytes one [`ToDevice::TissueChunk`] carries (its frame stays within
+/// The most table bytes one [`ToDevice::TissueChunk`](crate::ToDevice::TissueChunk) carries (its frame stays within
 /// [`crate::MAX_FRAME`]).
 pub const TISSUE_CHUNK: usize = 200;
 

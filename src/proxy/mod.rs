@@ -1,7 +1,7 @@
 //! `Proxy`: a god-object contact that slides on the standard patch's surface with Coulomb
 //! friction, in fixed point: the `f64` reference is `mccs_host::roam` (`docs/roaming.md`),
 //! whose model this follows. One update per tick and one force per substep
-//! ([`Proxy::update`], [`Proxy::force`]) for every [`Shape`] of tissue: on a flat one
+//! (`Proxy::update`, `Proxy::force`) for every [`Shape`] of tissue: on a flat one
 //! (`flat.rs`) or on a cap (`cap.rs`); the coupling's force and its ratios in `force.rs`.
 //!
 //! The surface is the patch's `n × n` surface nodes (outer ring fixed at rest), each

@@ -15,7 +15,7 @@
 //! spring it continues and computes the entering springs' (about `5 (n − 2)`, one
 //! reciprocal square root each: `cap_springs.rs`).
 //!
-//! The window owns its shift rules ([`Window::step_for`], [`Window::advance`]); the
+//! The window owns its shift rules (`Window::step_for`, `Window::advance`); the
 //! solver moves the patch's state with it (`solver/roaming.rs`).
 
 mod cap_springs;

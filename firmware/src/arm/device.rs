@@ -1,5 +1,5 @@
 //! [`ArmDevice`]: a 3-DOF arm as the tick's [`HapticDevice`] — three joints, each a
-//! [`JointEncoder`] and a PWM channel with a direction pin, one driver-enable pin and a
+//! [`JointEncoder`](crate::arm::encoder::JointEncoder) and a PWM channel with a direction pin, one driver-enable pin and a
 //! home input — through the core's [`Arm`] (counts to the probe, the force to duties).
 //!
 //! # Safety

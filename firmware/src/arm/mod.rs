@@ -6,7 +6,7 @@
 //!   homing and safe state, and the WoodenHaptics constant;
 //! - [`runaway`], [`walls`], [`thermal`]: what keeps the device safe beyond its parts'
 //!   faults — the speed limits, the virtual walls, the I²t model;
-//! - [`direction`]: the start-up check that each motor turns its joint the way it is
+//! - [`direction`](crate::direction): the start-up check that each motor turns its joint the way it is
 //!   driven;
 //! - [`trims`]: each amplifier's duty offset and dead band;
 //! - [`joint`]: a joint's counter, PWM channel and direction pin behind one interface;

@@ -18,7 +18,7 @@ pub struct SpeedLimits {
 }
 
 impl SpeedLimits {
-    /// No limit (what [`ArmDevice::new`] starts with).
+    /// No limit (what [`ArmDevice::new`](crate::arm::device::ArmDevice::new) starts with).
     pub const NONE: SpeedLimits = SpeedLimits {
         joint_counts: [u32::MAX; 3],
         probe: Length::MAX,

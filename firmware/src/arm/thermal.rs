@@ -1,4 +1,4 @@
-//! [`Thermal`]: each joint's I²t model, and [`Heat`], a joint's state in it, which
+//! [`Thermal`]: each joint's I²t model, and `Heat`, a joint's state in it, which
 //! [`super::device::ArmDevice`] runs on every duty it writes.
 
 /// Each joint's I²t model, per tick: the heat `h` (the current's square over the

@@ -1,5 +1,5 @@
 //! What a force table built at a device's start-up costs, measured in QEMU under
-//! `-icount` as the bench measures ([`harness`]): `ForceTable64::new` on Table 2 (the
+//! `-icount` as the bench measures (its `harness`): `ForceTable64::new` on Table 2 (the
 //! builder's best placement, measured against the `f64` law in software floating point,
 //! held to the product's bound), once. The table must be, bit for bit, the one
 //! `mccs table` emits (`tables/table2.rs`), or the run fails. Prints

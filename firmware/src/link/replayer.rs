@@ -1,5 +1,5 @@
 //! A replay on the device ([`ReplayRun`]): a patch and solver built for the host's
-//! options, a path that arrives in pieces with flow control, one [`ReplayRow`] per tick
+//! options, a path that arrives in pieces with flow control, one [`ReplayRow`](mccs_link::ReplayRow) per tick
 //! computed by the same code as the host's `mccs replay --backend fixed`
 //! ([`mccs_link::replay`]). It runs in the main loop, never in the tick, and never past
 //! the samples it has received.

@@ -1,10 +1,10 @@
 //! Instruction counts of the per-tick arithmetic, measured in QEMU under `-icount`:
 //! SysTick runs free (no interrupt) at the machine's clock, and is calibrated against a
-//! loop of known instruction count ([`harness`]); each case ([`cases`]) is averaged over
+//! loop of known instruction count (`harness`); each case (`cases`) is averaged over
 //! repeated calls of an `#[inline(never)]` entry point (`mccs_firmware::entry`) with
 //! `black_box`ed inputs, less the cost of an empty call. Prints
 //! `BENCH core=<m4f|m3|m0> case=<name> instructions=<n>`, then checks this core's budgets
-//! ([`report`], `bench/budgets.txt`) and exits with failure on a breach.
+//! (`report`, `bench/budgets.txt`) and exits with failure on a breach.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
