@@ -29,10 +29,16 @@ const IDENTITY_Q: [i32; 4] = [ONE, 0, 0, 0];
 const IDENTITY_R: [[i32; 3]; 3] = [[ONE, 0, 0], [0, ONE, 0], [0, 0, ONE]];
 
 /// Whether `q` (Q30) is a unit quaternion within 2⁻¹⁰ of its squared norm: what a pose
-/// from a host must be (the tick renormalises what it slews, not what it is sent).
+/// from a host must be (the tick renormalises what it slews, not what it is sent). Any
+/// four `i32`s: the squares in `u64`, their sum saturated (four of `i32::MIN` make 2⁶⁴;
+/// summed in `i64`, `[MIN, MIN, 2³⁰, 0]` wrapped to a difference of `i64::MIN`, whose
+/// `abs` passed it as a unit).
 pub fn is_unit(q: [i32; 4]) -> bool {
-    let n2: i64 = q.iter().map(|&c| c as i64 * c as i64).sum();
-    (n2 - (1i64 << 60)).abs() <= 1i64 << 50
+    let n2 = q.iter().fold(0u64, |s, &c| {
+        let a = c.unsigned_abs() as u64;
+        s.saturating_add(a * a)
+    });
+    n2.abs_diff(1u64 << 60) <= 1u64 << 50
 }
 
 /// A tissue's pose in the device's frame, moving toward a target.

@@ -446,6 +446,30 @@ fn is_clamped(f: [Force; 3], max: Force) -> bool {
     if b.iter().any(|&c| c.saturating_abs() >= near) {
         return true;
     }
-    let f2: i64 = b.iter().map(|&c| c as i64 * c as i64).sum();
-    f2 >= near as i64 * near as i64
+    // (In `u64`: three squares of up to 2⁶² each; in `i64` they overflowed for a clamp
+    // past 1,672 N, with every axis just under it.)
+    let f2: u64 = b.iter().map(|&c| (c as i64 * c as i64) as u64).sum();
+    f2 >= (near as i64 * near as i64) as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A clamp near the largest the solver takes (1,999.99 N): a force just under it on
+    /// every axis is clamped by its magnitude; its three squares passed an `i64` and
+    /// overflowed (a panic with overflow checks, a wrapped verdict without), for any clamp
+    /// past 1,672 N.
+    #[test]
+    fn a_force_near_a_large_clamp_on_every_axis_is_clamped() {
+        let max = Force::from_num(1999.99);
+        assert!(is_clamped([Force::from_num(1990.0); 3], max));
+        assert!(is_clamped([Force::from_num(-1990.0); 3], max));
+        assert!(is_clamped([Force::from_num(1200.0); 3], max));
+        assert!(!is_clamped(
+            [Force::from_num(1100.0), Force::ZERO, Force::ZERO],
+            max
+        ));
+        assert!(is_clamped([Force::MIN, Force::ZERO, Force::ZERO], max));
+    }
 }

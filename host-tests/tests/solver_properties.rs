@@ -492,3 +492,87 @@ fn after_lift_off_the_patch_returns_to_rest_and_loses_energy_wide() {
 fn after_lift_off_the_patch_returns_to_rest_and_loses_energy_narrow() {
     long::<Narrow>("narrow");
 }
+
+/// A configuration at the limits `SolverConfig::validate` takes (each at its end or
+/// anywhere between): tick rates of 1 Hz to 100 kHz, node masses of 1e-9 to 100 kg, no
+/// damping or the most, a coupling of up to 1,000 N/mm and 1,000 N·s/m and a clamp of up
+/// to 1,999.99 N; spacings of 1 to 6 mm (a 16-node tissue within the core's ±100 mm).
+fn limit_case() -> impl Strategy<Value = Case> {
+    let log = |lo: f64, hi: f64| (lo.ln()..hi.ln()).prop_map(f64::exp);
+    let ends = |lo: f64, hi: f64| prop_oneof![Just(lo), Just(hi), lo..hi];
+    (
+        (3usize..=4, ends(1.0, 6.0), ends(1.0, 100_000.0)),
+        (log(1e-9, 100.0), ends(0.0, 30.0), ends(0.0, 1e4)),
+        (
+            prop_oneof![Just(1000.0), log(1e-6, 1000.0)],
+            ends(0.0, 1000.0),
+            prop_oneof![Just(1999.99), log(1e-6, 1999.99)],
+        ),
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(
+            |((grid, spacing, hz), (mass, c, node_c), (kc, bc, fmax), conservative, symplectic)| {
+                Case {
+                    grid,
+                    spacing,
+                    config: SolverConfig {
+                        tick_hz: hz,
+                        node_mass: mass,
+                        spring_damping: c,
+                        node_damping: node_c,
+                        max_substeps: 12,
+                        coupling: Coupling {
+                            stiffness: kc,
+                            damping: bc,
+                            max_force: fmax,
+                        },
+                        bound: if conservative {
+                            Bound::Conservative
+                        } else {
+                            Bound::Estimated
+                        },
+                        integrator: if symplectic {
+                            Integrator::SymplecticDamped
+                        } else {
+                            Integrator::ImprovedEuler
+                        },
+                    },
+                }
+            },
+        )
+}
+
+/// The short runs' promises (no panic, the force within its clamp, zero after a
+/// fault) for configurations at the solver's limits, glued or roaming, each arithmetic.
+/// They found the controller's clamp flag summing three squares of up to 2⁶² in an
+/// `i64` (a clamp past 1,672 N with every axis just under it: a panic with overflow
+/// checks, a wrapped verdict without).
+fn at_the_limits<A: Arith>(name: &str) {
+    let seen = std::sync::Mutex::new(Seen::default());
+    run_cases(
+        cases(500, 1),
+        (
+            limit_case(),
+            any_path(200),
+            prop::option::weighted(0.3, (1u32..200, any::<bool>())),
+            prop::option::weighted(0.3, ((0.0f64..2.0, 0.0f64..2.0), 0.0f64..1.0)),
+        ),
+        |(case, path, fail, roam)| short_run::<A>(&case, path, fail, roam, &seen),
+    );
+    let s = seen.into_inner().unwrap();
+    println!(
+        "PROPERTY case=limits arith={name} cases={} roaming={} ticks={} device_faults={}",
+        s.cases, s.roaming, s.ticks, s.faults
+    );
+}
+
+#[test]
+fn configurations_at_the_solver_s_limits_keep_the_short_runs_promises_wide() {
+    at_the_limits::<Wide>("wide");
+}
+
+#[test]
+fn configurations_at_the_solver_s_limits_keep_the_short_runs_promises_narrow() {
+    at_the_limits::<Narrow>("narrow");
+}

@@ -126,3 +126,35 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4096))]
+
+    /// `is_unit`, the check of a host's rotation, over any four `i32`s (the extremes
+    /// among them): unit within 2⁻¹⁰ of the squared norm, exactly as in `i128`. Summed in
+    /// `i64`, `[MIN, MIN, 2³⁰, 0]` wrapped to a difference of `i64::MIN`, whose `abs`
+    /// passed it (and panicked with overflow checks).
+    #[test]
+    fn a_host_s_rotation_is_unit_exactly_when_its_norm_says_so(
+        q in prop::array::uniform4(prop_oneof![
+            any::<i32>(),
+            Just(i32::MIN),
+            Just(i32::MAX),
+            Just(1 << 30),
+            Just(-(1 << 30)),
+            Just(0),
+            (-(1i32 << 30)..=(1 << 30)),
+        ])
+    ) {
+        let n2: i128 = q.iter().map(|&c| c as i128 * c as i128).sum();
+        let want = (n2 - (1i128 << 60)).abs() <= 1i128 << 50;
+        prop_assert_eq!(is_unit(q), want, "{:?}", q);
+    }
+}
+
+#[test]
+fn the_wrapping_rotation_is_not_unit() {
+    assert!(!is_unit([i32::MIN, i32::MIN, 1 << 30, 0]));
+    assert!(!is_unit([i32::MIN; 4]));
+    assert!(is_unit([1 << 30, 0, 0, 0]));
+}
