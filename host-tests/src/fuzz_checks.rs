@@ -300,7 +300,8 @@ fn fuzzed_device_facts(config: mccs::SolverConfig) -> mccs_firmware::link::Live 
 
 /// The device's side of the link on any bytes: the board's own server, link state and
 /// glued controller on the N = 3 patch, a tick between polls of at most 64 bytes; no
-/// panic; a valid `Hello` after them is answered.
+/// panic; a valid `Hello` after them is answered. The bytes are raw, or after a first
+/// `F` chunks each framed or not ([`chunk_stream`]).
 pub fn link_device(data: &[u8]) {
     use mccs_firmware::link::{
         Guard, GuardTimes, LinkServer, LinkState, LinkedDevice, Session, Work,
@@ -329,7 +330,13 @@ pub fn link_device(data: &[u8]) {
     let hello = encode(&ToDevice::Hello, &mut hello)
         .expect("a frame")
         .to_vec();
-    let all: Vec<u8> = data.iter().copied().chain([0u8]).chain(hello).collect();
+    // The bytes as they come, or, after a first byte `F`, chunks each raw or framed
+    // (`chunk_stream`), so that a mutated message reaches the session past the CRC.
+    let stream = match data.split_first() {
+        Some((b'F', rest)) => chunk_stream(rest),
+        _ => data.to_vec(),
+    };
+    let all: Vec<u8> = stream.into_iter().chain([0u8]).chain(hello).collect();
     let mut decoder = Decoder::new();
     let mut answers = Vec::new();
     let mut rx = all.iter().copied();
@@ -508,11 +515,11 @@ pub fn view_request(data: &[u8]) {
     }
 }
 
-/// A device's bytes for [`link_host`]: chunks of `[tag, length, bytes…]` (the last one
+/// A peer's bytes for [`link_host`] and [`link_device`]: chunks of `[tag, length, bytes…]` (the last one
 /// takes what is left), each sent raw where its tag is even, or as one frame around its
 /// bytes (at most [`mccs_link::MAX_PAYLOAD`]) where it is odd, so that the messages'
 /// parser is reached past the CRC; then a delimiter.
-fn device_bytes(data: &[u8]) -> Vec<u8> {
+fn chunk_stream(data: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
     let mut rest = data;
     while let [tag, len, tail @ ..] = rest {
@@ -603,7 +610,7 @@ fn scripted_device(
     }
 }
 
-/// The scene's library's side of the link on any bytes from a device (`device_bytes`),
+/// The scene's library's side of the link on any bytes from a device (`chunk_stream`),
 /// sent after its hello's answer: no thread panics, what the library keeps of it is
 /// finite, and an error is one line. Where the bytes hold no message at all (noise on
 /// the line), the library drops each frame and counts it as the decoder does, and the
@@ -612,7 +619,7 @@ pub fn link_host(data: &[u8]) {
     use mccs_link::{parse, Decoder, ToHost};
     static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let hello = soft_hello();
-    let bytes = device_bytes(data);
+    let bytes = chunk_stream(data);
     let (mut dropped, mut messages) = (0u32, 0usize);
     let mut decoder = Decoder::new();
     for &b in &bytes {

@@ -307,8 +307,9 @@ proptest! {
     }
 }
 
-/// The link's fuzz target starts from every message's frame, and a whole tissue load
-/// (`fuzz/seeds/link_device/`, written by `MCCS_UPDATE_SEEDS=1`).
+/// The link's fuzz target starts from every message's frame, a whole tissue load, and
+/// every message as a framed chunk of its check (`fuzz/seeds/link_device/`, written by
+/// `MCCS_UPDATE_SEEDS=1`).
 #[test]
 fn the_link_fuzz_seeds_are_every_message() {
     let mut every = Vec::new();
@@ -334,7 +335,28 @@ fn the_link_fuzz_seeds_are_every_message() {
         env!("CARGO_MANIFEST_DIR"),
         "/../fuzz/seeds/link_device"
     ));
-    for (name, bytes) in [("every-message", every), ("tissue-load", load)] {
+    // The same messages as the check's framed chunks (`F`, then `[1, length, payload]`
+    // each): what a fuzzer mutates inside the frame.
+    let mut framed = vec![b'F'];
+    for (_, m) in to_device() {
+        let p = postcard::to_allocvec(&m).unwrap();
+        framed.extend([1, p.len() as u8]);
+        framed.extend(p);
+    }
+    // The rotation whose squares wrapped `is_unit`'s `i64` sum to a pass.
+    let wrapped = ToDevice::Pose(Pose {
+        origin: [0; 3],
+        rotation: [i32::MIN, i32::MIN, 1 << 30, 0],
+    });
+    let p = postcard::to_allocvec(&wrapped).unwrap();
+    let mut pose = vec![b'F', 1, p.len() as u8];
+    pose.extend(p);
+    for (name, bytes) in [
+        ("every-message", every),
+        ("tissue-load", load),
+        ("every-message-framed", framed),
+        ("a-rotation-whose-norm-wrapped-framed", pose),
+    ] {
         let path = dir.join(name);
         if std::env::var("MCCS_UPDATE_SEEDS").as_deref() == Ok("1") {
             std::fs::create_dir_all(dir).unwrap();
