@@ -67,33 +67,50 @@ fn any_case(grids: std::ops::RangeInclusive<usize>) -> impl Strategy<Value = Cas
             )| Case {
                 grid,
                 spacing,
-                config: SolverConfig {
-                    tick_hz: hz,
-                    node_mass: mass_g / 1000.0,
-                    spring_damping: c,
-                    node_damping: node_c,
-                    // A tick's work is bounded here to keep 10⁴ cases within the test
-                    // command's time: configurations that need more substeps are refused by
-                    // the solver (and left out by the property).
-                    max_substeps: 12,
-                    coupling: Coupling {
-                        stiffness: kc,
-                        damping: bc,
-                        max_force: fmax,
-                    },
-                    bound: if conservative {
-                        Bound::Conservative
-                    } else {
-                        Bound::Estimated
-                    },
-                    integrator: if symplectic {
-                        Integrator::SymplecticDamped
-                    } else {
-                        Integrator::ImprovedEuler
-                    },
-                },
+                config: config(
+                    (hz, mass_g / 1000.0, c, node_c),
+                    (kc, bc, fmax),
+                    conservative,
+                    symplectic,
+                ),
             },
         )
+}
+
+/// A configuration of the short runs: `(tick_hz, node_mass kg, spring_damping,
+/// node_damping)`, the coupling `(stiffness, damping, max_force)`, the bound and the
+/// integrator.
+fn config(
+    (hz, mass_kg, c, node_c): (f64, f64, f64, f64),
+    (kc, bc, fmax): (f64, f64, f64),
+    conservative: bool,
+    symplectic: bool,
+) -> SolverConfig {
+    SolverConfig {
+        tick_hz: hz,
+        node_mass: mass_kg,
+        spring_damping: c,
+        node_damping: node_c,
+        // A tick's work is bounded here to keep 10⁴ cases within the test command's
+        // time: configurations that need more substeps are refused by the solver (and
+        // left out by the property).
+        max_substeps: 12,
+        coupling: Coupling {
+            stiffness: kc,
+            damping: bc,
+            max_force: fmax,
+        },
+        bound: if conservative {
+            Bound::Conservative
+        } else {
+            Bound::Estimated
+        },
+        integrator: if symplectic {
+            Integrator::SymplecticDamped
+        } else {
+            Integrator::ImprovedEuler
+        },
+    }
 }
 
 /// A probe trajectory: waypoints (tick, position) anywhere within ±64 mm, some of them
@@ -516,28 +533,12 @@ fn limit_case() -> impl Strategy<Value = Case> {
                 Case {
                     grid,
                     spacing,
-                    config: SolverConfig {
-                        tick_hz: hz,
-                        node_mass: mass,
-                        spring_damping: c,
-                        node_damping: node_c,
-                        max_substeps: 12,
-                        coupling: Coupling {
-                            stiffness: kc,
-                            damping: bc,
-                            max_force: fmax,
-                        },
-                        bound: if conservative {
-                            Bound::Conservative
-                        } else {
-                            Bound::Estimated
-                        },
-                        integrator: if symplectic {
-                            Integrator::SymplecticDamped
-                        } else {
-                            Integrator::ImprovedEuler
-                        },
-                    },
+                    config: config(
+                        (hz, mass, c, node_c),
+                        (kc, bc, fmax),
+                        conservative,
+                        symplectic,
+                    ),
                 }
             },
         )
