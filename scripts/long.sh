@@ -4,7 +4,8 @@
 #      (default 50,000: ten times the test command's, about 10⁷ ticks in all), and the
 #      settling properties at CASES / 100;
 #   2. the roaming probe over random caps and paths at CASES / 10 cases
-#      (host-tests/tests/cap.rs), the stability bound against the exact one on CASES / 2
+#      (host-tests/tests/cap.rs), any run of the link at CASES / 25
+#      (host-tests/tests/link/any_run.rs), the stability bound against the exact one on CASES / 2
 #      random configurations (host-tests/tests/stability.rs), and the force-table bound
 #      over 10⁵ random springs (host-tests/tests/table_bound/), and the arm's stable
 #      region against its device file's (`mccs arm stability`);
@@ -52,6 +53,12 @@ caps=$((cases / 10))
 say "long.sh: the roaming probe over random caps at $caps cases"
 PROPTEST_CASES=$caps run_stage cap-paths cargo test --release -p mccs-host --test host -- cap::robust
 echo "PROPERTY case=cap_paths cases=$caps result=ok"
+
+links=$((cases / 25))
+say "long.sh: any run of the link, end to end, at $links cases (about 80 s at 1,500)"
+PROPTEST_CASES=$links run_stage link-runs cargo test --release -p mccs-host --test host \
+  -- link::any_run
+echo "PROPERTY case=link_runs cases=$links result=ok"
 
 configs=$((cases / 2))
 # (A new seed each run unless PROPTEST_RNG_SEED is set; the STABILITY line names it.)

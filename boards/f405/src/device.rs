@@ -9,8 +9,8 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Mode, SpiDevice, MODE_1};
 use mccs::{
-    ArmError, Flat, ForceTable, ProxyConfig, ProxyError, Solver, SolverError, TissuePose, Topology,
-    TopologyError, Wide, WindowConfig,
+    ArmError, Flat, Force, ForceTable, ProxyConfig, ProxyError, Solver, SolverError, TissuePose,
+    Topology, TopologyError, Wide, WindowConfig,
 };
 use mccs_firmware::drivers::as5047p::As5047p;
 use mccs_firmware::drivers::pwm_motor::{MotorError, PwmMotor};
@@ -92,6 +92,7 @@ pub fn linked<D>(config: &BoardConfig, device: D) -> LinkedDevice<D> {
             config.pose_turn_deg_s as f64,
             config.tick_hz as f64,
         ),
+        Force::saturating_from_num(config.max_force),
     )
 }
 

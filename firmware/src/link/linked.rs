@@ -1,7 +1,15 @@
 //! [`LinkedDevice`]: a device as the link sees it — the probe read into the tissue's
 //! frame through the host's pose ([`mccs::TissuePose`], moved toward its target at the
 //! device's slew limits every tick) and the force rendered back in the device's frame,
-//! scaled by the link's gain ([`super::Guard`]) before it reaches the actuator.
+//! scaled by the link's gain ([`super::Guard`]) and held on each axis to the device's
+//! clamp before it reaches the actuator.
+//!
+//! The clamp again after the rotation: the glued contact clamps each axis in the
+//! tissue's frame (docs/solver.md), and a rotated tissue mixes its axes, so that one
+//! axis of the device's frame took up to √3 times the clamp (on the 1-DOF board, a
+//! tissue turned 78° about `x` rendered 3.01 N against a 3 N clamp on the tick it began
+//! to turn, and 4.24 N at 45°: `tests/link/any_run.rs`). The roaming contact clamps
+//! the force's size, which a rotation keeps, so that there it changes nothing.
 
 use crate::device::{DeviceStatus, HapticDevice};
 use mccs::{Force, Length, TissuePose};
@@ -15,18 +23,22 @@ pub struct LinkedDevice<D> {
     gain: u16,
     probe: [Length; 3],
     rendered: [Force; 3],
+    /// The device's clamp on each axis of its frame, Q20 N (positive).
+    max_force: i32,
 }
 
 impl<D> LinkedDevice<D> {
     /// `device` with the tissue at its origin, unrotated, at zero gain until the guard
-    /// raises it; the pose moves at most `pose` allows.
-    pub fn new(device: D, pose: TissuePose) -> Self {
+    /// raises it; the pose moves at most `pose` allows; each axis of the force it
+    /// renders held within `±max_force` (its size taken: a negative clamp is its size).
+    pub fn new(device: D, pose: TissuePose, max_force: Force) -> Self {
         Self {
             device,
             pose,
             gain: 0,
             probe: [Length::ZERO; 3],
             rendered: [Force::ZERO; 3],
+            max_force: max_force.to_bits().saturating_abs(),
         }
     }
 
@@ -55,7 +67,7 @@ impl<D> LinkedDevice<D> {
         self.probe
     }
 
-    /// The force last sent to the device, in its frame, the gain applied.
+    /// The force last sent to the device, in its frame, the gain and the clamp applied.
     pub fn rendered(&self) -> [Force; 3] {
         self.rendered
     }
@@ -83,8 +95,13 @@ impl<D: HapticDevice> HapticDevice for LinkedDevice<D> {
 
     fn write_force(&mut self, force: [Force; 3]) -> Result<(), Self::Error> {
         let g = self.gain as i64;
+        let m = self.max_force;
         let f = self.pose.to_device(force);
-        let scaled = f.map(|c| Force::from_bits(((c.to_bits() as i64 * g) >> 15) as i32));
+        // (`max` and `min`, not `clamp`, which asserts its bounds: a panic path.)
+        let scaled = f.map(|c| {
+            let s = ((c.to_bits() as i64 * g) >> 15) as i32;
+            Force::from_bits(s.max(-m).min(m))
+        });
         self.rendered = scaled;
         self.device.write_force(scaled)
     }

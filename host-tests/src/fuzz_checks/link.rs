@@ -58,6 +58,7 @@ pub fn link_device(data: &[u8]) {
     let device = LinkedDevice::new(
         SimulatedDevice::new(path),
         mccs::TissuePose::new(200.0, 180.0, 1000.0),
+        solver.max_force(),
     );
     let mut ctl = Controller::new(solver, device, u32::MAX);
     let mut hello = [0u8; MAX_FRAME];

@@ -540,6 +540,40 @@ fn a_pose_change_never_jumps_the_force_by_more_than_the_clamp() {
     );
 }
 
+/// The 1-DOF board's glued contact clamps each axis in the tissue's frame; turned 45°
+/// about `x`, a deep press saturates its `y` and `z`, which the rotation mixes into one
+/// axis of the device's frame: 4.24 N against the 3 N clamp before the device held each
+/// of its axes to it (`LinkedDevice`; found by `any_run`).
+#[test]
+fn a_turned_tissue_keeps_each_axis_of_the_device_within_the_clamp() {
+    let mut rig = Rig::glued(table2());
+    for _ in 0..600 {
+        rig.step();
+    }
+    rig.send(&ToDevice::Pose(Pose::from_mm_deg(
+        [0.0; 3],
+        [45.0, 0.0, 0.0],
+    )));
+    for _ in 0..400 {
+        rig.step();
+    }
+    rig.probe().at = [0.0, 0.0, -20.0];
+    let clamp = Force::from_num(BOARD.max_force);
+    let mut largest = Force::ZERO;
+    for _ in 0..300 {
+        rig.step();
+        for c in rig.ctl.device().rendered() {
+            largest = largest.max(c.saturating_abs());
+        }
+    }
+    assert!(largest <= clamp, "{largest} N on one axis");
+    assert!(
+        largest > clamp * 99 / 100,
+        "{largest} N: not pressed to the clamp"
+    );
+    println!("LINK case=turned_glued largest_axis_n={largest:.4}");
+}
+
 #[test]
 fn a_run_of_overruns_ends_in_the_safe_state() {
     let mut rig = Rig::roaming(table2());
@@ -1075,7 +1109,11 @@ fn homing_restarts_the_ramp() {
         &BOARD.solver(),
     )
     .unwrap();
-    let device = LinkedDevice::new(Homing(homed.clone()), TissuePose::new(200.0, 180.0, 1000.0));
+    let device = LinkedDevice::new(
+        Homing(homed.clone()),
+        TissuePose::new(200.0, 180.0, 1000.0),
+        solver.max_force(),
+    );
     let mut ctl = mccs_firmware::Controller::new(solver, device, u32::MAX);
     for _ in 0..600 {
         state.run_tick(&mut ctl);

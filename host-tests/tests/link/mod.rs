@@ -1,6 +1,9 @@
 //! The host link (`mccs-link`, docs/link.md): its codec here; the device's side of it in
-//! `device.rs` (its force gain over arbitrary runs in `guard.rs`); the firmware in QEMU behind `mccs link` in `qemu.rs`.
+//! `device.rs` (its force gain over arbitrary runs in `guard.rs`, the whole device over
+//! arbitrary runs of the link in `any_run.rs`); the firmware in QEMU behind `mccs link`
+//! in `qemu.rs`.
 
+mod any_run;
 mod cli;
 mod codec;
 mod device;

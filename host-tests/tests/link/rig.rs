@@ -27,6 +27,8 @@ pub struct Probe {
     pub rendered: Vec<[Force; 3]>,
     /// Its next read fails.
     pub fail: bool,
+    /// Calls of its safe state.
+    pub safe_states: u32,
 }
 
 impl HapticDevice for Probe {
@@ -42,6 +44,7 @@ impl HapticDevice for Probe {
         Ok(())
     }
     fn safe_state(&mut self) -> Result<(), ()> {
+        self.safe_states += 1;
         Ok(())
     }
 }

@@ -333,6 +333,7 @@ pub fn tick_link(h: &Harness, table: &ForceTable64) -> u32 {
         LinkedDevice::new(
             SimulatedDevice::new(path),
             mccs::TissuePose::new(200.0, 180.0, 1000.0),
+            solver().max_force(),
         ),
         u32::MAX,
     );
