@@ -199,7 +199,7 @@ pub struct SolverInfo {
 /// The device's counters and state.
 #[derive(Serialize, Deserialize, Schema, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct StatusInfo {
-    /// Ticks run.
+    /// Ticks run, wrapping at 2³² (49.7 days at 1 kHz).
     pub ticks: u32,
     /// Ticks that overran.
     pub overruns: u32,
@@ -230,7 +230,7 @@ pub struct StatusInfo {
 pub struct Telemetry {
     /// Counts telemetry messages, sent or dropped: a gap is a drop.
     pub seq: u32,
-    /// The tick.
+    /// The tick (the count `StatusInfo::ticks` gives, wrapping at 2³²).
     pub tick: u32,
     /// The probe in the tissue's frame, Q24 mm.
     pub probe: [i32; 3],
@@ -268,7 +268,7 @@ pub const MESH_PART: usize = 12;
 pub struct MeshPart {
     /// Counts meshes, sent or dropped: a gap is a drop.
     pub seq: u32,
-    /// The tick the positions are from.
+    /// The tick the positions are from (wrapping at 2³², as `StatusInfo::ticks`).
     pub tick: u32,
     /// The first node in this part.
     pub first: u16,

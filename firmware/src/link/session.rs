@@ -435,14 +435,18 @@ impl<const S: usize> Session<S> {
         send: &mut dyn FnMut(&ToHost) -> bool,
     ) {
         let (every, tick) = (self.watch_every, snap.ticks);
-        if every == 0 || tick < self.next_watch {
+        // On the link's clock, which wraps: due once `tick` has reached `next_watch`
+        // (within half the clock's range; the main loop polls far more often).
+        let since = tick.wrapping_sub(self.next_watch);
+        if every == 0 || since > i32::MAX as u32 {
             return;
         }
-        // The due slots since the last: all but this one were missed.
-        let missed = (tick - self.next_watch) / every;
+        // The due slots since the last: all but this one were missed. (`since + every`
+        // is below 2³¹ + 2¹⁶: no overflow.)
+        let missed = since / every;
         self.dropped = self.dropped.saturating_add(missed);
         self.seq = self.seq.wrapping_add(missed);
-        self.next_watch = self.next_watch.saturating_add((missed + 1) * every);
+        self.next_watch = self.next_watch.wrapping_add((missed + 1) * every);
         let msg = ToHost::Telemetry(Telemetry {
             seq: self.seq,
             tick,
@@ -472,7 +476,7 @@ impl<const S: usize> Session<S> {
             return;
         }
         if let Some(last) = self.last_mesh {
-            let missed = (m.tick.saturating_sub(last) / every).saturating_sub(1);
+            let missed = (m.tick.wrapping_sub(last) / every).saturating_sub(1);
             self.mesh_seq = self.mesh_seq.wrapping_add(missed);
             self.dropped_mesh = self.dropped_mesh.saturating_add(missed);
         }

@@ -27,7 +27,7 @@ pub struct Swap<const S: usize, A: Arith> {
 /// The tick as the main loop sees it: what the last tick did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Snapshot {
-    /// Ticks run.
+    /// The link's clock after the tick: ticks run, wrapping at 2³² (49.7 days at 1 kHz).
     pub ticks: u32,
     /// Overruns.
     pub overruns: u32,
@@ -78,12 +78,24 @@ pub struct LinkState<const N: usize, const S: usize, A: Arith> {
     /// Whether the device was homed at the last tick (a homing restarts the ramp).
     homed: Shared<bool>,
     snapshot: Shared<Snapshot>,
+    /// The link's clock: the next tick's number, wrapping at 2³². The guard's, the
+    /// frames' and the streams' time. Not the controller's count of ticks, which
+    /// saturates: fed that, after 2³² − 1 ticks (49.7 days at 1 kHz, 5 at 10 kHz) every
+    /// frame and every tick would have the same time, and an armed host's silence
+    /// would never fade.
+    clock: Shared<u32>,
 }
 
 impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
     /// Standalone (the guard's gain ramps once the probe is out of contact), the tissue
-    /// at the origin, nothing to swap.
+    /// at the origin, nothing to swap; the clock at 0.
     pub const fn new(guard: Guard) -> Self {
+        Self::with_clock(guard, 0)
+    }
+
+    /// As [`LinkState::new`], the clock starting at `start`: the tests', which run the
+    /// clock across its wrap without 2³² ticks.
+    pub const fn with_clock(guard: Guard, start: u32) -> Self {
         Self {
             guard: Shared::new(guard),
             pose: Shared::new(None),
@@ -93,8 +105,9 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
             mesh: Mailbox::new(),
             contact: Shared::new(false),
             homed: Shared::new(false),
+            clock: Shared::new(start),
             snapshot: Shared::new(Snapshot {
-                ticks: 0,
+                ticks: start,
                 overruns: 0,
                 fault: FaultReason::None,
                 probe: [0; 3],
@@ -171,8 +184,8 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
         &self,
         ctl: &mut Controller<LinkedDevice<D>, N, E, S, A, C>,
     ) -> [Force; 3] {
-        let ticks = ctl.telemetry().ticks;
-        let gain = self.guard.update(|g| g.gain(ticks, self.contact.get()));
+        let now = self.clock.get();
+        let gain = self.guard.update(|g| g.gain(now, self.contact.get()));
         let d = ctl.device_mut();
         d.set_gain(gain);
         if let Some(p) = self.pose.update(|p| p.take()) {
@@ -212,10 +225,12 @@ impl<const N: usize, const S: usize, A: Arith> LinkState<N, S, A> {
             .with(Flags::GAIN_LIMITED, gain < GAIN_FULL);
         let window = contact.map_or([0; 2], |c| c.window);
         if self.mesh_clock.due() {
-            let _ = self.mesh.post(Mesh::of(ctl.solver(), ticks, window));
+            let _ = self.mesh.post(Mesh::of(ctl.solver(), now, window));
         }
+        let next = now.wrapping_add(1);
+        self.clock.set(next);
         self.snapshot.set(Snapshot {
-            ticks: t.ticks,
+            ticks: next,
             overruns: t.overruns,
             fault: fault_reason(t.fault),
             probe: ctl.device().probe().map(|c| c.to_bits()),

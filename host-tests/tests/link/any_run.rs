@@ -3,7 +3,8 @@
 //! the host's messages (tissue loads whole, refused or cut short, poses inside and
 //! outside the workspace, rotations that are not one, `Arm`, `Disarm`, the streams),
 //! frames of noise, silences, a probe anywhere, failed reads and runs of overruns.
-//! Checked against a model of the protocol's promises (docs/protocol.md), not the
+//! The link's clock starts at 0, anywhere, or a few thousand ticks before its wrap at
+//! 2³². Checked against a model of the protocol's promises (docs/protocol.md), not the
 //! device's own state:
 //!
 //! - **at the actuator**, every tick: the force within the device's clamp; zero once
@@ -188,6 +189,10 @@ struct Model<C: Contact<NODES, EDGES, 64, Wide>> {
     answers: Vec<Answer>,
     /// The link's gain at the last tick, Q15.
     gain: u16,
+    /// The link's clock: its start, a tick more each tick, wrapping.
+    clock: u32,
+    /// The last `Watch` on: when it was handled and its period, ticks.
+    watch: Option<(u32, u32)>,
     /// The guard's timeout and fade at the board's rate, ticks.
     timeout: u32,
     fade: u32,
@@ -225,6 +230,7 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
     fn new(rig: Rig<C>, roaming: bool) -> Self {
         let times = mccs_firmware::link::GuardTimes::at_rate(BOARD.tick_hz, BOARD.ramp_ms);
         Self {
+            clock: rig.state.snapshot().ticks,
             rig,
             roaming,
             held: Held::Standalone,
@@ -234,13 +240,15 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
             bad_frames: 0,
             answers: Vec::new(),
             gain: 0,
+            watch: None,
             timeout: times.timeout,
             fade: times.fade,
         }
     }
 
+    /// The link's clock after the last tick, as the model counts it.
     fn now(&self) -> u32 {
-        self.rig.ctl.telemetry().ticks
+        self.clock
     }
 
     /// One tick (on time or not), its actuator and gain checked, then a poll.
@@ -251,6 +259,12 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
             (p.rendered.len(), p.safe_states)
         };
         self.rig.tick();
+        self.clock = self.clock.wrapping_add(1);
+        assert_eq!(
+            self.rig.state.snapshot().ticks,
+            self.clock,
+            "the link's clock"
+        );
         if overran {
             self.rig.ctl.note_overrun();
             self.overruns_in_row += 1;
@@ -407,6 +421,10 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
                 self.answers.push(self.status(Some(false)));
             }
             (Msg::BlackBox(_), _) => self.answers.push(Answer::BlackBox),
+            (Msg::Watch(every), _) => {
+                let least = rates::telemetry_least_every(BOARD.tick_hz, BOARD.baud) as u32;
+                self.watch = (*every != 0).then(|| (self.now(), (*every as u32).max(least)));
+            }
             (_, ToDevice::Pose(p)) => match refusal(&p) {
                 Some(r) => self.answers.push(Answer::Nak(r)),
                 None => self.pose = p,
@@ -619,12 +637,13 @@ proptest! {
     #[test]
     fn any_run_keeps_the_actuator_and_the_answers_to_the_protocol(
         roaming in any::<bool>(),
+        clock in prop_oneof![Just(0u32), u32::MAX - 4000..=u32::MAX, any::<u32>()],
         ops in ops(),
     ) {
         if roaming {
-            run(Model::new(Rig::roaming(table2()), true), &ops)?;
+            run(Model::new(Rig::roaming_from(table2(), clock), true), &ops)?;
         } else {
-            run(Model::new(Rig::glued(table2()), false), &ops)?;
+            run(Model::new(Rig::glued_from(table2(), clock), false), &ops)?;
         }
     }
 }
@@ -650,5 +669,34 @@ fn run<C: Contact<NODES, EDGES, 64, Wide>>(
         model.step(false);
     }
     check_answers(&model.rig.out, &model.answers);
+    check_telemetry(&model);
     Ok(())
+}
+
+/// The telemetry stream: numbered without a gap (the rig's main loop polls every tick
+/// and sends whatever it is given: nothing is dropped), and, where a `Watch` is on,
+/// still coming at its period at the end of the run, the clock's wrap included.
+fn check_telemetry<C: Contact<NODES, EDGES, 64, Wide>>(model: &Model<C>) {
+    let samples: Vec<&Telemetry> = model
+        .rig
+        .out
+        .iter()
+        .filter_map(|m| match m {
+            ToHost::Telemetry(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    for w in samples.windows(2) {
+        assert_eq!(w[1].seq, w[0].seq.wrapping_add(1), "a gap: {:?}", w);
+    }
+    let now = model.now();
+    if let Some((from, every)) = model.watch {
+        if now.wrapping_sub(from) > 2 * every + 2 {
+            let last = samples.last().map(|t| t.tick);
+            assert!(
+                last.is_some_and(|t| now.wrapping_sub(t) <= every + 1),
+                "at tick {now}, the last sample {last:?} of a watch every {every} ticks"
+            );
+        }
+    }
 }

@@ -540,6 +540,76 @@ fn a_pose_change_never_jumps_the_force_by_more_than_the_clamp() {
     );
 }
 
+/// The link's clock wraps at 2³² (49.7 days at 1 kHz): across it, an armed host held by
+/// its keepalives keeps its force, its silence still fades it, and the telemetry keeps
+/// its period and its numbers. (The guard was fed the controller's count of ticks,
+/// which saturates: from then on every frame and tick had one time, and a silence never
+/// faded.)
+#[test]
+fn an_armed_host_s_silence_fades_across_the_clock_s_wrap() {
+    let mut rig = Rig::roaming_from(table2(), u32::MAX - 1000);
+    let mut samples: Vec<Telemetry> = Vec::new();
+    // A tick, the telemetry it sent kept.
+    let mut step = |rig: &mut Rig<_>| {
+        rig.step();
+        rig.out.retain(|m| match m {
+            ToHost::Telemetry(t) => {
+                samples.push(*t);
+                false
+            }
+            _ => true,
+        });
+    };
+    rig.send(&ToDevice::Watch { every: 10 });
+    for _ in 0..600 {
+        step(&mut rig);
+    }
+    rig.send(&ToDevice::Arm);
+    // Keepalives across the wrap (the clock passes 0 at the 1,001st tick).
+    for _ in 0..40 {
+        for _ in 0..25 {
+            step(&mut rig);
+        }
+        rig.send(&ToDevice::Keepalive);
+    }
+    let snap = rig.state.snapshot();
+    assert!(snap.ticks < 1000, "the clock at {}", snap.ticks);
+    assert_eq!(snap.gain, GAIN_FULL, "held armed across the wrap");
+    // Silent: zero within the timeout and the fade, and disarmed.
+    let times = GuardTimes::at_rate(BOARD.tick_hz, BOARD.ramp_ms);
+    for _ in 0..times.timeout + times.fade + 2 {
+        step(&mut rig);
+    }
+    assert_eq!(
+        rig.state.snapshot().gain,
+        0,
+        "the silence did not fade the force"
+    );
+    assert_eq!(rig.ctl.device().rendered(), [Force::ZERO; 3]);
+    rig.send(&ToDevice::Status);
+    step(&mut rig);
+    let statuses: Vec<bool> = rig
+        .out
+        .iter()
+        .filter_map(|m| match m {
+            ToHost::Status(s) => Some(s.armed),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(statuses, [true, false], "Arm's, then after the silence");
+    // The telemetry: every 10 ticks, across the wrap, numbered without a gap.
+    assert!(
+        samples.len() >= 170,
+        "{} samples in 1,723 ticks",
+        samples.len()
+    );
+    assert!(samples.iter().any(|t| t.tick < 1000), "none after the wrap");
+    for w in samples.windows(2) {
+        assert_eq!(w[1].tick.wrapping_sub(w[0].tick), 10, "{w:?}");
+        assert_eq!(w[1].seq, w[0].seq + 1, "{w:?}");
+    }
+}
+
 /// The 1-DOF board's glued contact clamps each axis in the tissue's frame; turned 45°
 /// about `x`, a deep press saturates its `y` and `z`, which the rotation mixes into one
 /// axis of the device's frame: 4.24 N against the 3 N clamp before the device held each

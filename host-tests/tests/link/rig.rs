@@ -90,15 +90,16 @@ pub fn live(contact: ContactKind) -> Live {
 
 fn parts(
     table: ForceTable64,
+    clock: u32,
 ) -> (
     &'static LinkState<NODES, 64, Wide>,
     &'static mut Work<NODES, EDGES, 64, Wide, P>,
     Solver<NODES, EDGES, 64, Wide>,
 ) {
-    let state = Box::leak(Box::new(LinkState::new(Guard::new(GuardTimes::at_rate(
-        BOARD.tick_hz,
-        BOARD.ramp_ms,
-    )))));
+    let state = Box::leak(Box::new(LinkState::with_clock(
+        Guard::new(GuardTimes::at_rate(BOARD.tick_hz, BOARD.ramp_ms)),
+        clock,
+    )));
     let work = Box::leak(Box::default());
     let topo = Topology::standard_patch(BOARD.grid, SPACING_MM).unwrap();
     let solver = Solver::new(topo, table, &BOARD.solver()).unwrap();
@@ -109,7 +110,12 @@ impl Rig<BoardRoaming> {
     /// The arm board's device (roaming with friction) with `table` live, the probe
     /// 5 mm above the tissue.
     pub fn roaming(table: ForceTable64) -> Self {
-        let (state, work, mut solver) = parts(table);
+        Self::roaming_from(table, 0)
+    }
+
+    /// [`Rig::roaming`], the link's clock starting at `clock`.
+    pub fn roaming_from(table: ForceTable64, clock: u32) -> Self {
+        let (state, work, mut solver) = parts(table, clock);
         let contact = roaming(&BOARD, &mut solver).unwrap();
         let mut ctl = Controller::with_contact(
             solver,
@@ -133,7 +139,12 @@ impl Rig<BoardRoaming> {
 impl Rig<Glued> {
     /// The 1-DOF board's device (glued) with `table` live, the probe 5 mm above.
     pub fn glued(table: ForceTable64) -> Self {
-        let (state, work, solver) = parts(table);
+        Self::glued_from(table, 0)
+    }
+
+    /// [`Rig::glued`], the link's clock starting at `clock`.
+    pub fn glued_from(table: ForceTable64, clock: u32) -> Self {
+        let (state, work, solver) = parts(table, clock);
         let mut ctl = Controller::new(
             solver,
             linked(
