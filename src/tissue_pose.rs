@@ -29,7 +29,7 @@ const IDENTITY_Q: [i32; 4] = [ONE, 0, 0, 0];
 const IDENTITY_R: [[i32; 3]; 3] = [[ONE, 0, 0], [0, ONE, 0], [0, 0, ONE]];
 
 /// Whether `q` (Q30) is a unit quaternion within 2⁻¹⁰ of its squared norm: what a pose
-/// from a host must be (the tick renormalises what it slews, not what it is sent). Any
+/// from a host must be ([`TissuePose::set_target`] makes it unit to Q30's rounding). Any
 /// four `i32`s: the squares in `u64`, their sum saturated (four of `i32::MIN` make 2⁶⁴;
 /// summed in `i64`, `[MIN, MIN, 2³⁰, 0]` wrapped to a difference of `i64::MIN`, whose
 /// `abs` passed it as a unit).
@@ -39,6 +39,14 @@ pub fn is_unit(q: [i32; 4]) -> bool {
         s.saturating_add(a * a)
     });
     n2.abs_diff(1u64 << 60) <= 1u64 << 50
+}
+
+/// `q (3 − |q|²)/2`: one Newton step toward unit length, for a `q` within 2⁻¹⁰ of it
+/// (`|q|²` in `i64` below 2⁶¹; the factor below 2³¹; each product below 2⁶²).
+fn renormalised(q: [i32; 4]) -> [i32; 4] {
+    let n2: i64 = q.iter().map(|&c| c as i64 * c as i64).sum();
+    let f = ((3i64 << 60) - n2) >> (QUAT_FRAC + 1);
+    q.map(|c| ((c as i64 * f) >> QUAT_FRAC) as i32)
 }
 
 /// A tissue's pose in the device's frame, moving toward a target.
@@ -76,15 +84,23 @@ impl TissuePose {
     }
 
     /// Where to move: an origin (Q24 mm) and a unit quaternion (Q30, [`is_unit`]: the
-    /// caller checks it). The nearer of `q` and `−q` (the same rotation) is taken.
+    /// caller checks it; one that is not leaves the target's rotation as it was). The
+    /// nearer of `q` and `−q` (the same rotation) is taken, and made unit to Q30's
+    /// rounding (two Newton steps): `is_unit` takes `|q|²` within 2⁻¹⁰ of 1, and the
+    /// matrix of such a quaternion, reached as it was sent, scaled a force by as much
+    /// (a roaming force past its clamp by 0.5 mN in 3 N: found by
+    /// `tests/link/any_run.rs`).
     pub fn set_target(&mut self, origin: V3, rotation: [i32; 4]) {
         self.target_origin = origin;
         let dot: i64 = (0..4).map(|k| self.q[k] as i64 * rotation[k] as i64).sum();
-        self.target_q = if dot < 0 {
+        let q = if dot < 0 {
             rotation.map(|c| c.saturating_neg())
         } else {
             rotation
         };
+        if is_unit(q) {
+            self.target_q = renormalised(renormalised(q));
+        }
     }
 
     /// The origin now, Q24 mm.
@@ -128,17 +144,9 @@ impl TissuePose {
             }
             // A step moves the quaternion up to `s sin(β/2)` inside the sphere (β its arc
             // to the target): n² within 1 − 2 s; two Newton steps bring it within 7 s⁴.
-            self.renormalise();
-            self.renormalise();
+            self.q = renormalised(renormalised(self.q));
         }
         self.rebuild();
-    }
-
-    /// `q ← q (3 − |q|²)/2`: one Newton step toward unit length.
-    fn renormalise(&mut self) {
-        let n2: i64 = self.q.iter().map(|&c| c as i64 * c as i64).sum();
-        let f = ((3i64 << 60) - n2) >> (QUAT_FRAC + 1);
-        self.q = self.q.map(|c| ((c as i64 * f) >> QUAT_FRAC) as i32);
     }
 
     /// The matrix of the quaternion now.

@@ -1,5 +1,6 @@
 //! The tissue's pose as the tick slews it (`mccs::TissuePose`) over arbitrary runs of
-//! targets: any origin the link takes and any unit rotation, at any speed and turn rate
+//! targets: any origin the link takes and any rotation it takes (unit within `is_unit`'s
+//! 2⁻¹⁰ on `|q|²`, made unit as the target is set), at any speed and turn rate
 //! and tick rate, held in `f64` at every tick to what its documentation promises — the
 //! origin moves at most its step an axis, the rotation at most its chord, the
 //! quaternion stays unit and the matrix a rotation, and the pose reaches its target
@@ -40,6 +41,9 @@ fn chord(a: [f64; 4], b: [f64; 4]) -> f64 {
 struct Target {
     origin: [i32; 3],
     rotation: [f64; 4],
+    /// Added to the rotation's Q30 components: a host's quaternion off unit by up to
+    /// the 2⁻¹⁰ on `|q|²` that `is_unit` allows (and some past it, which it refuses).
+    nudge: [i32; 4],
     /// Ticks to run toward it (fewer than it needs, sometimes: a new target mid-way).
     ticks: u32,
 }
@@ -58,11 +62,13 @@ fn targets() -> impl Strategy<Value = Vec<Target>> {
                     v
                 }),
             ],
+            prop_oneof![Just([0; 4]), prop::array::uniform4(-(1i32 << 21)..1 << 21),],
             prop_oneof![1u32..50, 50u32..3000],
         )
-            .prop_map(|(origin, rotation, ticks)| Target {
+            .prop_map(|(origin, rotation, nudge, ticks)| Target {
                 origin,
                 rotation,
+                nudge,
                 ticks,
             }),
         1..8,
@@ -86,6 +92,10 @@ proptest! {
         let max_chord = ((2.0 * (theta / 4.0).sin()) * (1u64 << QUAT_FRAC) as f64).round().max(1.0) / (1u64 << QUAT_FRAC) as f64;
         for (i, t) in run.iter().enumerate() {
             let Some(q) = unit(t.rotation) else { continue };
+            let q: [i32; 4] = core::array::from_fn(|k| q[k].saturating_add(t.nudge[k]));
+            if !is_unit(q) {
+                continue;
+            }
             pose.set_target(t.origin, q);
             let target = q.map(q30);
             for k in 0..t.ticks {
