@@ -6,7 +6,9 @@
 # With it, the `table_new` firmware (firmware/src/bin/table_new.rs): what a force table
 # built at a device's start-up costs, in instructions and stack, and in flash the code
 # only its builder reaches (scripts/code_size.py, into target/qemu/code-size.txt).
-# `scripts/bench.sh --update` rewrites the baseline instead of comparing.
+# `scripts/bench.sh --update` rewrites the baseline instead of comparing. `mccs check`
+# compiles the baseline in (its TRAINER figures in docs/): run the host tests again after
+# an update before `scripts/figures.py update`, or the docs take the old baseline's.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/lib.sh  # core_target
