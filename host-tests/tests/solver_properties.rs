@@ -298,20 +298,26 @@ struct Seen {
     force_of_max: f64,
 }
 
-fn short<A: Arith>(name: &str) {
+/// `n` short runs of cases `strategy` draws, on any path, a device fault in 30 % and the
+/// roaming contact in 30 % of them: what they saw.
+fn short_runs<A: Arith>(n: u32, strategy: impl Strategy<Value = Case>) -> Seen {
     let seen = std::sync::Mutex::new(Seen::default());
-    // 10⁴ cases in all: half in each arithmetic (on parallel test threads).
     run_cases(
-        cases(5_000, 1),
+        n,
         (
-            any_case(3..=4),
+            strategy,
             any_path(200),
             prop::option::weighted(0.3, (1u32..200, any::<bool>())),
             prop::option::weighted(0.3, ((0.0f64..2.0, 0.0f64..2.0), 0.0f64..1.0)),
         ),
         |(case, path, fail, roam)| short_run::<A>(&case, path, fail, roam, &seen),
     );
-    let s = seen.into_inner().unwrap();
+    seen.into_inner().unwrap()
+}
+
+fn short<A: Arith>(name: &str) {
+    // 10⁴ cases in all: half in each arithmetic (on parallel test threads).
+    let s = short_runs::<A>(cases(5_000, 1), any_case(3..=4));
     println!(
         "PROPERTY case=short arith={name} cases={} roaming={} ticks={} device_faults={} max_force_of_limit={:.4}",
         s.cases, s.roaming, s.ticks, s.faults, s.force_of_max
@@ -550,18 +556,7 @@ fn limit_case() -> impl Strategy<Value = Case> {
 /// `i64` (a clamp past 1,672 N with every axis just under it: a panic with overflow
 /// checks, a wrapped verdict without).
 fn at_the_limits<A: Arith>(name: &str) {
-    let seen = std::sync::Mutex::new(Seen::default());
-    run_cases(
-        cases(500, 1),
-        (
-            limit_case(),
-            any_path(200),
-            prop::option::weighted(0.3, (1u32..200, any::<bool>())),
-            prop::option::weighted(0.3, ((0.0f64..2.0, 0.0f64..2.0), 0.0f64..1.0)),
-        ),
-        |(case, path, fail, roam)| short_run::<A>(&case, path, fail, roam, &seen),
-    );
-    let s = seen.into_inner().unwrap();
+    let s = short_runs::<A>(cases(500, 1), limit_case());
     println!(
         "PROPERTY case=limits arith={name} cases={} roaming={} ticks={} device_faults={}",
         s.cases, s.roaming, s.ticks, s.faults
