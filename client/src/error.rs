@@ -1,6 +1,7 @@
 //! [`Error`]: everything that can go wrong talking to a device, typed; a device's
 //! refusal carries its reason and values ([`Refusal`]).
 
+use crate::shown::ShownName;
 use mccs_link::{scale, NakReason, SpecOption};
 use std::fmt;
 use std::time::Duration;
@@ -46,7 +47,7 @@ impl fmt::Display for Refusal {
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The address is not one.
-    #[error("{addr}: {why}")]
+    #[error("{}: {why}", ShownName(.addr))]
     Address {
         /// As given.
         addr: String,
@@ -54,7 +55,7 @@ pub enum Error {
         why: &'static str,
     },
     /// The device could not be reached.
-    #[error("{addr}: {source}")]
+    #[error("{}: {source}", ShownName(.addr))]
     Connect {
         /// Where.
         addr: String,
@@ -62,7 +63,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// The device never answered `Hello`.
-    #[error("{addr}: no answer to hello in {} s", .waited.as_secs())]
+    #[error("{}: no answer to hello in {} s", ShownName(.addr), .waited.as_secs())]
     NoAnswer {
         /// Where.
         addr: String,
@@ -71,7 +72,8 @@ pub enum Error {
     },
     /// The device speaks another protocol or schema.
     #[error(
-        "{addr}: the device speaks protocol {device_protocol} schema {device_schema:08x}, this client protocol {protocol} schema {schema:08x}: update one of them"
+        "{}: the device speaks protocol {device_protocol} schema {device_schema:08x}, this client protocol {protocol} schema {schema:08x}: update one of them",
+        ShownName(.addr)
     )]
     Protocol {
         /// Where.
@@ -86,7 +88,7 @@ pub enum Error {
         schema: u32,
     },
     /// The device refused, with its reason and values.
-    #[error("{addr}: the device refused: {refusal}")]
+    #[error("{}: the device refused: {refusal}", ShownName(.addr))]
     Refused {
         /// Where.
         addr: String,
@@ -94,7 +96,7 @@ pub enum Error {
         refusal: Refusal,
     },
     /// No answer within the wait's timeout.
-    #[error("{addr}: no answer to {what} in {} ms", .waited.as_millis())]
+    #[error("{}: no answer to {what} in {} ms", ShownName(.addr), .waited.as_millis())]
     Timeout {
         /// Where.
         addr: String,
@@ -104,7 +106,7 @@ pub enum Error {
         waited: Duration,
     },
     /// The connection was lost (the device fades its force by its own guard).
-    #[error("{addr}: the connection was lost: {why}")]
+    #[error("{}: the connection was lost: {why}", ShownName(.addr))]
     Lost {
         /// Where.
         addr: String,
@@ -123,7 +125,7 @@ pub enum Error {
         why: String,
     },
     /// The device answered something this client cannot use.
-    #[error("{addr}: {what}")]
+    #[error("{}: {what}", ShownName(.addr))]
     Unexpected {
         /// Where.
         addr: String,

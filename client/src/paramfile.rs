@@ -70,15 +70,19 @@ pub enum ParamFileError {
 /// `FILE: ` or `FILE: line N: `.
 fn at(f: &mut fmt::Formatter<'_>, path: &Path, line: Option<usize>) -> fmt::Result {
     match line {
-        Some(l) => write!(f, "{}: line {l}: ", path.display()),
-        None => write!(f, "{}: ", path.display()),
+        Some(l) => write!(f, "{}: line {l}: ", crate::shown::ShownPath(path)),
+        None => write!(f, "{}: ", crate::shown::ShownPath(path)),
     }
 }
 
 impl fmt::Display for ParamFileError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Read { path, reason } => write!(f, "{}: cannot read: {reason}", path.display()),
+            Self::Read { path, reason } => write!(
+                f,
+                "{}: cannot read: {reason}",
+                crate::shown::ShownPath(path)
+            ),
             Self::Toml {
                 path,
                 line,
@@ -87,7 +91,9 @@ impl fmt::Display for ParamFileError {
                 at(f, path, *line)?;
                 write!(f, "invalid TOML: {message}")
             }
-            Self::Missing { path, key } => write!(f, "{}: {key}: missing", path.display()),
+            Self::Missing { path, key } => {
+                write!(f, "{}: {key}: missing", crate::shown::ShownPath(path))
+            }
             Self::NotNumber { path, line, key } => {
                 at(f, path, *line)?;
                 write!(f, "{key}: must be a number")

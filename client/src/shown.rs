@@ -1,6 +1,8 @@
-//! A user's text and numbers inside a one-line message: [`Shown`], [`ShownNumber`].
+//! A user's text, names and numbers inside a one-line message: [`Shown`], [`ShownName`],
+//! [`ShownPath`], [`ShownNumber`].
 
 use std::fmt;
+use std::path::Path;
 
 /// The most characters a message shows of a user's text, its escapes written out; past
 /// them, `…`.
@@ -22,22 +24,52 @@ pub struct Shown<'a>(pub &'a str);
 
 impl fmt::Display for Shown<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let mut shown = 0;
-        for c in self.0.chars() {
-            let plain = matches!(c, '"' | '\'' | '\\');
-            // (An escape counts as the characters it shows: `\u{1b}` is six.)
-            shown += if plain { 1 } else { c.escape_debug().len() };
-            if shown > SHOWN_CHARS {
-                return f.write_str("…");
-            }
-            if plain {
-                fmt::Write::write_char(f, c)?;
-            } else {
-                write!(f, "{}", c.escape_debug())?;
-            }
-        }
-        Ok(())
+        write_escaped(f, self.0, SHOWN_CHARS)
     }
+}
+
+/// A file's path or a device's address as a one-line message names it: escaped as
+/// [`Shown`] escapes, but in full (a name cut short would not say which file). A file
+/// `a⏎b.toml` is named `a\nb.toml`, and a terminal's escape sequence in a name is written
+/// out (`\u{1b}[31m`), not sent to the terminal.
+#[derive(Clone, Copy, Debug)]
+pub struct ShownName<'a>(pub &'a str);
+
+impl fmt::Display for ShownName<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_escaped(f, self.0, usize::MAX)
+    }
+}
+
+/// A path as [`ShownName`] names it; what of it is not Unicode is shown as U+FFFD
+/// (`Path::to_string_lossy`).
+#[derive(Clone, Copy, Debug)]
+pub struct ShownPath<'a>(pub &'a Path);
+
+impl fmt::Display for ShownPath<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_escaped(f, &self.0.to_string_lossy(), usize::MAX)
+    }
+}
+
+/// `text` escaped (every character `escape_debug` escapes but quotes and backslashes),
+/// at most `limit` characters so written, then `…` if it goes on.
+fn write_escaped(f: &mut fmt::Formatter<'_>, text: &str, limit: usize) -> fmt::Result {
+    let mut shown = 0usize;
+    for c in text.chars() {
+        let plain = matches!(c, '"' | '\'' | '\\');
+        // (An escape counts as the characters it shows: `\u{1b}` is six.)
+        shown = shown.saturating_add(if plain { 1 } else { c.escape_debug().len() });
+        if shown > limit {
+            return f.write_str("…");
+        }
+        if plain {
+            fmt::Write::write_char(f, c)?;
+        } else {
+            write!(f, "{}", c.escape_debug())?;
+        }
+    }
+    Ok(())
 }
 
 /// The longest a [`ShownNumber`] is written in full; past it, in exponent form.
@@ -87,6 +119,27 @@ mod tests {
         assert_eq!(Shown(&exact).to_string(), exact);
         // Quotes and backslashes as they are.
         assert_eq!(Shown(r#""a"\'b'"#).to_string(), r#""a"\'b'"#);
+    }
+
+    #[test]
+    fn a_name_is_one_line_and_whole() {
+        // A line break and a terminal's escape sequence written out; quotes, backslashes
+        // (a Windows path's) and other scripts as they are; no limit on the length.
+        let name = "dir/a\nb \u{1b}[31m\"é\"\\x.toml";
+        assert_eq!(
+            ShownName(name).to_string(),
+            r#"dir/a\nb \u{1b}[31m"é"\x.toml"#
+        );
+        assert_eq!(
+            ShownPath(Path::new(name)).to_string(),
+            ShownName(name).to_string()
+        );
+        let long = format!("/{}", "d/".repeat(300));
+        assert_eq!(ShownName(&long).to_string(), long);
+        for c in (0u32..0x3_0000).filter_map(char::from_u32) {
+            let s = ShownName(c.encode_utf8(&mut [0; 4])).to_string();
+            assert!(!s.chars().any(char::is_control), "{c:?} shown as {s:?}");
+        }
     }
 
     #[test]

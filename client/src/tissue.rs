@@ -19,7 +19,7 @@ pub enum TissueError {
     #[error("{0}")]
     Invalid(mccs::ParamError),
     /// The table builder refused (the bound not met, no nonlinear phase, …).
-    #[error("{}: the force table: {source}", .file.display())]
+    #[error("{}: the force table: {source}", crate::shown::ShownPath(.file))]
     Table {
         /// The parameters' file (`<memory>` for parameters in memory).
         file: PathBuf,
@@ -27,7 +27,7 @@ pub enum TissueError {
         source: mccs::TableError,
     },
     /// A `.bin` file could not be read.
-    #[error("{}: {source}", .file.display())]
+    #[error("{}: {source}", crate::shown::ShownPath(.file))]
     Read {
         /// The file.
         file: PathBuf,
@@ -35,7 +35,7 @@ pub enum TissueError {
         source: std::io::Error,
     },
     /// A `.bin` file is not a tissue's.
-    #[error("{}: {source}", .file.display())]
+    #[error("{}: {source}", crate::shown::ShownPath(.file))]
     Bin {
         /// The file.
         file: PathBuf,

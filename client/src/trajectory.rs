@@ -88,7 +88,7 @@ impl Trajectory {
 
 /// Reads a trajectory file.
 pub fn read(path: &Path) -> Result<Trajectory, TrajectoryError> {
-    let file = path.display().to_string();
+    let file = crate::shown::ShownPath(path).to_string();
     let text =
         crate::input::read_text(path, crate::input::DATA_BYTES).map_err(|e| TrajectoryError {
             file: file.clone(),

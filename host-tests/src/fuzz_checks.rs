@@ -18,7 +18,7 @@ pub use link::{link_device, link_host, link_script};
 pub type Check = fn(&[u8]);
 
 /// The targets, by name, with their checks.
-pub const TARGETS: [(&str, Check); 13] = [
+pub const TARGETS: [(&str, Check); 15] = [
     ("param_file", param_file),
     ("fit_data", fit_data),
     ("trajectory", trajectory),
@@ -32,6 +32,8 @@ pub const TARGETS: [(&str, Check); 13] = [
     ("arm_inputs", arm_inputs),
     ("link_host", link_host),
     ("link_script", link_script),
+    ("addr", addr),
+    ("tissue_file", tissue_file),
 ];
 
 /// The longest error line a parser may give: what it says, a line number and a user's
@@ -416,5 +418,49 @@ pub fn view_request(data: &[u8]) {
             }
         }
         Err(e) => assert!([400, 413, 431].contains(&e.status), "{e:?}"),
+    }
+}
+
+/// A device's address (`--connect`, `Device::open`): one that reads back as itself, or
+/// a reason, and the client's error naming the address on one line (escaped, in full).
+pub fn addr(data: &[u8]) {
+    use mccs_client::Addr;
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match Addr::parse(text) {
+        Ok(a) => {
+            assert_eq!(a.to_string(), text);
+            match &a {
+                Addr::Unix(p) => assert!(!p.as_os_str().is_empty()),
+                Addr::Tcp(hp) => assert!(hp.rsplit_once(':').is_some()),
+                Addr::Serial(p) => assert!(!p.is_empty()),
+            }
+        }
+        Err(why) => {
+            one_line(why, "");
+            let e = mccs_client::Error::Address {
+                addr: text.into(),
+                why,
+            };
+            let line = e.to_string();
+            assert!(!line.chars().any(char::is_control), "{line:?}");
+        }
+    }
+}
+
+/// A tissue file (`mccs table --format bin`, a scene's `Tissue::from_bin`): a typed
+/// reason on one line, or a tissue that writes back as the same bytes.
+pub fn tissue_file(data: &[u8]) {
+    match mccs_client::Tissue::from_bin(data) {
+        Ok(t) => {
+            assert_eq!(t.to_bin(), data);
+            assert_eq!(
+                t.bytes().len(),
+                mccs_link::table_bytes::len(t.segments().into())
+            );
+            assert_eq!(mccs_link::table_bytes::hash_bytes(t.bytes()), t.hash());
+        }
+        Err(e) => one_line(&e.to_string(), ""),
     }
 }

@@ -7,6 +7,7 @@
 use crate::paramfile::{key_line, nearest_in, section_line};
 use mccs::{ArmSpec, GravitySpec, JointSpec};
 use mccs_client::shown::Shown;
+use mccs_client::shown::ShownPath;
 use std::path::Path;
 
 /// The keys of `[arm]`.
@@ -86,7 +87,7 @@ impl StableRegion {
 /// Reads a device file's `[stability]` (None: the file has none).
 pub fn read_stability(path: &Path) -> Result<Option<StableRegion>, String> {
     let text = mccs_client::input::read_text(path, mccs_client::input::CONFIG_BYTES)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        .map_err(|e| format!("{}: cannot read: {e}", ShownPath(path)))?;
     parse_stability(&text, path)
 }
 
@@ -193,7 +194,7 @@ pub fn with_stability(text: &str, region: &StableRegion, comment: &str) -> Strin
 /// Reads and checks a device file.
 pub fn read(path: &Path) -> Result<ArmSpec, String> {
     let text = mccs_client::input::read_text(path, mccs_client::input::CONFIG_BYTES)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        .map_err(|e| format!("{}: cannot read: {e}", ShownPath(path)))?;
     parse(&text, path)
 }
 
@@ -203,7 +204,7 @@ fn with_doc<T>(
     path: &Path,
     read: impl FnOnce(&Doc) -> Result<T, String>,
 ) -> Result<T, String> {
-    let file = path.display().to_string();
+    let file = ShownPath(path).to_string();
     let table = toml_table(text, &file)?;
     let doc = Doc {
         text,

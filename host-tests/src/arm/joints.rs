@@ -4,11 +4,12 @@
 //! (`mccs replay --device --joints`).
 
 use mccs::{Arm, ArmPose};
+use mccs_client::shown::ShownPath;
 
 /// The rows of a joints file, or one line naming the file and the row (the header is
 /// row 1).
 pub fn read(path: &std::path::Path) -> Result<Vec<(f64, [f64; 3])>, String> {
-    let file = path.display().to_string();
+    let file = ShownPath(path).to_string();
     let text = mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES)
         .map_err(|e| format!("{file}: cannot read: {e}"))?;
     parse(&text, &file)

@@ -5,6 +5,7 @@ use super::{arg_error, io_error, Backend, CliError};
 use crate::arm::gravity_fit::{self, HeldPose};
 use crate::arm::{columns, device_file, ArmTwin};
 use mccs::{Arm, Force};
+use mccs_client::shown::ShownPath;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -79,7 +80,7 @@ enum Command {
 
 /// The rows of a numeric CSV file with exactly `header` ([`columns::parse`]).
 fn rows(path: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, CliError> {
-    let file = path.display().to_string();
+    let file = ShownPath(path).to_string();
     let text = mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES)
         .map_err(|e| CliError::new(format!("{file}: cannot read: {e}")))?;
     columns::parse(&text, &file, header).map_err(CliError::new)
@@ -153,7 +154,7 @@ fn stability(
         if k == 0.0 {
             return Err(CliError::new(format!(
                 "{}: no coupling is stable at {b} N·s/m: {why}",
-                device.display()
+                ShownPath(device)
             )));
         }
         writeln!(
@@ -166,7 +167,7 @@ fn stability(
     }
     if let Some(path) = written {
         let text = mccs_client::input::read_text(device, mccs_client::input::CONFIG_BYTES)
-            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", ShownPath(device))))?;
         let region = device_file::StableRegion { points };
         let new = device_file::with_stability(
             &text,
@@ -174,10 +175,10 @@ fn stability(
             "measured by `mccs arm stability` on the simulated arm (docs/safety.md):\nat each coupling damping, the largest coupling stiffness a held press\nwas stable with; `mccs check --device arm` allows half of it.",
         );
         std::fs::write(path, new)
-            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", ShownPath(path))))?;
         eprintln!(
             "mccs: wrote {} with the measured [stability]",
-            path.display()
+            ShownPath(path)
         );
     }
     Ok(())
@@ -274,7 +275,7 @@ fn calibrate(
         .collect();
     let twin = ArmTwin { spec };
     let fit = gravity_fit::fit(&twin, &held)
-        .map_err(|e| CliError::new(format!("{}: {e}", poses.display())))?;
+        .map_err(|e| CliError::new(format!("{}: {e}", ShownPath(poses))))?;
     writeln!(
         out,
         "GRAVITY upper_arm_mass_kg={:.4} forearm_mass_kg={:.4} g_b_nmm={:.2} g_c_nmm={:.2} offset_duty_b={:.4} offset_duty_c={:.4} rms_duty_b={:.4} rms_duty_c={:.4} poses={}",
@@ -298,16 +299,16 @@ fn calibrate(
     }
     if let Some(path) = written {
         let text = mccs_client::input::read_text(device, mccs_client::input::CONFIG_BYTES)
-            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", device.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", ShownPath(device))))?;
         let new = gravity_fit::with_masses(&text, &fit).ok_or_else(|| {
             CliError::new(format!(
                 "{}: gravity.upper_arm_mass_kg or gravity.forearm_mass_kg: not found to rewrite",
-                device.display()
+                ShownPath(device)
             ))
         })?;
         std::fs::write(path, new)
-            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
-        eprintln!("mccs: wrote {} with the fitted masses", path.display());
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", ShownPath(path))))?;
+        eprintln!("mccs: wrote {} with the fitted masses", ShownPath(path));
     }
     Ok(())
 }

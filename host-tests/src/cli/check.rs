@@ -10,6 +10,7 @@ use super::{arg_error, io_error, CliError, IntegratorArg};
 use crate::paramfile;
 use crate::replay::{FIXED_EDGES, FIXED_NODES};
 use mccs::{Arith, ForceTable, Solver, SolverConfig, Topology};
+use mccs_client::shown::ShownPath;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -250,7 +251,7 @@ fn coupling_within_region(
             (p, r)
         }
     };
-    let file = path.display();
+    let file = ShownPath(&path);
     let Some(region) = region.map_err(CliError::new)? else {
         eprintln!(
             "mccs check: warning: {file} has no [stability] (`mccs arm stability` measures it): the coupling is not held to the arm's stable region"

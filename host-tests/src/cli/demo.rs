@@ -2,6 +2,7 @@
 //! against it.
 
 use super::{arg_error, io_error, CliError};
+use mccs_client::shown::ShownPath;
 use mccs_firmware::demo::{self, ArmSummary, Summary};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -114,7 +115,7 @@ fn check_demo_log(
     host_line: &str,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
-    let name = log.display();
+    let name = ShownPath(log);
     let text = mccs_client::input::read_text(log, mccs_client::input::DATA_BYTES)
         .map_err(|e| CliError::new(format!("{name}: cannot read: {e}")))?;
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();

@@ -9,6 +9,7 @@ use super::progress::Ticker;
 use super::{arg_error, check_writable, fmt_given, io_error, CliError};
 use crate::fit::{self, ModelKind, Progress};
 use crate::paramfile;
+use mccs_client::shown::ShownPath;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -39,7 +40,7 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     if points.len() > fit::FIT_ROWS {
         eprintln!(
             "mccs: {}: {} rows: fitting on {} of them, evenly spread; the metrics are on all",
-            a.data.display(),
+            ShownPath(&a.data),
             points.len(),
             fit::FIT_ROWS
         );
@@ -54,16 +55,16 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     if let (Some(path), Some(p)) = (a.out, mccs_params) {
         let text = format!(
             "# MCCS parameters fitted by `mccs fit` to {}\n{}",
-            a.data.display(),
+            ShownPath(&a.data),
             paramfile::to_toml(&p)
         );
         std::fs::write(&path, text)
-            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", path.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot write: {e}", ShownPath(&path))))?;
     }
     if let Some(path) = a.plot {
-        let title = format!("{}: fitted models", a.data.display());
+        let title = format!("{}: fitted models", ShownPath(&a.data));
         fit::plot(&path, &points, &fits, &title)
-            .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", path.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot draw: {e}", ShownPath(&path))))?;
     }
     Ok(())
 }
@@ -94,7 +95,7 @@ fn models_asked(a: &Args) -> Result<Vec<ModelKind>, CliError> {
                 "--plot",
                 &format!(
                     "{}: the plot is drawn as SVG only: name it .svg (PNG would need a font built in)",
-                    p.display()
+                    ShownPath(p)
                 ),
             ));
         }
@@ -191,7 +192,7 @@ fn not_fitted(
     };
     let mut line = format!(
         "{}: {} could not be fitted: no starting point ended on {why}, for forces {} … {} N",
-        data.display(),
+        ShownPath(data),
         models(failed),
         fmt_given(lo),
         fmt_given(hi),

@@ -22,6 +22,7 @@ use super::link::{device_error, pose_line, telemetry_row, with_friction, TELEMET
 use super::{io_error, CliError};
 use mccs_client::pose_text::{self, numbers};
 use mccs_client::shown::Shown;
+use mccs_client::shown::ShownPath;
 use mccs_client::{Device, Pose, Tissue};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -51,7 +52,7 @@ pub(crate) struct Script {
 
 /// `FILE:LINE: what`.
 fn at(file: &Path, line: usize, what: impl std::fmt::Display) -> CliError {
-    CliError::new(format!("{}:{line}: {what}", file.display()))
+    CliError::new(format!("{}:{line}: {what}", ShownPath(file)))
 }
 
 /// `every=N` (1 … 1000), or `default`.
@@ -75,7 +76,7 @@ impl Script {
     /// Reads and checks `file`: every step, its arguments and its files.
     pub(super) fn read(file: &Path) -> Result<Script, CliError> {
         let text = mccs_client::input::read_text(file, mccs_client::input::CONFIG_BYTES)
-            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", file.display())))?;
+            .map_err(|e| CliError::new(format!("{}: cannot read: {e}", ShownPath(file))))?;
         Self::parse(&text, file, &|path| {
             Tissue::from_file(path).map_err(|e| e.to_string())
         })

@@ -4,6 +4,7 @@
 
 use crate::paramfile;
 use clap::{Parser, Subcommand, ValueEnum};
+use mccs_client::shown::ShownPath;
 use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -85,7 +86,7 @@ pub(crate) fn arg_error(arg: &str, what: &str) -> CliError {
 
 /// `FILE: what`, for a parameter file whose values break a rule.
 pub(crate) fn file_error(file: &Path, e: impl std::fmt::Display) -> CliError {
-    CliError::new(format!("{}: {e}", file.display()))
+    CliError::new(format!("{}: {e}", ShownPath(file)))
 }
 
 /// The exit status when the reader closed stdout: 128 + `SIGPIPE`.
@@ -244,7 +245,7 @@ pub fn join_negative_values(args: impl IntoIterator<Item = OsString>) -> Vec<OsS
 /// Fails unless `path` can be written: its folder exists and takes a new file, and it is
 /// not a folder or a read-only file itself.
 pub(crate) fn check_writable(arg: &str, path: &Path) -> Result<(), CliError> {
-    let bad = |what: &str| arg_error(arg, &format!("{}: {what}", path.display()));
+    let bad = |what: &str| arg_error(arg, &format!("{}: {what}", ShownPath(path)));
     if path.is_dir() {
         return Err(bad("is a folder"));
     }

@@ -3,6 +3,7 @@
 
 use super::Fitted;
 use mccs::Params;
+use mccs_client::shown::ShownPath;
 use mccs_client::shown::{Shown, ShownNumber};
 use std::fmt;
 use std::path::Path;
@@ -52,7 +53,7 @@ pub fn parse_data(text: &str, file: &str) -> Result<Vec<Point>, DataError> {
 /// the unloaded sample every compression test starts from and every model passes
 /// through, is dropped (the models take strains above zero), and said so: the note.
 pub fn read_data_noted(path: &Path) -> Result<(Vec<Point>, Option<String>), DataError> {
-    let file = path.display().to_string();
+    let file = ShownPath(path).to_string();
     let text =
         mccs_client::input::read_text(path, mccs_client::input::DATA_BYTES).map_err(|e| {
             DataError {

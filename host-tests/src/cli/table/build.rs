@@ -7,6 +7,7 @@
 use super::remedy::remedy;
 use crate::cli::{arg_error, file_error, CliError};
 use mccs::{ForceTable, Params, TableBound, TableError};
+use mccs_client::shown::ShownPath;
 use std::path::Path;
 
 /// The table options every fixed-point path shares, with the same defaults.
@@ -124,7 +125,7 @@ pub(crate) fn build<const S: usize>(
         if warn {
             eprintln!(
                 "mccs: warning: {}: the {}-knot force table misses the bound ({}): it reaches force {:.1e} of F({to:?}) and stiffness {:.1e}; used anyway (--accept-error)",
-                file.display(),
+                ShownPath(file),
                 S + 1,
                 product_bound(),
                 reached.force,
