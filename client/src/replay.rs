@@ -4,6 +4,7 @@
 //! same options computes on the host.
 
 use crate::error::Error;
+use crate::session::Session;
 use crate::trajectory::Trajectory;
 use crate::Device;
 use mccs_link::replay::PathPoint;
@@ -56,20 +57,7 @@ impl Device {
         let mut rows = Vec::with_capacity(ticks.len());
         let (mut sent, mut last) = (0usize, Instant::now());
         while rows.len() < ticks.len() {
-            while sent < ticks.len() && (sent as u32) < until {
-                let n = (until as usize - sent)
-                    .min(PathPoint::PER_FRAME)
-                    .min(ticks.len() - sent);
-                let points: Vec<u8> = ticks[sent..sent + n]
-                    .iter()
-                    .flat_map(|(_, p)| PathPoint(probe_bits(*p).map(|c| c.to_bits())).to_bytes())
-                    .collect();
-                s.send(&ToDevice::ReplayPath {
-                    first: sent as u32,
-                    points: &points,
-                })?;
-                sent += n;
-            }
+            sent = send_path(s, &ticks, sent, until)?;
             let m = s.wait(from, "a replay row", Duration::from_millis(500), |m| {
                 matches!(
                     m,
@@ -93,6 +81,18 @@ impl Device {
                     last = Instant::now();
                 }
                 Ok(ToHost::ReplayCredit { until: u }) => until = u,
+                // The end before the last row (the loop ends on it): the device
+                // abandoned the replay, its path late past `REPLAY_STARVED_MS`.
+                Ok(ToHost::ReplayEnd { ticks: ran }) => {
+                    return Err(Error::Unexpected {
+                        addr: self.addr().to_string(),
+                        what: format!(
+                            "the device ended the replay after {ran} of {} ticks: the path did not come within {} ms",
+                            ticks.len(),
+                            mccs_link::rates::REPLAY_STARVED_MS
+                        ),
+                    })
+                }
                 Ok(_) => break,
                 Err(Error::Timeout { .. }) if last.elapsed() < self.options().load_timeout => {}
                 Err(Error::Timeout { .. }) => {
@@ -107,4 +107,29 @@ impl Device {
         }
         Ok(rows)
     }
+}
+
+/// The path's samples from `sent` up to the credit `until`, in frames of at most
+/// [`PathPoint::PER_FRAME`]; the samples sent after them.
+fn send_path(
+    s: &Session,
+    ticks: &[(f64, [f64; 3])],
+    mut sent: usize,
+    until: u32,
+) -> Result<usize, Error> {
+    while sent < ticks.len() && (sent as u32) < until {
+        let n = (until as usize - sent)
+            .min(PathPoint::PER_FRAME)
+            .min(ticks.len() - sent);
+        let points: Vec<u8> = ticks[sent..sent + n]
+            .iter()
+            .flat_map(|(_, p)| PathPoint(probe_bits(*p).map(|c| c.to_bits())).to_bytes())
+            .collect();
+        s.send(&ToDevice::ReplayPath {
+            first: sent as u32,
+            points: &points,
+        })?;
+        sent += n;
+    }
+    Ok(sent)
 }

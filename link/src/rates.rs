@@ -30,6 +30,10 @@ pub const MESH_PART_FRAME_MAX: u32 = 237;
 pub const SILENCE_TIMEOUT_MS: u32 = 100;
 /// How long the fade lasts, ms.
 pub const FADE_MS: u32 = 20;
+/// How long a replay waits for its path's next sample, ms: past it the device abandons
+/// the replay (`ReplayEnd` with the ticks it ran), so that a host that stopped feeding
+/// it (gone, or given up) does not hold the device's one job, and every load, for good.
+pub const REPLAY_STARVED_MS: u32 = 1000;
 /// How often an armed host with nothing else to say sends a frame (a `Keepalive`), ms:
 /// four to a timeout.
 pub const KEEPALIVE_MS: u32 = 25;

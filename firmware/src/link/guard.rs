@@ -52,7 +52,7 @@ impl GuardTimes {
 }
 
 /// `ms` at `tick_hz`, ticks.
-const fn ticks(tick_hz: u32, ms: u32) -> u32 {
+pub(crate) const fn ticks(tick_hz: u32, ms: u32) -> u32 {
     ((tick_hz as u64 * ms as u64) / 1000) as u32
 }
 

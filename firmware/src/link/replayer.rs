@@ -43,6 +43,10 @@ pub struct ReplayRun<
     samples: u32,
     received: u32,
     done: u32,
+    /// The link's tick of its last progress: its start, a piece of its path, a row.
+    since: u32,
+    /// The ticks it waits for its path's next sample before it is abandoned.
+    patience: u32,
 }
 
 /// The solver configuration a spec asks for.
@@ -77,12 +81,15 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
             samples: 0,
             received: 0,
             done: 0,
+            since: 0,
+            patience: 0,
         }
     }
 
     /// Starts a replay of `spec` on `table` in this run (abandoning the one under way);
-    /// `narrow`: whether `A` is the narrow arithmetic (what a spec must ask for). On a
-    /// refusal the run replays nothing. Out of line: the solver is built on this frame
+    /// `narrow`: whether `A` is the narrow arithmetic (what a spec must ask for); `now`
+    /// the link's tick, `patience` the ticks it waits for its path's next sample
+    /// ([`mccs_link::rates::REPLAY_STARVED_MS`]). On a refusal the run replays nothing. Out of line: the solver is built on this frame
     /// alone, and into its place.
     #[inline(never)]
     pub fn start(
@@ -90,12 +97,16 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
         spec: &ReplaySpec,
         table: ForceTable<S>,
         narrow: bool,
+        now: u32,
+        patience: u32,
     ) -> Result<(), NakReason> {
         self.solver = None;
         self.contact = Contact::Glued;
         self.samples = 0;
         self.received = 0;
         self.done = 0;
+        self.since = now;
+        self.patience = patience;
         let option = |option, limit| NakReason::Option { option, limit };
         if spec.narrow != narrow {
             return Err(option(SpecOption::Arith, narrow as i32));
@@ -145,9 +156,9 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
         self.done.saturating_add(P as u32).min(self.samples)
     }
 
-    /// Samples for ticks `first …` ([`PathPoint`]s); refused out of order or past the
-    /// credit (the caller then abandons the replay).
-    pub fn path(&mut self, first: u32, points: &[u8]) -> Result<(), NakReason> {
+    /// Samples for ticks `first …` ([`PathPoint`]s) at the link's tick `now`; refused
+    /// out of order or past the credit (the caller then abandons the replay).
+    pub fn path(&mut self, first: u32, points: &[u8], now: u32) -> Result<(), NakReason> {
         let n = (points.len() / PathPoint::BYTES) as u32;
         let all = PathPoint::all(points);
         let (Some(all), true) = (
@@ -162,17 +173,24 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
             }
         }
         self.received += n;
+        self.since = now;
         Ok(())
     }
 
     /// One tick, if its sample has arrived: its row to `out` (then, after the last, the
-    /// end). Whether it ran, and whether the replay is over.
-    pub fn step(&mut self, out: &mut dyn FnMut(&ToHost)) -> (bool, bool) {
+    /// end). Without its sample, at the link's tick `now`: the end, where it has no
+    /// samples or has waited its patience for the next (`ReplayEnd` with the ticks it
+    /// ran), else nothing. Whether it ran, and whether the replay is over.
+    pub fn step(&mut self, now: u32, out: &mut dyn FnMut(&ToHost)) -> (bool, bool) {
         let Some(solver) = self.solver.as_mut() else {
             return (false, false);
         };
         if self.done >= self.received {
-            return (false, false);
+            let over = self.done == self.samples || now.wrapping_sub(self.since) > self.patience;
+            if over {
+                out(&ToHost::ReplayEnd { ticks: self.done });
+            }
+            return (false, over);
         }
         let tick = self.done;
         let probe = self
@@ -189,6 +207,7 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
         };
         out(&ToHost::ReplayRow(row));
         self.done += 1;
+        self.since = now;
         if self.done == self.samples {
             out(&ToHost::ReplayEnd { ticks: self.done });
             return (true, true);

@@ -131,11 +131,14 @@ impl<'a, const N: usize, const E: usize, const S: usize, A: Arith, const P: usiz
         self.acknowledge(&mut |m| {
             send(m);
         });
-        let (worked, checked) = self
-            .work
-            .run(REPLAY_ROWS_PER_POLL, self.check_steps, &mut |m| {
+        let (worked, checked) = self.work.run(
+            snap.ticks,
+            REPLAY_ROWS_PER_POLL,
+            self.check_steps,
+            &mut |m| {
                 send(m);
-            });
+            },
+        );
         if let Some(outcome) = checked {
             self.hand_over(outcome, &mut |m| {
                 send(m);

@@ -95,6 +95,9 @@ pub struct Session<const S: usize> {
     dropped_mesh: u32,
     /// The record kept from the device's last run, if it keeps one.
     black_box: Option<&'static LastRun>,
+    /// The ticks a replay waits for its path's next sample
+    /// ([`mccs_link::rates::REPLAY_STARVED_MS`] at the device's rate).
+    replay_patience: u32,
 }
 
 /// The black box a session answers `BlackBox` from: the last run's, which only a boot
@@ -126,6 +129,10 @@ impl<const S: usize> Session<S> {
             mesh_seq: 0,
             dropped_mesh: 0,
             black_box: None,
+            replay_patience: super::guard::ticks(
+                live.config.tick_hz as u32,
+                rates::REPLAY_STARVED_MS,
+            ),
         }
     }
 
@@ -280,13 +287,14 @@ impl<const S: usize> Session<S> {
                 }
             }
             ToDevice::ReplayBegin(spec) => {
-                match work.begin_replay(&spec, self.table, self.live.narrow) {
+                let (narrow, patience) = (self.live.narrow, self.replay_patience);
+                match work.begin_replay(&spec, self.table, narrow, snap.ticks, patience) {
                     Ok(until) => out(&ToHost::ReplayCredit { until }),
                     Err(r) => out(&ToHost::Nak(r)),
                 }
             }
             ToDevice::ReplayPath { first, points } => {
-                if let Err(r) = work.replay_path(first, points) {
+                if let Err(r) = work.replay_path(first, points, snap.ticks) {
                     out(&ToHost::Nak(r));
                 }
             }

@@ -36,8 +36,9 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
         matches!(self, Self::Check(_))
     }
 
-    /// Starts a replay of `spec` on `table` (abandoning one under way); its first
-    /// credit, or why not. Refused during a tissue's check. The replay is built where
+    /// Starts a replay of `spec` on `table` (abandoning one under way) at the link's
+    /// tick `now`, waiting `patience` ticks at most for each sample; its first credit,
+    /// or why not. Refused during a tissue's check. The replay is built where
     /// it stays ([`ReplayRun::start`]); out of line, so that no caller's frame holds one.
     #[inline(never)]
     pub fn begin_replay(
@@ -45,6 +46,8 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
         spec: &ReplaySpec,
         table: ForceTable<S>,
         narrow: bool,
+        now: u32,
+        patience: u32,
     ) -> Result<u32, NakReason> {
         if self.checking() {
             return Err(NakReason::Busy);
@@ -53,7 +56,9 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
             *self = Self::Replay(ReplayRun::idle());
         }
         let started = match self {
-            Self::Replay(run) => run.start(spec, table, narrow).map(|()| run.credit()),
+            Self::Replay(run) => run
+                .start(spec, table, narrow, now, patience)
+                .map(|()| run.credit()),
             _ => Err(NakReason::Busy),
         };
         if started.is_err() {
@@ -62,12 +67,13 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
         started
     }
 
-    /// A replay's path samples; refused (and the replay abandoned) out of order.
-    pub fn replay_path(&mut self, first: u32, points: &[u8]) -> Result<(), NakReason> {
+    /// A replay's path samples at the link's tick `now`; refused (and the replay
+    /// abandoned) out of order.
+    pub fn replay_path(&mut self, first: u32, points: &[u8], now: u32) -> Result<(), NakReason> {
         let Self::Replay(run) = self else {
             return Err(NakReason::Order);
         };
-        let r = run.path(first, points);
+        let r = run.path(first, points, now);
         if r.is_err() {
             *self = Self::Idle;
         }
@@ -83,13 +89,15 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
         Ok(())
     }
 
-    /// A slice of the work: up to `replay_rows` replay ticks (their rows to `out`), or
-    /// up to `check_steps` steps of a tissue's check; the check's outcome when it ends.
+    /// A slice of the work at the link's tick `now`: up to `replay_rows` replay ticks
+    /// (their rows to `out`; a replay that has waited its patience for its path ends),
+    /// or up to `check_steps` steps of a tissue's check; the check's outcome when it ends.
     /// Whether anything ran. Out of line, so that the link's poll does not hold its
     /// frames (a tick's solver locals, a checked tissue) while it decodes.
     #[inline(never)]
     pub fn run(
         &mut self,
+        now: u32,
         replay_rows: u32,
         check_steps: u32,
         out: &mut dyn FnMut(&ToHost),
@@ -99,7 +107,7 @@ impl<const N: usize, const E: usize, const S: usize, A: Arith, const P: usize> W
             Self::Replay(run) => {
                 let mut ran = false;
                 for _ in 0..replay_rows {
-                    let (stepped, over) = run.step(out);
+                    let (stepped, over) = run.step(now, out);
                     ran |= stepped;
                     if over {
                         *self = Self::Idle;

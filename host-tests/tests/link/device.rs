@@ -1031,13 +1031,14 @@ fn a_replay_beyond_the_device_is_refused_naming_the_option() {
     );
     assert_eq!(r, ToHost::Nak(NakReason::Order));
     let mut run = mccs_firmware::link::ReplayRun::<NODES, EDGES, 64, mccs::Wide, P>::idle();
-    run.start(&spec(1000, [0.0; 3], None), table2(), false)
+    run.start(&spec(1000, [0.0; 3], None), table2(), false, 0, u32::MAX)
         .unwrap();
     for k in 0..P / PathPoint::PER_FRAME {
-        run.path((k * PathPoint::PER_FRAME) as u32, &chunk).unwrap();
+        run.path((k * PathPoint::PER_FRAME) as u32, &chunk, 0)
+            .unwrap();
     }
     assert_eq!(
-        run.path(P as u32, &chunk),
+        run.path(P as u32, &chunk, 0),
         Err(NakReason::Order),
         "past the credit"
     );

@@ -1,6 +1,7 @@
 //! The host link (`mccs-link`, docs/link.md): its codec here; the device's side of it in
 //! `device.rs` (its force gain over arbitrary runs in `guard.rs`, the whole device over
-//! arbitrary runs of the link in `any_run.rs`); the firmware in QEMU behind `mccs link`
+//! arbitrary runs of the link in `any_run.rs`; how a replay ends when its host does not see
+//! it through in `replay_ends.rs`); the firmware in QEMU behind `mccs link`
 //! in `qemu.rs`.
 
 mod any_run;
@@ -10,6 +11,7 @@ mod device;
 mod guard;
 mod messages;
 mod qemu;
+mod replay_ends;
 mod replies;
 mod rig;
 mod scene_api;

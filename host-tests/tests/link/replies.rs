@@ -162,3 +162,59 @@ fn a_refused_load_leaves_nothing_to_refuse_the_next() {
     }
     assert_eq!(device.load_tissue(&tissue).unwrap(), tissue.hash());
 }
+
+/// A device that ends a replay before its last row (it abandons one whose path does not
+/// come within `REPLAY_STARVED_MS`) fails the replay, naming the ticks it ran: its rows
+/// came back `Ok`, a replay cut short as if whole.
+#[test]
+fn a_replay_the_device_ends_early_is_an_error() {
+    let (hello, dir) = hello_and_dir("replay");
+    let socket = dir.join("replies-replay.sock");
+    scripted(&socket, move |m, now, _| match m {
+        ToDevice::Hello => now.push(ToHost::Hello(hello)),
+        ToDevice::Status => now.push(status(false)),
+        ToDevice::ReplayBegin(spec) => now.push(ToHost::ReplayCredit {
+            until: spec.samples,
+        }),
+        ToDevice::ReplayPath { first: 0, .. } => {
+            for tick in 0..3 {
+                now.push(ToHost::ReplayRow(mccs_link::ReplayRow {
+                    tick,
+                    ..Default::default()
+                }));
+            }
+            now.push(ToHost::ReplayEnd { ticks: 3 });
+        }
+        _ => {}
+    });
+    let device = Device::open(&format!("unix:{}", socket.display())).unwrap();
+    let text = "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n0.1,0,0,-1\n";
+    let path = mccs_client::trajectory::parse(text, "path.csv").unwrap();
+    let c = mccs::SolverConfig::default();
+    let spec = mccs_link::ReplaySpec {
+        grid: 5,
+        spacing_mm: 2.5,
+        tick_hz: 1000.0,
+        node_mass_kg: c.node_mass,
+        spring_damping: c.spring_damping,
+        coupling_stiffness: c.coupling.stiffness,
+        coupling_damping: c.coupling.damping,
+        max_force: c.coupling.max_force,
+        symplectic: false,
+        narrow: false,
+        samples: 0,
+        start: [0.0; 2],
+        roaming: None,
+    };
+    match device.replay(&path, spec, |_| {}) {
+        Err(e @ Error::Unexpected { .. }) => assert!(
+            e.to_string()
+                .contains("ended the replay after 3 of 101 ticks"),
+            "{e}"
+        ),
+        other => panic!(
+            "a replay ended after 3 ticks came back {:?}",
+            other.map(|r| r.len())
+        ),
+    }
+}
