@@ -3,7 +3,7 @@
 //! every refusal with its reason, the tissue check in slices and its budget, the byte
 //! budget of the streams, the run of overruns, and replays equal to the host's.
 
-use super::rig::{Rig, P};
+use super::rig::{replay_spec as spec, Rig, P};
 use haptic_f405::device::{EDGES, NODES};
 use haptic_f405::BOARD;
 use mccs::{Force, ForceTable64, Length, Params, SolverConfig, TissuePose};
@@ -884,25 +884,6 @@ fn device_replay(
         }
     }
     rows
-}
-
-fn spec(samples: u32, start: [f64; 3], roaming: Option<RoamSpec>) -> ReplaySpec {
-    let c = SolverConfig::default();
-    ReplaySpec {
-        grid: 5,
-        spacing_mm: 2.5,
-        tick_hz: 1000.0,
-        node_mass_kg: c.node_mass,
-        spring_damping: c.spring_damping,
-        coupling_stiffness: c.coupling.stiffness,
-        coupling_damping: c.coupling.damping,
-        max_force: c.coupling.max_force,
-        symplectic: false,
-        narrow: false,
-        samples,
-        start: [start[0], start[1]],
-        roaming,
-    }
 }
 
 #[test]

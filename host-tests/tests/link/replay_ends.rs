@@ -6,7 +6,7 @@
 
 use super::rig::Rig;
 use haptic_f405::BOARD;
-use mccs::{ForceTable64, Params, SolverConfig};
+use mccs::{ForceTable64, Params};
 use mccs_client::Tissue;
 use mccs_link::replay::PathPoint;
 use mccs_link::*;
@@ -16,22 +16,7 @@ fn table2() -> ForceTable64 {
 }
 
 fn spec(samples: u32) -> ReplaySpec {
-    let c = SolverConfig::default();
-    ReplaySpec {
-        grid: 5,
-        spacing_mm: 2.5,
-        tick_hz: 1000.0,
-        node_mass_kg: c.node_mass,
-        spring_damping: c.spring_damping,
-        coupling_stiffness: c.coupling.stiffness,
-        coupling_damping: c.coupling.damping,
-        max_force: c.coupling.max_force,
-        symplectic: false,
-        narrow: false,
-        samples,
-        start: [0.0; 2],
-        roaming: None,
-    }
+    super::rig::replay_spec(samples, [0.0; 3], None)
 }
 
 /// The device's ticks a replay waits for its path before it is abandoned.

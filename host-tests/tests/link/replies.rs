@@ -190,22 +190,7 @@ fn a_replay_the_device_ends_early_is_an_error() {
     let device = Device::open(&format!("unix:{}", socket.display())).unwrap();
     let text = "time_s,x_mm,y_mm,z_mm\n0,0,0,0\n0.1,0,0,-1\n";
     let path = mccs_client::trajectory::parse(text, "path.csv").unwrap();
-    let c = mccs::SolverConfig::default();
-    let spec = mccs_link::ReplaySpec {
-        grid: 5,
-        spacing_mm: 2.5,
-        tick_hz: 1000.0,
-        node_mass_kg: c.node_mass,
-        spring_damping: c.spring_damping,
-        coupling_stiffness: c.coupling.stiffness,
-        coupling_damping: c.coupling.damping,
-        max_force: c.coupling.max_force,
-        symplectic: false,
-        narrow: false,
-        samples: 0,
-        start: [0.0; 2],
-        roaming: None,
-    };
+    let spec = super::rig::replay_spec(0, [0.0; 3], None);
     match device.replay(&path, spec, |_| {}) {
         Err(e @ Error::Unexpected { .. }) => assert!(
             e.to_string()

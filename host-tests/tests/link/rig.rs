@@ -252,3 +252,28 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Rig<C> {
         panic!("no answer in {ticks} ticks; sent {:?}", self.out);
     }
 }
+
+/// A replay of `samples` on the standard 5-node patch at 1 kHz with the solver's
+/// defaults, its first sample at `start` (`x, y`, mm), glued or `roaming`.
+pub fn replay_spec(
+    samples: u32,
+    start: [f64; 3],
+    roaming: Option<mccs_link::RoamSpec>,
+) -> mccs_link::ReplaySpec {
+    let c = mccs::SolverConfig::default();
+    mccs_link::ReplaySpec {
+        grid: 5,
+        spacing_mm: 2.5,
+        tick_hz: 1000.0,
+        node_mass_kg: c.node_mass,
+        spring_damping: c.spring_damping,
+        coupling_stiffness: c.coupling.stiffness,
+        coupling_damping: c.coupling.damping,
+        max_force: c.coupling.max_force,
+        symplectic: false,
+        narrow: false,
+        samples,
+        start: [start[0], start[1]],
+        roaming,
+    }
+}
