@@ -17,10 +17,14 @@
 //!   check has run, its `Ack`, one for each load accepted and none for another); after
 //!   the run, a `Hello` still answered.
 //!
-//! Replays are left out (their stream interleaves with the answers; `device.rs` holds
-//! them to the host's replay).
+//! Replays run among them, glued on the standard 5-node patch, their path whole or cut
+//! short: each begun at once or refused `Busy` (a tissue's check under way), their rows
+//! numbered from 0, each end after as many rows as it says, and the last replay's end
+//! as its path says (its samples, or those it was sent once it has waited its limit for
+//! the next: `rates::REPLAY_STARVED_MS`). `device.rs` holds their rows to the host's
+//! replay.
 
-use super::rig::Rig;
+use super::rig::{replay_spec, Rig, P};
 use haptic_f405::device::{EDGES, NODES};
 use haptic_f405::BOARD;
 use mccs::Wide;
@@ -85,6 +89,8 @@ enum Op {
     FailRead,
     /// Ticks that overran, in a row.
     Overruns(u32),
+    /// A replay of so many samples, the first so many of its path sent.
+    Replay(u32, u32),
 }
 
 fn ops() -> impl Strategy<Value = Vec<Op>> {
@@ -134,6 +140,8 @@ fn ops() -> impl Strategy<Value = Vec<Op>> {
         4 => prop::collection::vec(1u8..=255, 0..40).prop_map(Op::Noise),
         1 => Just(Op::FailRead),
         1 => (1u32..12).prop_map(Op::Overruns),
+        1 => (0u32..=P as u32).prop_map(|n| Op::Replay(n, n)),
+        1 => (0u32..=P as u32, 0u32..=P as u32).prop_map(|(n, f)| Op::Replay(n, f.min(n))),
     ];
     prop::collection::vec(op, 1..64)
 }
@@ -170,6 +178,11 @@ enum Answer {
         refused: Option<NakReason>,
         hash: u32,
     },
+    /// A replay's begin and path (in so many pieces), then a `Status` as a fence: no
+    /// `Nak`, or `Busy` and an `Order` for each piece.
+    Replay {
+        pieces: usize,
+    },
 }
 
 /// The device under test and what the model expects of it.
@@ -196,6 +209,8 @@ struct Model<C: Contact<NODES, EDGES, 64, Wide>> {
     /// The guard's timeout and fade at the board's rate, ticks.
     timeout: u32,
     fade: u32,
+    /// The replays sent, in order: their samples and the samples of their path sent.
+    replays: Vec<(u32, u32)>,
 }
 
 fn tissues() -> &'static [Tissue; 2] {
@@ -243,6 +258,7 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
             watch: None,
             timeout: times.timeout,
             fade: times.fade,
+            replays: Vec::new(),
         }
     }
 
@@ -534,7 +550,34 @@ impl<C: Contact<NODES, EDGES, 64, Wide>> Model<C> {
                 self.step(false);
             }
             Op::Overruns(n) => (0..*n).for_each(|_| self.step(true)),
+            Op::Replay(samples, fed) => self.replay(*samples, *fed),
         }
+    }
+
+    /// A replay of `samples` on the standard patch, the first `fed` of its path sent (the
+    /// probe at the tissue's surface, then pressing in), then a `Status`.
+    fn replay(&mut self, samples: u32, fed: u32) {
+        let mut frames = vec![ToDevice::ReplayBegin(replay_spec(samples, [0.0; 3], None))];
+        let points: Vec<[u8; 12]> = (0..fed)
+            .map(|k| replay::PathPoint([0, 0, -(k as i32) << 18]).to_bytes())
+            .collect();
+        let pieces: Vec<Vec<u8>> = points
+            .chunks(replay::PathPoint::PER_FRAME)
+            .map(|c| c.concat())
+            .collect();
+        for (i, piece) in pieces.iter().enumerate() {
+            frames.push(ToDevice::ReplayPath {
+                first: (i * replay::PathPoint::PER_FRAME) as u32,
+                points: piece,
+            });
+        }
+        frames.push(ToDevice::Status);
+        self.send(&frames);
+        self.framed();
+        self.replays.push((samples, fed));
+        self.answers.push(Answer::Replay {
+            pieces: pieces.len(),
+        });
     }
 }
 
@@ -556,17 +599,24 @@ fn refusal(p: &Pose) -> Option<NakReason> {
     ((n2 - (1i128 << 60)).abs() > 1i128 << 50).then_some(NakReason::Rotation)
 }
 
-/// The device's answers held to the model's, in order; the acknowledgements apart.
-fn check_answers(out: &[ToHost], want: &[Answer]) {
+/// The device's answers held to the model's, in order; the acknowledgements and the
+/// replays' streams apart. Whether each replay was begun, in order.
+fn check_answers(out: &[ToHost], want: &[Answer]) -> Vec<bool> {
     let mut got = out
         .iter()
         .filter(|m| {
             !matches!(
                 m,
-                ToHost::Telemetry(_) | ToHost::Mesh(_) | ToHost::Ack { .. }
+                ToHost::Telemetry(_)
+                    | ToHost::Mesh(_)
+                    | ToHost::Ack { .. }
+                    | ToHost::ReplayCredit { .. }
+                    | ToHost::ReplayRow(_)
+                    | ToHost::ReplayEnd { .. }
             )
         })
         .peekable();
+    let mut begun = Vec::new();
     let mut acks_due = Vec::new();
     for (i, w) in want.iter().enumerate() {
         let next = got.next();
@@ -595,24 +645,21 @@ fn check_answers(out: &[ToHost], want: &[Answer]) {
                 );
             }
             (Answer::Load { refused, hash }, first) => {
-                // Its refusals, then the fence's status.
-                let mut naks = Vec::new();
-                let mut m = first;
-                while let Some(ToHost::Nak(r)) = m {
-                    naks.push(*r);
-                    m = got.next();
-                }
-                assert!(
-                    matches!(m, Some(ToHost::Status(_))),
-                    "{}: then {m:?}",
-                    fail()
-                );
+                let naks = naks_to_fence(first, &mut got, &fail());
                 match (refused, naks.first()) {
                     (None, None) => acks_due.push(*hash),
                     (_, Some(NakReason::Busy)) => {}
                     (Some(r), Some(n)) => assert_eq!(r, n, "{}: {naks:?}", fail()),
                     _ => panic!("{}: {naks:?}", fail()),
                 }
+            }
+            (Answer::Replay { pieces }, first) => {
+                let naks = naks_to_fence(first, &mut got, &fail());
+                let busy: Vec<NakReason> = std::iter::once(NakReason::Busy)
+                    .chain(std::iter::repeat_n(NakReason::Order, *pieces))
+                    .collect();
+                assert!(naks.is_empty() || naks == busy, "{}: {naks:?}", fail());
+                begun.push(naks.is_empty());
             }
             _ => panic!("{}", fail()),
         }
@@ -627,6 +674,77 @@ fn check_answers(out: &[ToHost], want: &[Answer]) {
         })
         .collect();
     assert_eq!(acks, acks_due, "the acknowledgements");
+    begun
+}
+
+/// The `Nak`s from `first` on, then the fence's `Status` (a load's or a replay's).
+fn naks_to_fence<'a>(
+    first: Option<&'a ToHost>,
+    got: &mut impl Iterator<Item = &'a ToHost>,
+    at: &str,
+) -> Vec<NakReason> {
+    let mut naks = Vec::new();
+    let mut m = first;
+    while let Some(ToHost::Nak(r)) = m {
+        naks.push(*r);
+        m = got.next();
+    }
+    assert!(matches!(m, Some(ToHost::Status(_))), "{at}: then {m:?}");
+    naks
+}
+
+/// The replays' rows and ends: a replay's rows numbered from 0, each end after as many
+/// rows as it says (or none: a replay begun and abandoned before a row is not seen
+/// until its end); the last replay begun, `last` (its samples and the samples of its
+/// path sent), ended last, after its path's rows.
+fn check_replays(out: &[ToHost], last: Option<(u32, u32)>) {
+    let stream: Vec<&ToHost> = out
+        .iter()
+        .filter(|m| matches!(m, ToHost::ReplayRow(_) | ToHost::ReplayEnd { .. }))
+        .collect();
+    let mut rows = 0;
+    for m in &stream {
+        match m {
+            ToHost::ReplayRow(r) => {
+                assert!(r.tick == rows || r.tick == 0, "row {} after {rows}", r.tick);
+                rows = r.tick + 1;
+            }
+            ToHost::ReplayEnd { ticks } => {
+                assert!(
+                    *ticks == rows || *ticks == 0,
+                    "an end of {ticks} after {rows} rows"
+                );
+                rows = 0;
+            }
+            _ => unreachable!(),
+        }
+    }
+    let Some((samples, fed)) = last else {
+        return;
+    };
+    // Its whole path, or what it was sent once it waited its limit for the next.
+    let ran = fed.min(samples);
+    let tail = stream.len().checked_sub(ran as usize + 1);
+    let tail = tail.map(|t| &stream[t..]);
+    let want: Vec<Option<u32>> = (0..ran).map(Some).chain([None]).collect();
+    let seen: Option<Vec<Option<u32>>> = tail.map(|t| {
+        t.iter()
+            .map(|m| match m {
+                ToHost::ReplayRow(r) => Some(r.tick),
+                _ => None,
+            })
+            .collect()
+    });
+    assert_eq!(
+        seen.as_ref(),
+        Some(&want),
+        "the last replay ({samples} samples, {fed} sent)"
+    );
+    assert!(
+        matches!(stream.last(), Some(ToHost::ReplayEnd { ticks }) if *ticks == ran),
+        "the last replay's end: {:?}, {ran} ticks",
+        stream.last()
+    );
 }
 
 proptest! {
@@ -664,11 +782,26 @@ fn run<C: Contact<NODES, EDGES, 64, Wide>>(
         spare -= 1;
     }
     prop_assert!(spare > 0, "a tissue check never ended");
+    // And a replay's rows, or its wait for a path that does not come.
+    if !model.replays.is_empty() {
+        let limit = BOARD.tick_hz * rates::REPLAY_STARVED_MS / 1000;
+        for _ in 0..limit + P as u32 + 2 {
+            model.step(false);
+        }
+    }
     model.message(&Msg::Hello);
     for _ in 0..3 {
         model.step(false);
     }
-    check_answers(&model.rig.out, &model.answers);
+    let begun = check_answers(&model.rig.out, &model.answers);
+    let last = model
+        .replays
+        .iter()
+        .zip(&begun)
+        .filter(|(_, b)| **b)
+        .map(|(r, _)| *r)
+        .next_back();
+    check_replays(&model.rig.out, last);
     check_telemetry(&model);
     Ok(())
 }
