@@ -198,9 +198,27 @@ fn black_box(device: &Device, out: &mut dyn Write) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Opens the device; every failure one line (exit 2).
+/// How long `open` waits for the device's hello before it says that it waits.
+const SAY_WAITING: Duration = Duration::from_secs(4);
+
+/// Opens the device; every failure one line (exit 2). A device that has not answered
+/// its hello within [`SAY_WAITING`] (another host holds it, or it is not one) gets a
+/// line saying the command waits for it, and for how long at most.
 pub(super) fn open(addr: &str) -> Result<Device, CliError> {
-    Device::open(addr).map_err(|e| match e {
+    let (opened, waiting) = std::sync::mpsc::channel::<()>();
+    let name = mccs_client::shown::ShownName(addr).to_string();
+    let most = mccs_client::Options::default().hello_timeout.as_secs();
+    let say = std::thread::spawn(move || {
+        if waiting.recv_timeout(SAY_WAITING) == Err(std::sync::mpsc::RecvTimeoutError::Timeout) {
+            eprintln!(
+                "mccs: waiting for {name} to answer hello ({most} s at most; a view or a scene may hold it)"
+            );
+        }
+    });
+    let device = Device::open(addr);
+    drop(opened);
+    let _ = say.join();
+    device.map_err(|e| match e {
         Error::Address { .. } | Error::Connect { .. } => arg_error("--connect", &e.to_string()),
         e => device_error(e),
     })

@@ -446,3 +446,34 @@ fn blackbox_reads_the_last_run_back_part_by_part() {
     );
     assert!(rows.iter().all(|r| r.split(',').nth(10) == Some("1.00000")));
 }
+
+/// A device that does not answer its hello (another host holds it, or it is not one):
+/// `mccs link` says that it waits, and for how long at most, before the error at the
+/// end of its wait; it was silent for the whole 10 s. (The run is ended once the line
+/// has come.)
+#[test]
+fn a_silent_device_is_waited_for_out_loud() {
+    use std::io::BufRead;
+    let dir = std::env::temp_dir().join(format!("mccs-link-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let socket = dir.join("silent.sock");
+    let _ = std::fs::remove_file(&socket);
+    let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    let addr = format!("unix:{}", socket.display());
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mccs"))
+        .args(["link", "--connect", &addr, "hello"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    std::io::BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(
+        first,
+        format!("mccs: waiting for {addr} to answer hello (10 s at most; a view or a scene may hold it)\n")
+    );
+}
