@@ -89,8 +89,8 @@ impl<const NODES: usize, const EDGES: usize, const S: usize, A: Arith, const P: 
     /// Starts a replay of `spec` on `table` in this run (abandoning the one under way);
     /// `narrow`: whether `A` is the narrow arithmetic (what a spec must ask for); `now`
     /// the link's tick, `patience` the ticks it waits for its path's next sample
-    /// ([`mccs_link::rates::REPLAY_STARVED_MS`]). On a refusal the run replays nothing. Out of line: the solver is built on this frame
-    /// alone, and into its place.
+    /// ([`mccs_link::rates::REPLAY_STARVED_MS`]). On a refusal the run replays nothing.
+    /// Out of line: the solver is built on this frame alone, and into its place.
     #[inline(never)]
     pub fn start(
         &mut self,

@@ -3,7 +3,7 @@
 //! every refusal with its reason, the tissue check in slices and its budget, the byte
 //! budget of the streams, the run of overruns, and replays equal to the host's.
 
-use super::rig::{replay_spec as spec, Rig, P};
+use super::rig::{load, replay_spec as spec, Rig, P};
 use haptic_f405::device::{EDGES, NODES};
 use haptic_f405::BOARD;
 use mccs::{Force, ForceTable64, Length, Params, SolverConfig, TissuePose};
@@ -158,30 +158,6 @@ fn the_pose_moves_at_its_limits_and_maps_the_probe_and_the_force() {
             assert!((fd[i] - want).abs() < 1e-5, "{fd:?}");
         }
     }
-}
-
-/// Sends `t` to the rig as a host does, proposing `substeps` (0: none); the answer.
-fn load<C: mccs_firmware::Contact<NODES, EDGES, 64, mccs::Wide>>(
-    rig: &mut Rig<C>,
-    t: &Tissue,
-    substeps: u16,
-    hash: u32,
-) -> ToHost {
-    rig.send(&ToDevice::TissueBegin(TissueBegin {
-        segments: t.segments(),
-        len: t.bytes().len() as u32,
-        hash,
-        friction: t.friction(),
-        substeps,
-    }));
-    for (i, c) in t.bytes().chunks(TISSUE_CHUNK).enumerate() {
-        rig.send(&ToDevice::TissueChunk {
-            offset: (i * TISSUE_CHUNK) as u32,
-            bytes: c,
-        });
-    }
-    rig.send(&ToDevice::TissueCommit);
-    rig.wait(20_000, |m| matches!(m, ToHost::Ack { .. }))
 }
 
 #[test]

@@ -28,21 +28,21 @@ fn starved_ticks() -> u32 {
 /// refusal).
 fn load(rig: &mut Rig<mccs_firmware::Glued>) -> ToHost {
     let t = Tissue::from_params(&Params::TABLE2).unwrap();
-    rig.send(&ToDevice::TissueBegin(TissueBegin {
-        segments: t.segments(),
-        len: t.bytes().len() as u32,
-        hash: t.hash(),
-        friction: None,
-        substeps: 0,
-    }));
-    for (i, c) in t.bytes().chunks(TISSUE_CHUNK).enumerate() {
-        rig.send(&ToDevice::TissueChunk {
-            offset: (i * TISSUE_CHUNK) as u32,
-            bytes: c,
-        });
+    super::rig::load(rig, &t, 0, t.hash())
+}
+
+/// The replay's rows (their ticks) and its end (its ticks) the device sent since the
+/// last call.
+fn replayed(rig: &mut Rig<mccs_firmware::Glued>) -> (Vec<u32>, Option<u32>) {
+    let (mut rows, mut end) = (Vec::new(), None);
+    for m in rig.out.drain(..) {
+        match m {
+            ToHost::ReplayRow(r) => rows.push(r.tick),
+            ToHost::ReplayEnd { ticks } => end = Some(ticks),
+            _ => {}
+        }
     }
-    rig.send(&ToDevice::TissueCommit);
-    rig.wait(20_000, |m| matches!(m, ToHost::Ack { .. }))
+    (rows, end)
 }
 
 /// `n` path samples from `first` on, the probe 1 mm into the tissue.
@@ -76,25 +76,19 @@ fn a_replay_whose_path_stops_coming_is_abandoned_and_loads_are_taken_again() {
     path(&mut rig, 0, 10);
     let starved = starved_ticks();
     // Its ten rows, then nothing until it has waited its limit for the eleventh sample.
-    let (mut rows, mut end) = (0, None);
+    let (mut rows, mut end) = (Vec::new(), None);
     for tick in 0..starved + 20 {
         rig.step();
-        for m in rig.out.drain(..) {
-            match m {
-                ToHost::ReplayRow(r) => {
-                    assert_eq!(r.tick, rows);
-                    rows += 1;
-                }
-                ToHost::ReplayEnd { ticks } => end = Some((ticks, tick)),
-                _ => {}
-            }
-        }
-        if end.is_some() {
+        let (r, e) = replayed(&mut rig);
+        rows.extend(r);
+        if let Some(ticks) = e {
+            end = Some((ticks, tick));
             break;
         }
     }
     let (ticks, at) = end.expect("the starved replay never ended");
-    assert_eq!((rows, ticks), (10, 10));
+    assert_eq!(rows, (0..10).collect::<Vec<u32>>());
+    assert_eq!(ticks, 10);
     assert!(
         (starved..starved + 10).contains(&at),
         "ended at tick {at}, its limit {starved} ticks"
@@ -115,19 +109,15 @@ fn a_replay_fed_within_the_limit_runs_to_its_end() {
     rig.ask(&ToDevice::ReplayBegin(spec(6)), 5, |m| {
         matches!(m, ToHost::ReplayCredit { .. })
     });
-    let mut rows = 0;
+    let mut rows = Vec::new();
     for k in 0..6 {
         path(&mut rig, k, 1);
         for _ in 0..starved_ticks() - 5 {
             rig.step();
         }
-        for m in rig.out.drain(..) {
-            match m {
-                ToHost::ReplayRow(_) => rows += 1,
-                ToHost::ReplayEnd { ticks } => assert_eq!((k, ticks), (5, 6)),
-                _ => {}
-            }
-        }
+        let (r, end) = replayed(&mut rig);
+        rows.extend(r);
+        assert_eq!(end, (k == 5).then_some(6), "after sample {k}");
     }
-    assert_eq!(rows, 6);
+    assert_eq!(rows, (0..6).collect::<Vec<u32>>());
 }

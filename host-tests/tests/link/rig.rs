@@ -11,7 +11,8 @@ use mccs_firmware::link::{
 };
 use mccs_firmware::{Contact, Controller, Glued, HapticDevice};
 use mccs_link::{
-    encode, parse, ContactKind, Core, Decoder, DeviceKind, ToDevice, ToHost, MAX_FRAME,
+    encode, parse, ContactKind, Core, Decoder, DeviceKind, TissueBegin, ToDevice, ToHost,
+    MAX_FRAME, TISSUE_CHUNK,
 };
 use std::collections::VecDeque;
 
@@ -276,4 +277,28 @@ pub fn replay_spec(
         start: [start[0], start[1]],
         roaming,
     }
+}
+
+/// Sends `t` to the rig as a host does, proposing `substeps` (0: none); the answer.
+pub fn load<C: Contact<NODES, EDGES, 64, Wide>>(
+    rig: &mut Rig<C>,
+    t: &mccs_client::Tissue,
+    substeps: u16,
+    hash: u32,
+) -> ToHost {
+    rig.send(&ToDevice::TissueBegin(TissueBegin {
+        segments: t.segments(),
+        len: t.bytes().len() as u32,
+        hash,
+        friction: t.friction(),
+        substeps,
+    }));
+    for (i, c) in t.bytes().chunks(TISSUE_CHUNK).enumerate() {
+        rig.send(&ToDevice::TissueChunk {
+            offset: (i * TISSUE_CHUNK) as u32,
+            bytes: c,
+        });
+    }
+    rig.send(&ToDevice::TissueCommit);
+    rig.wait(20_000, |m| matches!(m, ToHost::Ack { .. }))
 }
