@@ -1,7 +1,7 @@
 //! `mccs arm`: the 3-DOF arm's kinematics and torques on the host, in the fixed point the
 //! firmware runs (default) or the `f64` twin (docs/arm.md).
 
-use super::{arg_error, io_error, Backend, CliError};
+use super::{arg_error, io_error, CliError};
 use crate::arm::gravity_fit::{self, HeldPose};
 use crate::arm::{columns, device_file, ArmTwin};
 use mccs::{Arm, Force};
@@ -15,6 +15,16 @@ pub(super) struct Args {
     command: Command,
 }
 
+/// Which arm computes: the `--backend` of `fk` and `torque` (the law's `Backend`
+/// names a force table, which the arm's kinematics do not use).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ArmBackend {
+    /// The arm's f64 twin (host only).
+    Reference,
+    /// The core's fixed-point kinematics and torques, as the firmware computes them.
+    Fixed,
+}
+
 #[derive(clap::Subcommand, Debug)]
 enum Command {
     /// The probe in the device frame, CSV `x_mm,y_mm,z_mm`, for each row of joint counts.
@@ -22,12 +32,12 @@ enum Command {
         /// The device file (docs/arm.md; devices/woodenhaptics.toml).
         #[arg(long)]
         device: PathBuf,
-        /// CSV `count_a,count_b,count_c` (whole numbers).
+        /// A CSV file of joint counts, `count_a,count_b,count_c` a row (whole numbers).
         #[arg(long)]
         counts: PathBuf,
         /// Fixed point, as the firmware computes it, or the f64 twin.
-        #[arg(long, value_enum, default_value_t = Backend::Fixed)]
-        backend: Backend,
+        #[arg(long, value_enum, default_value_t = ArmBackend::Fixed)]
+        backend: ArmBackend,
     },
     /// The joints' torques before saturation (Jᵀ F + gravity, N·m) and the duties after
     /// it, CSV `tau_a_nm,tau_b_nm,tau_c_nm,duty_a,duty_b,duty_c`, for each row of counts
@@ -36,12 +46,12 @@ enum Command {
         /// The device file.
         #[arg(long)]
         device: PathBuf,
-        /// CSV `count_a,count_b,count_c,fx_n,fy_n,fz_n`.
+        /// A CSV file of counts and forces, `count_a,count_b,count_c,fx_n,fy_n,fz_n` a row.
         #[arg(long)]
         input: PathBuf,
         /// Fixed point, as the firmware computes it, or the f64 twin.
-        #[arg(long, value_enum, default_value_t = Backend::Fixed)]
-        backend: Backend,
+        #[arg(long, value_enum, default_value_t = ArmBackend::Fixed)]
+        backend: ArmBackend,
     },
     /// The arm's masses from static poses: prints `GRAVITY upper_arm_mass_kg=…
     /// forearm_mass_kg=… g_b_nmm=… g_c_nmm=… offset_duty_b=… offset_duty_c=…
@@ -192,7 +202,12 @@ fn load(device: &Path) -> Result<(Arm, ArmTwin), CliError> {
 }
 
 /// `mccs arm fk`.
-fn fk(device: &Path, counts: &Path, backend: Backend, out: &mut dyn Write) -> Result<(), CliError> {
+fn fk(
+    device: &Path,
+    counts: &Path,
+    backend: ArmBackend,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
     let (arm, twin) = load(device)?;
     let rows = rows(counts, &["count_a", "count_b", "count_c"])?;
     let mut w = std::io::BufWriter::new(out);
@@ -200,8 +215,8 @@ fn fk(device: &Path, counts: &Path, backend: Backend, out: &mut dyn Write) -> Re
     for r in rows {
         let c = [r[0], r[1], r[2]];
         let p = match backend {
-            Backend::Fixed => arm.pose(c.map(|x| x as i32)).device_mm(),
-            Backend::Reference => twin.fk(twin.angles(c)),
+            ArmBackend::Fixed => arm.pose(c.map(|x| x as i32)).device_mm(),
+            ArmBackend::Reference => twin.fk(twin.angles(c)),
         };
         writeln!(w, "{},{},{}", p[0], p[1], p[2]).map_err(io_error)?;
     }
@@ -212,7 +227,7 @@ fn fk(device: &Path, counts: &Path, backend: Backend, out: &mut dyn Write) -> Re
 fn torque(
     device: &Path,
     input: &Path,
-    backend: Backend,
+    backend: ArmBackend,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
     let (arm, twin) = load(device)?;
@@ -226,7 +241,7 @@ fn torque(
         let c = [r[0], r[1], r[2]];
         let f = [r[3], r[4], r[5]];
         let (tau, duty) = match backend {
-            Backend::Fixed => {
+            ArmBackend::Fixed => {
                 let d = arm.drive(
                     &arm.pose(c.map(|x| x as i32)),
                     f.map(Force::saturating_from_num),
@@ -236,7 +251,7 @@ fn torque(
                     d.duty_q16.map(|x| x as f64 / 65_536.0),
                 )
             }
-            Backend::Reference => {
+            ArmBackend::Reference => {
                 let t = twin.torque(twin.angles(c), f);
                 (t.map(|x| x / 1000.0), twin.duties(t).0)
             }

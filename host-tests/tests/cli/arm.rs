@@ -171,6 +171,27 @@ fn bad_rows_are_named() {
     );
 }
 
+/// The arm's `--backend` values say what they compute: its kinematics, fixed or f64;
+/// they once read as the law's (a "force table", which the arm does not use).
+#[test]
+fn the_arms_backends_are_described_as_the_arms() {
+    for sub in ["fk", "torque"] {
+        let out = mccs(&["arm", sub, "--help"]);
+        assert!(out.status.success());
+        let help = String::from_utf8(out.stdout).unwrap();
+        assert!(
+            help.contains("fixed:     The core's fixed-point kinematics and torques")
+                && help.contains("reference: The arm's f64 twin")
+                && !help.contains("table"),
+            "mccs arm {sub} --help:\n{help}"
+        );
+        assert!(
+            help.contains("A CSV file of "),
+            "mccs arm {sub} --help:\n{help}"
+        );
+    }
+}
+
 #[test]
 fn both_backends_agree() {
     let d = "devices/woodenhaptics.toml";
