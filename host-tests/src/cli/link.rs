@@ -101,7 +101,13 @@ enum Command {
     },
 }
 
+/// (`--backend` is `mccs replay`'s, shared through `PatchArgs`: here the device's core
+/// runs, so it is left out of the help, and any value but its default is refused; the
+/// grid's and arithmetic's help name the device's limits, not that flag.)
 #[derive(clap::Args, Debug)]
+#[command(mut_arg("backend", |a| a.hide(true)))]
+#[command(mut_arg("grid", |a| a.help("Surface nodes per side, N (3 … the device's `grid` in `mccs link hello`)")))]
+#[command(mut_arg("arith", |a| a.help("Arithmetic of the device's core (it runs one, `core` in `mccs link hello`, and refuses the other)")))]
 struct ReplayArgs {
     /// Probe trajectory, CSV `time_s,x_mm,y_mm,z_mm`.
     #[arg(long)]
@@ -119,13 +125,19 @@ pub(super) fn run(a: Args, out: &mut dyn Write) -> Result<(), CliError> {
     mccs_client::Addr::parse(&a.connect).map_err(|e| arg_error("--connect", e))?;
     match &a.command {
         Command::Replay(r) => {
-            r.patch.check()?;
             if r.patch.backend != Backend::Reference {
                 return Err(arg_error(
                     "--backend",
                     "a link replay runs the device's core: leave it out",
                 ));
             }
+            // The device runs the fixed-point core: its arguments are checked as
+            // `mccs replay --backend fixed`'s (`--arith` among them).
+            PatchArgs {
+                backend: Backend::Fixed,
+                ..r.patch
+            }
+            .check()?;
         }
         Command::Watch { seconds, every } | Command::Mesh { seconds, every } => {
             stream_args(*seconds, *every)?

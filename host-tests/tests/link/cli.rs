@@ -177,6 +177,7 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
             "--node-mass",
             "8",
         ][..],
+        &["--arith", "wide"][..],
     ] {
         let mut host = vec![
             "replay",
@@ -213,6 +214,11 @@ fn a_link_replay_prints_the_hosts_fixed_replay() {
         (
             &["--arith", "narrow", "--backend", "fixed"][..],
             "--backend: a link replay runs the device's core",
+        ),
+        // (Checked by the device, where `--arith` was refused before it was sent.)
+        (
+            &["--arith", "narrow"][..],
+            "the device runs one arithmetic (wide)",
         ),
         (
             &["--tissue", "64,64", "--cap-radius", "300"][..],
