@@ -382,6 +382,11 @@ type ArmPoses = (mccs::Arm, Vec<mccs::ArmPose>);
 /// counts, and its pose for the duties).
 fn probe_motion(a: &Args) -> Result<(trajectory::Trajectory, Option<ArmPoses>), CliError> {
     match (&a.probe, &a.joints, &a.device) {
+        // (clap's `requires = "joints"` on --device did not hold beside --probe.)
+        (Some(_), _, Some(_)) => Err(arg_error(
+            "--device",
+            "only with --joints (a --probe trajectory needs no arm)",
+        )),
         (Some(p), _, _) => Ok((
             trajectory::read(p).map_err(|e| CliError::new(e.to_string()))?,
             None,

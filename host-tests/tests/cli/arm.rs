@@ -351,6 +351,22 @@ fn a_joint_space_replay_is_the_cartesian_replay_at_the_fixed_kinematics() {
     assert!(pressed > 100, "{pressed} ticks in contact");
 }
 
+/// `--device` without `--joints` is refused, not ignored: a `--probe` replay with it
+/// once ran as if it were not there.
+#[test]
+fn a_device_without_joints_is_refused() {
+    let out = mccs(&[
+        "replay",
+        "--params",
+        "params/table2.toml",
+        "--probe",
+        "params/palpation.csv",
+        "--device",
+        "devices/woodenhaptics.toml",
+    ]);
+    assert_one_line_error(&out, &["--device: only with --joints"]);
+}
+
 /// `count_a,count_b,count_c,duty_b,duty_c` rows of `n` poses held still by the arm
 /// `truth`, spread over B's and C's ranges (5° inside them), each duty off by up to
 /// `noise` (a fixed pseudo-random draw).
