@@ -382,7 +382,9 @@ type ArmPoses = (mccs::Arm, Vec<mccs::ArmPose>);
 /// counts, and its pose for the duties).
 fn probe_motion(a: &Args) -> Result<(trajectory::Trajectory, Option<ArmPoses>), CliError> {
     match (&a.probe, &a.joints, &a.device) {
-        // (clap's `requires = "joints"` on --device did not hold beside --probe.)
+        // (clap's `requires = "joints"` on --device does not hold here: clap drops a
+        // requirement whose argument conflicts with one given, and --joints conflicts
+        // with --probe.)
         (Some(_), _, Some(_)) => Err(arg_error(
             "--device",
             "only with --joints (a --probe trajectory needs no arm)",
